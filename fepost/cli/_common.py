@@ -1,0 +1,60 @@
+"""Options and helpers shared by the subcommands."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import ArgumentError
+from ..polar import DEFAULT_NPHI, DEFAULT_NR, PolarGrid
+
+
+def repo_meshes() -> Path:
+    """The sample meshes folder shipped beside the package (``<repo>/meshes``)."""
+    return Path(__file__).resolve().parents[2] / "meshes"
+
+
+def sample_mesh(name: str) -> Path:
+    """Path of a shipped sample mesh; a one-line error if it is missing."""
+    p = repo_meshes() / name
+    if not p.is_file():
+        raise ArgumentError(f"{p}: sample mesh not found (give the FE exports explicitly)")
+    return p
+
+
+def add_input_options(p: argparse.ArgumentParser) -> None:
+    """Reading, patch and grid options common to commands that read FE exports."""
+    g = p.add_argument_group("reading and resampling")
+    g.add_argument("--field", metavar="NAME", help="contact-pressure array (NAME:K for component K)")
+    g.add_argument("--step", type=int, metavar="N", help="Exodus time step (default: last)")
+    g.add_argument(
+        "--displacement",
+        default="auto",
+        metavar="NAME",
+        help="nodal displacement array added to the coordinates ('auto' default, 'none' to skip)",
+    )
+    g.add_argument("--rolling-axis", metavar="X,Y,Z", help="global rolling direction (default 1,0,0)")
+    g.add_argument("--threshold", type=float, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
+    g.add_argument("--nr", type=int, default=DEFAULT_NR, help=f"radial grid nodes (default {DEFAULT_NR})")
+    g.add_argument("--nphi", type=int, default=DEFAULT_NPHI, help=f"angular grid nodes (default {DEFAULT_NPHI})")
+    g.add_argument("--rule", choices=("gauss", "trapezoid"), default="gauss", help="radial quadrature rule")
+
+
+def analysis_kwargs(args: argparse.Namespace) -> dict:
+    axis = None
+    if args.rolling_axis:
+        try:
+            axis = tuple(float(v) for v in args.rolling_axis.split(","))
+        except ValueError:
+            raise ArgumentError(f"--rolling-axis must be three numbers X,Y,Z, got {args.rolling_axis!r}") from None
+        if len(axis) != 3:
+            raise ArgumentError(f"--rolling-axis must be three numbers X,Y,Z, got {args.rolling_axis!r}")
+    disp = None if str(args.displacement).lower() == "none" else args.displacement
+    return {
+        "field": args.field,
+        "step": args.step,
+        "displacement": disp,
+        "grid": PolarGrid.make(args.nr, args.nphi, args.rule),
+        "threshold": args.threshold,
+        "rolling_axis": axis,
+    }

@@ -1,0 +1,73 @@
+"""``fepost coefficients STATIC [--rolling ROLLING] [--field NAME] [--friction F] [--json PATH]``."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..analysis import Analysis, analyse
+from ..output import write_json_atomic
+from ._common import add_input_options, analysis_kwargs
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "coefficients",
+        help="patch, circularity and friction-model coefficients of an FE contact map",
+        description="Compute the contact patch and the coefficients of THEORY.md sections 1-2.",
+    )
+    p.add_argument("static", metavar="STATIC", help="static contact map (.vtu .vtk .vtp .e .exo)")
+    p.add_argument("--rolling", metavar="ROLLING", help="rolling contact map at the same deflection")
+    p.add_argument("--friction", type=float, default=0.3, metavar="F", help="friction coefficient f (default 0.3)")
+    p.add_argument("--json", metavar="PATH", help="write the coefficients as JSON")
+    add_input_options(p)
+    p.set_defaults(func=run)
+
+
+def format_analysis(a: Analysis) -> str:
+    """A readable table of the patch and the coefficients."""
+    c, p = a.coefficients, a.static_patch
+    rows = [
+        ("static map", f"{a.static_field.source}  [{a.static_field.field}, {p.location} data]"),
+        ("normal load N (polar)", f"{c.N:.6g} N"),
+        ("normal load N_fe (FE faces)", f"{p.N_fe:.6g} N  (differs by {c.N / p.N_fe - 1:+.2e})"),
+    ]
+    if p.reaction_z is not None:
+        rows.append(("solver reaction", f"{p.reaction_z:.6g} N  (N/reaction - 1 = {c.N / p.reaction_z - 1:+.2%})"))
+    o = p.frame.origin
+    rows += [
+        ("patch centre (global)", f"({o[0]:.5g}, {o[1]:.5g}, {o[2]:.5g}) m"),
+        ("patch normal", "(" + ", ".join(f"{v:.4f}" for v in p.frame.axes[2]) + ")"),
+        ("R = r_max", f"{c.R:.6g} m"),
+        ("r_equiv", f"{p.r_equiv:.6g} m"),
+        ("ellipse semi-axes", f"{p.ellipse_axes[0]:.5g} x {p.ellipse_axes[1]:.5g} m, aspect {p.aspect:.4f}"),
+        ("load outside r_equiv", f"{p.load_outside:.2%}"),
+        ("circular", f"{'yes' if p.circular else 'NO'}  ({p.to_dict()['circular_rule']})"),
+        ("A0..A3", ", ".join(f"{v:.6g}" for v in c.A) + " Pa"),
+        ("f", f"{c.f:g}"),
+        ("F0", f"{c.F0:.6g} N"),
+        ("M0", f"{c.M0:.6g} N m"),
+        ("a", f"{c.a:.6g}   (aR^2 = {c.a * c.R**2:.6g} m^2)"),
+        ("m", f"{c.m:.6g}   (m/R^2 = {c.m / c.R**2:.6g} 1/m^2)"),
+        ("b = m/4", f"{c.b:.6g}"),
+        ("b1 = M0/2", f"{c.b1:.6g} N m"),
+    ]
+    if c.k_x is not None:
+        rows += [
+            ("rolling map", f"{a.rolling_field.source}"),
+            ("x_c (rolling CoP shift)", f"{c.x_c:.6g} m"),
+            ("k_x", f"{c.k_x:.6g}"),
+        ]
+    g = a.grid
+    rows.append(("polar grid", f"{g.rule}, {g.shape[0]} x {g.shape[1]} (r x phi)"))
+    width = max(len(k) for k, _ in rows)
+    lines = [f"{k:<{width}}  {v}" for k, v in rows]
+    lines += [f"note: {n}" for n in p.notes]
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
+    print(format_analysis(result))
+    if args.json:
+        write_json_atomic(args.json, result.to_dict())
+    return 0

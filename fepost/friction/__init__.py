@@ -1,0 +1,1 @@
+"""Friction resultants of a pressure map: exact Coulomb integrals and the paper's closed forms."""

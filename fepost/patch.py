@@ -1,0 +1,476 @@
+"""The contact patch: loaded region, ground plane, frame and circularity check.
+
+Definitions (THEORY.md §1)
+--------------------------
+* **Loaded**: a face is loaded when the FE pressure exceeds the threshold
+  somewhere on it: for nodal data when one of its nodes does, for face data
+  when its value does. The threshold is ``threshold`` × the peak pressure
+  (default :data:`DEFAULT_THRESHOLD` = 1e-6, i.e. essentially "non-zero").
+* **Plane**: least-squares plane through the nodes with pressure above the
+  threshold (SVD). Its normal is the road normal z, oriented to have a
+  positive component along the global axis it is closest to (z-up and y-up
+  models both come out with z pointing up).
+* **Frame**: origin = static centre of pressure (exact integral over the FE
+  faces), x = the rolling axis projected on the plane (default: global x),
+  y = z × x.
+* **R** = ``r_max``: largest in-plane distance from the origin of a node of a
+  loaded face (the support of the FE field). ``r_equiv`` = √(area/π) with the
+  area of the loaded faces.
+* **Circularity**: best-fit ellipse from the second area moments of the
+  loaded faces (a uniform ellipse of semi-axes a ≥ b has moments a²/4, b²/4).
+  ``circular`` is true when ``aspect`` = a/b ≤ 1 + :data:`ASPECT_TOL` and
+  r_max/r_equiv ≤ :data:`RMAX_TOL` (a square, aspect 1, has 1.25).
+
+Rejected (:class:`~fepost.errors.PatchError` / :class:`~fepost.errors.PressureError`):
+all-zero pressure, NaN inside the patch, negative pressures below −1 % of the
+peak, several patches each carrying more than 1 % of the load, a patch whose
+RMS distance from its plane exceeds :data:`PLANARITY_TOL` × r_equiv.
+Repaired with a warning: NaN away from the patch and small negative values
+(set to zero), fragments under 1 % of the load (dropped).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from ._arrays import frozen
+from .errors import ArgumentError, PatchError, PatchWarning, PressureError, PressureWarning
+from .field import ContactField
+
+DEFAULT_THRESHOLD = 1e-6
+ASPECT_TOL = 0.10
+RMAX_TOL = 1.15
+PLANARITY_TOL = 0.02
+NEGATIVE_TOL = 0.01
+FRAGMENT_SHARE = 0.01
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Patch frame: ``origin`` (3,) in global coordinates (m); ``axes`` rows are x, y, z."""
+
+    origin: np.ndarray
+    axes: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "origin", frozen(self.origin))
+        object.__setattr__(self, "axes", frozen(self.axes))
+
+    def to_local(self, points) -> np.ndarray:
+        """Global (n, 3) points → patch coordinates (n, 3), m."""
+        return (np.asarray(points, float) - self.origin) @ self.axes.T
+
+    def to_global(self, local) -> np.ndarray:
+        """Patch coordinates (n, 2 or 3) → global (n, 3), m."""
+        local = np.asarray(local, float)
+        if local.shape[-1] == 2:
+            local = np.concatenate([local, np.zeros(local.shape[:-1] + (1,))], axis=-1)
+        return local @ self.axes + self.origin
+
+
+@dataclass(frozen=True)
+class Patch:
+    """A contact patch in its own frame.
+
+    ``xy`` (k, 2) are the in-plane coordinates (m) of the nodes of the loaded
+    faces ``triangles`` (m, 3); ``values`` the pressure (Pa) per node or face.
+    Lengths in m, areas in m², forces in N.
+    """
+
+    source: str
+    field: str
+    location: str
+    frame: Frame
+    xy: np.ndarray
+    height: np.ndarray
+    triangles: np.ndarray
+    values: np.ndarray
+    threshold: float
+    N_fe: float
+    centre_of_pressure: tuple[float, float]
+    area: float
+    r_max: float
+    r_equiv: float
+    ellipse_axes: tuple[float, float]
+    ellipse_angle: float
+    ellipse_centre: tuple[float, float]
+    aspect: float
+    load_outside: float
+    planarity_rms: float
+    circular: bool
+    reaction_z: float | None = None
+    dropped_fragments: int = 0
+    notes: tuple[str, ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        for name in ("xy", "height", "values"):
+            object.__setattr__(self, name, frozen(getattr(self, name)))
+        object.__setattr__(self, "triangles", frozen(self.triangles, dtype=np.int64))
+
+    @property
+    def R(self) -> float:
+        return self.r_max
+
+    def node_values(self) -> np.ndarray:
+        """Pressure per node (face data spread to nodes by area)."""
+        if self.location == "point":
+            return self.values
+        area = _areas(self.xy, self.triangles)
+        num = np.zeros(len(self.xy))
+        den = np.zeros(len(self.xy))
+        for k in range(3):
+            np.add.at(num, self.triangles[:, k], area * self.values)
+            np.add.at(den, self.triangles[:, k], area)
+        return np.divide(num, den, out=np.zeros_like(num), where=den > 0)
+
+    def to_dict(self) -> dict:
+        o = self.frame.origin
+        return {
+            "centre": [float(o[0]), float(o[1]), float(o[2])],
+            "normal": [float(v) for v in self.frame.axes[2]],
+            "x_axis": [float(v) for v in self.frame.axes[0]],
+            "r_equiv": self.r_equiv,
+            "r_max": self.r_max,
+            "area": self.area,
+            "aspect": self.aspect,
+            "ellipse_semi_axes": list(self.ellipse_axes),
+            "ellipse_angle_deg": float(np.degrees(self.ellipse_angle)),
+            "ellipse_centre": list(self.ellipse_centre),
+            "load_outside_r_equiv": self.load_outside,
+            "planarity_rms": self.planarity_rms,
+            "circular": bool(self.circular),
+            "circular_rule": f"aspect <= {1 + ASPECT_TOL:.2f} and r_max/r_equiv <= {RMAX_TOL:.2f}",
+            "threshold_pa": self.threshold,
+            "n_nodes": int(len(self.xy)),
+            "n_faces": int(len(self.triangles)),
+            "field": self.field,
+            "location": self.location,
+            "source": self.source,
+            "dropped_fragments": self.dropped_fragments,
+        }
+
+
+def _areas(xy: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    p = xy[tri]
+    d1 = p[:, 1] - p[:, 0]
+    d2 = p[:, 2] - p[:, 0]
+    return 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+
+
+def face_integrals(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str):
+    """Exact ∬σ dA, ∬σ x dA, ∬σ y dA per face for a linear (point) or constant (cell) field.
+
+    Returns (load, moment_x, moment_y), each of shape (m,).
+    """
+    area = _areas(xy, tri)
+    p = xy[tri]  # (m, 3, 2)
+    if location == "point":
+        s = values[tri]  # (m, 3)
+        ssum = s.sum(axis=1)
+        load = area * ssum / 3.0
+        mom = area[:, None] / 12.0 * (ssum[:, None] * p.sum(axis=1) + np.einsum("mk,mkd->md", s, p))
+    else:
+        load = area * values
+        mom = load[:, None] * p.mean(axis=1)
+    return load, mom[:, 0], mom[:, 1]
+
+
+def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
+    v = np.array(fld.values, float)
+    finite = np.isfinite(v)
+    if not finite.any():
+        raise PressureError(f"{fld.source}: pressure array {fld.field!r} holds no finite values")
+    peak = float(np.max(v[finite]))
+    if peak <= 0.0:
+        raise PressureError(
+            f"{fld.source}: pressure array {fld.field!r} is zero or negative everywhere "
+            "(no contact)"
+        )
+    if not finite.all():
+        bad = ~finite
+        if fld.location == "point":
+            loaded_nodes = np.zeros(v.size, bool)
+            face_loaded = np.any(np.where(finite[fld.triangles], v[fld.triangles], 0.0) > 0, axis=1)
+            loaded_nodes[fld.triangles[face_loaded].ravel()] = True
+            inside = bad & loaded_nodes
+        else:
+            inside = bad  # neighbourhood of cells is not cheap; any NaN face is refused below
+            tri_nodes_loaded = np.zeros(fld.n_points, bool)
+            tri_nodes_loaded[fld.triangles[finite & (np.where(finite, v, 0) > 0)].ravel()] = True
+            inside = bad & np.any(tri_nodes_loaded[fld.triangles], axis=1)
+        if inside.any():
+            raise PressureError(
+                f"{fld.source}: {int(inside.sum())} NaN/inf pressure values inside the contact "
+                f"patch (array {fld.field!r})"
+            )
+        warnings.warn(
+            f"{fld.source}: {int(bad.sum())} NaN/inf pressure values outside the contact patch "
+            "were set to zero",
+            PressureWarning,
+            stacklevel=3,
+        )
+        v[bad] = 0.0
+    vmin = float(v.min())
+    if vmin < -NEGATIVE_TOL * peak:
+        n = int(np.sum(v < -NEGATIVE_TOL * peak))
+        raise PressureError(
+            f"{fld.source}: negative contact pressure down to {vmin:.4g} Pa at {n} "
+            f"{'nodes' if fld.location == 'point' else 'faces'} (array {fld.field!r}); "
+            "is the sign convention tension-positive?"
+        )
+    if vmin < 0.0:
+        warnings.warn(
+            f"{fld.source}: {int(np.sum(v < 0))} small negative pressures (>= {vmin:.3g} Pa, "
+            f"under {NEGATIVE_TOL:.0%} of the peak) were set to zero",
+            PressureWarning,
+            stacklevel=3,
+        )
+        v = np.clip(v, 0.0, None)
+    return v, peak
+
+
+def _loaded_faces(fld: ContactField, v: np.ndarray, thr: float) -> np.ndarray:
+    if fld.location == "point":
+        return np.any(v[fld.triangles] > thr, axis=1)
+    return v > thr
+
+
+def _components(tri: np.ndarray, n_points: int) -> tuple[int, np.ndarray]:
+    """Connected components of faces sharing a node."""
+    m = tri.shape[0]
+    rows = np.repeat(np.arange(m), 3)
+    graph = coo_matrix((np.ones(3 * m), (rows, tri.ravel())), shape=(m, n_points)).tocsr()
+    # faces are connected through nodes: bipartite graph face-node
+    big = coo_matrix(
+        (np.ones(6 * m), (np.r_[rows, tri.ravel() + m], np.r_[tri.ravel() + m, rows])),
+        shape=(m + n_points, m + n_points),
+    )
+    del graph
+    n, labels = connected_components(big, directed=False)
+    face_labels = labels[:m]
+    uniq, face_labels = np.unique(face_labels, return_inverse=True)
+    return len(uniq), face_labels
+
+
+def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    w = weights / weights.sum()
+    c = w @ points
+    d = (points - c) * np.sqrt(w)[:, None]
+    _, _, vt = np.linalg.svd(d, full_matrices=False)
+    n = vt[2]
+    k = int(np.argmax(np.abs(n)))
+    if n[k] < 0:
+        n = -n
+    return c, n
+
+
+def _axes(normal: np.ndarray, rolling_axis) -> np.ndarray:
+    if rolling_axis is None:
+        rolling_axis = (1.0, 0.0, 0.0)
+    ax = np.asarray(rolling_axis, float)
+    if ax.shape != (3,) or not np.all(np.isfinite(ax)) or np.linalg.norm(ax) == 0:
+        raise ArgumentError(f"rolling_axis must be a non-zero 3-vector, got {rolling_axis!r}")
+    ax = ax / np.linalg.norm(ax)
+    x = ax - (ax @ normal) * normal
+    if np.linalg.norm(x) < 0.1:
+        raise ArgumentError(
+            f"rolling_axis {tuple(np.round(ax, 3))} is (nearly) normal to the patch plane "
+            f"(normal {tuple(np.round(normal, 3))}); give an in-plane rolling axis"
+        )
+    x /= np.linalg.norm(x)
+    y = np.cross(normal, x)
+    return np.vstack([x, y, normal])
+
+
+def _second_moments(xy: np.ndarray, tri: np.ndarray):
+    """Area, centroid and covariance of the union of triangles (exact)."""
+    area = _areas(xy, tri)
+    A = area.sum()
+    p = xy[tri]
+    cen = (area[:, None] * p.mean(axis=1)).sum(axis=0) / A
+    q = p - cen
+    # ∫ x_i x_j dA over a triangle = A/12 (Σ_k q_ki q_kj + (Σ_k q_ki)(Σ_k q_kj))
+    s = q.sum(axis=1)
+    cov = (area[:, None, None] / 12.0 * (np.einsum("mki,mkj->mij", q, q) + s[:, :, None] * s[:, None, :])).sum(
+        axis=0
+    ) / A
+    return A, cen, cov
+
+
+# 7-point degree-5 rule on the reference triangle (barycentric coords, weights sum to 1)
+_A1, _B1 = 0.059715871789770, 0.470142064105115
+_A2, _B2 = 0.797426985353087, 0.101286507323456
+_TRI_BARY = np.array(
+    [[1 / 3, 1 / 3, 1 / 3], [_A1, _B1, _B1], [_B1, _A1, _B1], [_B1, _B1, _A1], [_A2, _B2, _B2], [_B2, _A2, _B2], [_B2, _B2, _A2]]
+)
+_TRI_W = np.array([0.225, *([0.132394152788506] * 3), *([0.125939180544827] * 3)])
+
+
+def _load_outside(xy, tri, values, location, radius) -> float:
+    area = _areas(xy, tri)
+    pts = np.einsum("qk,mkd->mqd", _TRI_BARY, xy[tri])
+    if location == "point":
+        sig = values[tri] @ _TRI_BARY.T
+    else:
+        sig = np.repeat(values[:, None], len(_TRI_W), axis=1)
+    dl = sig * _TRI_W[None, :] * area[:, None]
+    outside = np.hypot(pts[..., 0], pts[..., 1]) > radius
+    total = dl.sum()
+    return float(dl[outside].sum() / total) if total > 0 else 0.0
+
+
+def build_patch(
+    fld: ContactField,
+    *,
+    threshold: float = DEFAULT_THRESHOLD,
+    rolling_axis=None,
+    frame: Frame | None = None,
+) -> Patch:
+    """Find the loaded region of ``fld`` and describe it in the patch frame.
+
+    Parameters
+    ----------
+    threshold : float
+        Relative pressure threshold (fraction of the peak) that defines "loaded".
+    rolling_axis : 3-vector, optional
+        Global direction projected on the plane to give x (default global x).
+    frame : Frame, optional
+        Use this frame (e.g. the static patch's, for a rolling map) instead of
+        fitting one; the centre of pressure is then reported relative to it.
+    """
+    if not (0.0 <= threshold < 1.0):
+        raise ArgumentError(f"threshold must be a fraction of the peak pressure in [0, 1), got {threshold!r}")
+    v, peak = _validate_values(fld)
+    thr = threshold * peak
+    loaded = _loaded_faces(fld, v, thr)
+    tri = fld.triangles[loaded]
+    fvals = v[loaded] if fld.location == "cell" else v
+
+    # connected components of the loaded region
+    ncomp, labels = _components(tri, fld.n_points)
+    dropped = 0
+    if ncomp > 1:
+        pts2 = fld.points
+        # approximate load per component from 3D face areas
+        p = pts2[tri]
+        a3 = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+        fl = a3 * (fvals[tri].mean(axis=1) if fld.location == "point" else fvals)
+        comp_load = np.bincount(labels, weights=fl, minlength=ncomp)
+        share = comp_load / comp_load.sum()
+        big = np.flatnonzero(share > FRAGMENT_SHARE)
+        if big.size > 1:
+            parts = ", ".join(f"{s:.0%}" for s in sorted(share[big], reverse=True))
+            raise PatchError(
+                f"{fld.source}: {big.size} separate contact patches (load shares {parts}); "
+                "dual wheels or a split patch? fepost analyses one patch at a time: crop the mesh"
+            )
+        keep = labels == big[0]
+        dropped = int(ncomp - 1)
+        warnings.warn(
+            f"{fld.source}: dropped {dropped} small loaded fragment(s) carrying "
+            f"{1 - share[big[0]]:.2%} of the load",
+            PatchWarning,
+            stacklevel=2,
+        )
+        tri = tri[keep]
+        if fld.location == "cell":
+            fvals = fvals[keep]
+
+    used, tri_local = np.unique(tri, return_inverse=True)
+    tri_local = tri_local.reshape(-1, 3)
+    pts = fld.points[used]
+    nvals = v[used] if fld.location == "point" else fvals
+
+    if frame is None:
+        if fld.location == "point":
+            wmask = nvals > thr
+            cpts, w = pts[wmask], nvals[wmask]
+        else:
+            cpts = pts
+            w = np.ones(len(pts))
+        if len(cpts) < 3:
+            raise PatchError(f"{fld.source}: the contact patch has fewer than 3 loaded nodes")
+        c, normal = _plane(cpts, w)
+        axes = _axes(normal, rolling_axis)
+        base = Frame(origin=c, axes=axes)
+    else:
+        base = frame
+    local = base.to_local(pts)
+    xy = local[:, :2]
+    load, mx, my = face_integrals(xy, tri_local, nvals, fld.location)
+    N = float(load.sum())
+    if not N > 0:
+        raise PatchError(f"{fld.source}: the contact patch carries no load")
+    cop = np.array([mx.sum() / N, my.sum() / N])
+    if frame is None:
+        origin = base.to_global(cop[None, :])[0]
+        # keep the origin on the plane: to_global gives z = 0 in the local frame
+        fr = Frame(origin=origin, axes=base.axes)
+        xy = xy - cop
+        height = local[:, 2]
+        cop_rel = (0.0, 0.0)
+    else:
+        fr = frame
+        height = local[:, 2]
+        cop_rel = (float(cop[0]), float(cop[1]))
+
+    area, cen, cov = _second_moments(xy, tri_local)
+    evals, evecs = np.linalg.eigh(cov)
+    evals = np.clip(evals, 0.0, None)
+    semi = 2.0 * np.sqrt(evals[::-1])  # major, minor
+    major = evecs[:, 1]
+    angle = float(np.arctan2(major[1], major[0]))
+    angle = (angle + np.pi / 2) % np.pi - np.pi / 2
+    aspect = float(semi[0] / semi[1]) if semi[1] > 0 else np.inf
+    r_max = float(np.max(np.hypot(xy[:, 0], xy[:, 1])))
+    r_equiv = float(np.sqrt(area / np.pi))
+    if fld.location == "point":
+        wmask = nvals > thr
+        rms = float(np.sqrt(np.average(height[wmask] ** 2, weights=nvals[wmask])))
+    else:
+        rms = float(np.sqrt(np.mean(height**2)))
+    if frame is None and rms > PLANARITY_TOL * r_equiv:
+        raise PatchError(
+            f"{fld.source}: the contact patch is not planar (RMS distance from its best-fit plane "
+            f"{rms:.3g} m = {rms / r_equiv:.1%} of its radius, limit {PLANARITY_TOL:.0%}); "
+            "are the coordinates undeformed? try --displacement NAME"
+        )
+    outside = _load_outside(xy, tri_local, nvals, fld.location, r_equiv)
+    circular = bool(aspect <= 1.0 + ASPECT_TOL and r_max / r_equiv <= RMAX_TOL)
+    notes = []
+    if not circular:
+        notes.append(
+            f"patch is not circular (aspect {aspect:.3f}, r_max/r_equiv {r_max / r_equiv:.3f}); "
+            "the paper's closed forms assume a circle"
+        )
+    return Patch(
+        source=fld.source,
+        field=fld.field,
+        location=fld.location,
+        frame=fr,
+        xy=xy,
+        height=height,
+        triangles=tri_local,
+        values=nvals,
+        threshold=thr,
+        N_fe=N,
+        centre_of_pressure=cop_rel,
+        area=float(area),
+        r_max=r_max,
+        r_equiv=r_equiv,
+        ellipse_axes=(float(semi[0]), float(semi[1])),
+        ellipse_angle=angle,
+        ellipse_centre=(float(cen[0]), float(cen[1])),
+        aspect=aspect,
+        load_outside=outside,
+        planarity_rms=rms,
+        circular=circular,
+        reaction_z=fld.reaction_z,
+        dropped_fragments=dropped,
+        notes=tuple(notes),
+    )
