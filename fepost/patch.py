@@ -155,29 +155,40 @@ class Patch:
         }
 
 
-def _areas(xy: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    p = xy[tri]
-    d1 = p[:, 1] - p[:, 0]
-    d2 = p[:, 2] - p[:, 0]
-    return 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+def _corners(xy: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Corner coordinates x, y of every triangle, each (m, 3)."""
+    return xy[:, 0][tri], xy[:, 1][tri]
 
 
-def face_integrals(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str):
+def _areas(xy: np.ndarray, tri: np.ndarray, corners=None) -> np.ndarray:
+    x, y = corners if corners is not None else _corners(xy, tri)
+    return 0.5 * np.abs((x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (y[:, 1] - y[:, 0]) * (x[:, 2] - x[:, 0]))
+
+
+def _rowsum(a: np.ndarray) -> np.ndarray:
+    return a[:, 0] + a[:, 1] + a[:, 2]
+
+
+def face_integrals(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str, corners=None, area=None):
     """Exact ∬σ dA, ∬σ x dA, ∬σ y dA per face for a linear (point) or constant (cell) field.
 
     Returns (load, moment_x, moment_y), each of shape (m,).
     """
-    area = _areas(xy, tri)
-    p = xy[tri]  # (m, 3, 2)
+    x, y = corners if corners is not None else _corners(xy, tri)
+    if area is None:
+        area = _areas(xy, tri, (x, y))
     if location == "point":
         s = values[tri]  # (m, 3)
-        ssum = s.sum(axis=1)
+        ssum = _rowsum(s)
         load = area * ssum / 3.0
-        mom = area[:, None] / 12.0 * (ssum[:, None] * p.sum(axis=1) + np.einsum("mk,mkd->md", s, p))
+        w = area / 12.0
+        mx = w * (ssum * _rowsum(x) + _rowsum(s * x))
+        my = w * (ssum * _rowsum(y) + _rowsum(s * y))
     else:
         load = area * values
-        mom = load[:, None] * p.mean(axis=1)
-    return load, mom[:, 0], mom[:, 1]
+        mx = load * _rowsum(x) / 3.0
+        my = load * _rowsum(y) / 3.0
+    return load, mx, my
 
 
 def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
@@ -241,20 +252,19 @@ def _loaded_faces(fld: ContactField, v: np.ndarray, thr: float) -> np.ndarray:
 
 
 def _components(tri: np.ndarray, n_points: int) -> tuple[int, np.ndarray]:
-    """Connected components of faces sharing a node."""
-    m = tri.shape[0]
-    rows = np.repeat(np.arange(m), 3)
-    graph = coo_matrix((np.ones(3 * m), (rows, tri.ravel())), shape=(m, n_points)).tocsr()
-    # faces are connected through nodes: bipartite graph face-node
-    big = coo_matrix(
-        (np.ones(6 * m), (np.r_[rows, tri.ravel() + m], np.r_[tri.ravel() + m, rows])),
-        shape=(m + n_points, m + n_points),
-    )
-    del graph
-    n, labels = connected_components(big, directed=False)
-    face_labels = labels[:m]
-    uniq, face_labels = np.unique(face_labels, return_inverse=True)
-    return len(uniq), face_labels
+    """Connected components of faces sharing a node; returns (count, label per face)."""
+    # two edges per triangle connect its three nodes
+    rows = np.concatenate([tri[:, 0], tri[:, 1]])
+    cols = np.concatenate([tri[:, 1], tri[:, 2]])
+    graph = coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n_points, n_points))
+    n, node_labels = connected_components(graph, directed=False)
+    face_labels = node_labels[tri[:, 0]]
+    present = np.zeros(n, bool)
+    present[face_labels] = True
+    if present.all():
+        return n, face_labels
+    compact = np.cumsum(present) - 1
+    return int(present.sum()), compact[face_labels]
 
 
 def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -287,18 +297,20 @@ def _axes(normal: np.ndarray, rolling_axis) -> np.ndarray:
     return np.vstack([x, y, normal])
 
 
-def _second_moments(xy: np.ndarray, tri: np.ndarray):
+def _second_moments(corners, area: np.ndarray):
     """Area, centroid and covariance of the union of triangles (exact)."""
-    area = _areas(xy, tri)
     A = area.sum()
-    p = xy[tri]
-    cen = (area[:, None] * p.mean(axis=1)).sum(axis=0) / A
-    q = p - cen
-    # ∫ x_i x_j dA over a triangle = A/12 (Σ_k q_ki q_kj + (Σ_k q_ki)(Σ_k q_kj))
-    s = q.sum(axis=1)
-    cov = (area[:, None, None] / 12.0 * (np.einsum("mki,mkj->mij", q, q) + s[:, :, None] * s[:, None, :])).sum(
-        axis=0
-    ) / A
+    x, y = corners
+    sx, sy = _rowsum(x), _rowsum(y)
+    cen = np.array([area @ sx, area @ sy]) / (3.0 * A)
+    x = x - cen[0]
+    y = y - cen[1]
+    sx, sy = sx - 3 * cen[0], sy - 3 * cen[1]
+    # ∫ q_i q_j dA over a triangle = A/12 (Σ_k q_ki q_kj + (Σ_k q_ki)(Σ_k q_kj))
+    cxx = area @ (_rowsum(x * x) + sx * sx)
+    cyy = area @ (_rowsum(y * y) + sy * sy)
+    cxy = area @ (_rowsum(x * y) + sx * sy)
+    cov = np.array([[cxx, cxy], [cxy, cyy]]) / (12.0 * A)
     return A, cen, cov
 
 
@@ -311,17 +323,26 @@ _TRI_BARY = np.array(
 _TRI_W = np.array([0.225, *([0.132394152788506] * 3), *([0.125939180544827] * 3)])
 
 
-def _load_outside(xy, tri, values, location, radius) -> float:
-    area = _areas(xy, tri)
-    pts = np.einsum("qk,mkd->mqd", _TRI_BARY, xy[tri])
-    if location == "point":
-        sig = values[tri] @ _TRI_BARY.T
-    else:
-        sig = np.repeat(values[:, None], len(_TRI_W), axis=1)
-    dl = sig * _TRI_W[None, :] * area[:, None]
-    outside = np.hypot(pts[..., 0], pts[..., 1]) > radius
-    total = dl.sum()
-    return float(dl[outside].sum() / total) if total > 0 else 0.0
+def _load_outside(xy, tri, values, location, radius, area, load) -> float:
+    """Share of the load outside the circle of ``radius`` about the origin.
+
+    Faces wholly inside contribute nothing, faces wholly outside their exact
+    load; faces that straddle the circle are integrated with a 7-point rule.
+    """
+    total = load.sum()
+    if total <= 0:
+        return 0.0
+    r = np.hypot(xy[:, 0], xy[:, 1])[tri]
+    out_all = r.min(axis=1) > radius
+    cut = (r.max(axis=1) > radius) & ~out_all
+    share = load[out_all].sum()
+    if cut.any():
+        t = tri[cut]
+        pts = np.einsum("qk,mkd->mqd", _TRI_BARY, xy[t])
+        sig = values[t] @ _TRI_BARY.T if location == "point" else np.repeat(values[cut][:, None], len(_TRI_W), axis=1)
+        dl = sig * _TRI_W[None, :] * area[cut][:, None]
+        share += dl[np.hypot(pts[..., 0], pts[..., 1]) > radius].sum()
+    return float(share / total)
 
 
 def build_patch(
@@ -381,9 +402,16 @@ def build_patch(
         if fld.location == "cell":
             fvals = fvals[keep]
 
-    used, tri_local = np.unique(tri, return_inverse=True)
-    tri_local = tri_local.reshape(-1, 3)
-    pts = fld.points[used]
+    used_mask = np.zeros(fld.n_points, bool)
+    used_mask[tri.ravel()] = True
+    if used_mask.all():
+        pts, tri_local = fld.points, tri
+        used = slice(None)
+    else:
+        used = np.flatnonzero(used_mask)
+        remap = np.cumsum(used_mask) - 1
+        tri_local = remap[tri]
+        pts = fld.points[used]
     nvals = v[used] if fld.location == "point" else fvals
 
     if frame is None:
@@ -402,7 +430,9 @@ def build_patch(
         base = frame
     local = base.to_local(pts)
     xy = local[:, :2]
-    load, mx, my = face_integrals(xy, tri_local, nvals, fld.location)
+    corners = _corners(xy, tri_local)
+    area_f = _areas(xy, tri_local, corners)
+    load, mx, my = face_integrals(xy, tri_local, nvals, fld.location, corners, area_f)
     N = float(load.sum())
     if not N > 0:
         raise PatchError(f"{fld.source}: the contact patch carries no load")
@@ -419,7 +449,9 @@ def build_patch(
         height = local[:, 2]
         cop_rel = (float(cop[0]), float(cop[1]))
 
-    area, cen, cov = _second_moments(xy, tri_local)
+    if frame is None:
+        corners = (corners[0] - cop[0], corners[1] - cop[1])
+    area, cen, cov = _second_moments(corners, area_f)
     evals, evecs = np.linalg.eigh(cov)
     evals = np.clip(evals, 0.0, None)
     semi = 2.0 * np.sqrt(evals[::-1])  # major, minor
@@ -440,7 +472,7 @@ def build_patch(
             f"{rms:.3g} m = {rms / r_equiv:.1%} of its radius, limit {PLANARITY_TOL:.0%}); "
             "are the coordinates undeformed? try --displacement NAME"
         )
-    outside = _load_outside(xy, tri_local, nvals, fld.location, r_equiv)
+    outside = _load_outside(xy, tri_local, nvals, fld.location, r_equiv, area_f, load)
     circular = bool(aspect <= 1.0 + ASPECT_TOL and r_max / r_equiv <= RMAX_TOL)
     notes = []
     if not circular:

@@ -213,8 +213,41 @@ def _pick_field(path: Path, data: pv.DataSet, field: str | None) -> tuple[str, i
     return hits[0], None, catalogue[hits[0]]
 
 
+def _direct_faces(data: pv.DataSet) -> tuple[np.ndarray, np.ndarray] | None:
+    """Triangles and their source cell ids straight from a mesh of triangles and quads.
+
+    Returns None when the mesh holds other cell types (then VTK extracts the surface).
+    """
+    if not isinstance(data, pv.UnstructuredGrid):
+        return None
+    types = np.asarray(data.celltypes)
+    is_tri = types == pv.CellType.TRIANGLE
+    is_quad = types == pv.CellType.QUAD
+    if not np.all(is_tri | is_quad):
+        return None
+    conn = np.asarray(data.cell_connectivity, np.int64)
+    off = np.asarray(data.cell_offsets, np.int64)[:-1]
+    ids = np.arange(types.size)
+    parts, src = [], []
+    if is_tri.any():
+        o = off[is_tri]
+        parts.append(np.column_stack([conn[o], conn[o + 1], conn[o + 2]]))
+        src.append(ids[is_tri])
+    if is_quad.any():
+        o = off[is_quad]
+        q = np.column_stack([conn[o], conn[o + 1], conn[o + 2], conn[o + 3]])
+        parts += [q[:, [0, 1, 2]], q[:, [0, 2, 3]]]
+        src += [ids[is_quad], ids[is_quad]]
+    return np.vstack(parts), np.concatenate(src)
+
+
 def _extract(data: pv.DataSet, name: str, location: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Return the triangulated boundary surface: points, triangles, values."""
+    direct = _direct_faces(data)
+    if direct is not None:
+        tri, src = direct
+        arr = np.asarray(data.point_data[name] if location == "point" else data.cell_data[name], float)
+        return np.asarray(data.points, float), tri, (arr if location == "point" else arr[src])
     if isinstance(data, pv.PolyData):
         surf = data
     else:
@@ -222,13 +255,11 @@ def _extract(data: pv.DataSet, name: str, location: str) -> tuple[np.ndarray, np
             pass_pointid=False, pass_cellid=False, algorithm="dataset_surface"
         )
     surf = surf.triangulate()
-    faces = surf.faces
+    if surf.n_lines or surf.n_verts:
+        surf = surf.extract_cells_by_type(pv.CellType.TRIANGLE).extract_surface(algorithm="dataset_surface")
+    faces = np.asarray(surf.faces)
     if surf.n_cells == 0 or faces.size == 0:
         return np.asarray(surf.points, float), np.empty((0, 3), np.int64), np.empty(0)
-    # triangulate() leaves only polygons with 3 vertices (lines/verts kept separately)
-    if surf.n_lines or surf.n_verts:
-        surf = surf.extract_cells_by_type(pv.CellType.TRIANGLE).extract_surface()
-        faces = surf.faces
     tri = faces.reshape(-1, 4)[:, 1:]
     arr = surf.point_data[name] if location == "point" else surf.cell_data[name]
     return np.asarray(surf.points, float), np.asarray(tri, np.int64), np.asarray(arr, float)
@@ -319,6 +350,7 @@ def read_contact(
     else:
         tmp.cell_data[key] = _mask_sentinels(path, values)
     points, tri, vals = _extract(tmp, key, location)
+    del tmp
     if tri.shape[0] == 0:
         raise InputFileError(f"{path}: the mesh has no surface faces (only points or lines)")
     side = _sidecar(path)
