@@ -7,12 +7,18 @@ With u = ω_z R (m/s) and v = |v| (m/s):
     F⊥ = k_x (M0 / 2R) u / √(u² + (m/4) v²)    (N, lateral)
 
 Magnitudes are returned; the signs of the components on the tire follow from
-THEORY.md §3 and are applied by :func:`components`.
+THEORY.md §3 and are applied by :func:`components`. :func:`asymptotic_coefficients`
+derives a and m of any pressure map from the asymptotes of the exact integrals.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+
+from ..errors import ArgumentError
+from .quadrature import PressureQuadrature
 
 
 def f_parallel(v, u, F0: float, a: float) -> np.ndarray:
@@ -52,3 +58,120 @@ def torque_ratio(upsilon, m: float) -> np.ndarray:
 def f_perpendicular_ratio(upsilon, m: float) -> np.ndarray:
     """F⊥/(k_x M0/2R) = 1/√(1 + mυ²/4), υ = v/u."""
     return 1.0 / np.sqrt(1.0 + 0.25 * m * np.asarray(upsilon, float) ** 2)
+
+
+def components(vx, vy, wz, *, F0: float, M0: float, a: float, m: float, k_x: float, radius: float):
+    """Closed-form force (N) and torque (N·m) components on the tire: (Fx, Fy, Mz).
+
+    ``vx``, ``vy``: sliding velocity of the patch origin (m/s); ``wz``: spin (rad/s);
+    ``radius``: R (m), so u = |ω_z| R. Signs, derived from THEORY.md §3 and tested
+    against :func:`fepost.friction.exact.friction_resultants`:
+
+    - F∥ acts along −v̂ (Coulomb friction opposes sliding);
+    - M_z = −sgn(ω_z)·M_C (the torque opposes the spin);
+    - F⊥ acts along y with sign −sgn(ω_z)·sgn(k_x): at pure spin the traction is
+      −fσ ê_φ, and a forward pressure shift σ0(1 + k_x x/R) loads the front
+      (x > 0), where ê_φ points to +y for ω_z > 0, so F_y = −k_x M0/(2R).
+    """
+    vx, vy, wz = np.broadcast_arrays(*(np.asarray(q, float) for q in (vx, vy, wz)))
+    v = np.hypot(vx, vy)
+    u = np.abs(wz) * radius
+    fpar = f_parallel(v, u, F0, a)
+    safe = np.where(v > 0, v, 1.0)
+    fx = -fpar * np.where(v > 0, vx / safe, 0.0)
+    fy = -fpar * np.where(v > 0, vy / safe, 0.0)
+    spin = np.sign(wz)
+    fy = fy - spin * np.sign(k_x) * f_perpendicular(v, u, M0, m, k_x, radius)
+    mz = -spin * torque(v, u, M0, m)
+    return fx, fy, mz
+
+
+@dataclass(frozen=True)
+class AsymptoticCoefficients:
+    """F0 = fN (N), M0 = f∬σ r dA (N·m), a, m (dimensionless) for ``radius`` R (m),
+    matched to the exact integrals' asymptotes for sliding along ``direction`` (rad)."""
+
+    F0: float
+    M0: float
+    a: float
+    m: float
+    radius: float
+    f: float
+    direction: float
+
+    def to_dict(self) -> dict:
+        return {
+            k: float(getattr(self, k)) for k in ("F0", "M0", "a", "m", "radius", "f", "direction")
+        }
+
+
+def asymptotic_coefficients(
+    quad: PressureQuadrature, f: float = 0.3, *, radius: float | None = None, direction: float = 0.0
+) -> AsymptoticCoefficients:
+    """a and m matched to the asymptotes of the exact integrals (THEORY.md §3–4).
+
+    Sliding at speed v along v̂ = (cos β, sin β) (β = ``direction``), spinning at ω,
+    u = |ω| R; σ-weighted integrals about the patch origin, n̂ = v̂ rotated by +90°:
+
+    - u ≫ v: the ICR sits at p0 = J v/ω, close to the origin, and to first order
+      F∥ = f v/|ω| · T, T = ∬ σ (n̂·ê_r)²/r dA. Matching F0 v/(√a u) gives
+      √a = N / (R T).
+    - v ≫ u: ŵ = v̂ + (ω/v)(v̂·p) n̂ + O(ω²), so M_z = −f(ω/v) ∬ σ (v̂·p)² dA
+      (plus −fN x_c × v̂, zero when the origin is the centre of pressure).
+      Matching M0 u/(√m v) gives √m = M0 R / (f ∬ σ (v̂·p)² dA).
+
+    For an axisymmetric map, T = π R A⁰ and ∬σ x² dA = π R⁴ A³ while N = 2πR²A¹
+    and M0 = 2π f R³ A², so √a = 2A¹/A⁰ and √m = 2A²/A³, THEORY.md §2.
+    ``radius`` defaults to ``quad.radius``.
+    """
+    if not isinstance(quad, PressureQuadrature):
+        raise ArgumentError(f"quad must be a PressureQuadrature, got {type(quad).__name__}")
+    if not (np.isfinite(f) and f > 0):
+        raise ArgumentError(f"f must be a positive finite friction coefficient, got {f!r}")
+    R = quad.radius if radius is None else radius
+    if not (np.isfinite(R) and R > 0):
+        raise ArgumentError(f"radius must be a positive finite length in m, got {radius!r}")
+    if not np.isfinite(direction):
+        raise ArgumentError(f"direction must be a finite angle in rad, got {direction!r}")
+    ex, ey = np.cos(direction), np.sin(direction)
+    nx, ny = -ey, ex
+    x, y, s, da = quad.x, quad.y, quad.sigma, quad.dA
+    r = np.hypot(x, y)
+    N = float(s @ da)
+    M0 = f * float(s @ (r * da))
+    T = _inverse_r_moment(quad, nx, ny)
+    second = float(s @ ((ex * x + ey * y) ** 2 * da))
+    a = (N / (R * T)) ** 2
+    m = (M0 * R / (f * second)) ** 2
+    return AsymptoticCoefficients(
+        f * N, M0, float(a), float(m), float(R), float(f), float(direction)
+    )
+
+
+def _inverse_r_moment(quad: PressureQuadrature, nx: float, ny: float) -> float:
+    """T = ∬ σ (n̂·ê_r)²/r dA about the origin (Pa·m).
+
+    The integrand is singular like 1/r at the origin; when the origin lies in the
+    domain, σ(0) + ∇σ(0)·p is subtracted and integrated exactly along rays
+    (∬ (n̂·ê)²/r dA = ∫ (n̂·ê_θ)² ρ_max dθ; ∬ (G·p)(n̂·ê)²/r dA = ∫ (G·ê)(n̂·ê)² ρ_max²/2 dθ),
+    leaving a bounded remainder for the nodes.
+    """
+    x, y, s, da = quad.x, quad.y, quad.sigma, quad.dA
+    r = np.hypot(x, y)
+    inv = np.divide(1.0, r, out=np.zeros_like(r), where=r > 0)
+    proj2 = (nx * x * inv + ny * y * inv) ** 2
+    d = quad.domain
+    if d.level(0.0, 0.0) >= 1.0:
+        return float(s @ (proj2 * inv * da))
+    h = 1e-4 * max(d.ax, d.ay)
+    s0 = float(quad.sigma_at(np.array([0.0]), np.array([0.0]))[0])
+    gx = float(np.diff(quad.sigma_at(np.array([-h, h]), np.zeros(2)))[0]) / (2 * h)
+    gy = float(np.diff(quad.sigma_at(np.zeros(2), np.array([-h, h])))[0]) / (2 * h)
+    rem = s - s0 - gx * x - gy * y
+    n = 4096
+    theta = np.arange(n) * (2.0 * np.pi / n)
+    c, sn = np.cos(theta), np.sin(theta)
+    rho = d.ray_length(0.0, 0.0, theta)
+    pr2 = (nx * c + ny * sn) ** 2
+    exact = (2.0 * np.pi / n) * np.sum(pr2 * (s0 * rho + (gx * c + gy * sn) * rho**2 / 2.0))
+    return float(rem @ (proj2 * inv * da)) + float(exact)

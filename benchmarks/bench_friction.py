@@ -1,0 +1,86 @@
+"""Speed and accuracy of the exact friction integrals (fepost.friction.exact).
+
+Times ``friction_resultants`` for 1,000 random kinematic points (half with the
+instantaneous centre of rotation inside the patch, half outside, a few pure
+sliding and pure spin) on the default friction grid, and compares with a fine
+grid. Errors are relative to the natural scales: |ΔF|/(fN) for Fx, Fy and
+|ΔM_z|/M0 with M0 = f∬σ r dA, the pure-spin torque.
+
+Run: ``.venv/bin/python benchmarks/bench_friction.py [--points 1000] [--nr 32 --nphi 64]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from fepost.analytic import pressure_function
+from fepost.friction.exact import friction_resultants
+from fepost.friction.law import FrictionLaw
+from fepost.friction.quadrature import FRICTION_NPHI, FRICTION_NR, PressureQuadrature, edge_grid
+from fepost.polar import PolarMap
+
+RADIUS = 0.1  # m
+
+
+def kinematics(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Random (vx, vy, wz): ICR at distance ~U(0, 2)·R in a random direction."""
+    wz = rng.choice([-1.0, 1.0], n) * rng.uniform(0.5, 20.0, n)  # rad/s
+    dist = RADIUS * np.concatenate(
+        [rng.uniform(0.0, 1.0, n // 2), rng.uniform(1.0, 3.0, n - n // 2)]
+    )
+    ang = rng.uniform(0.0, 2.0 * np.pi, n)
+    p0x, p0y = dist * np.cos(ang), dist * np.sin(ang)
+    vx, vy = wz * p0y, -wz * p0x  # p0 = (−vy/ω, vx/ω)
+    wz[:10] = 0.0  # pure sliding
+    vx[10:20] = vy[10:20] = 0.0  # pure spin about the origin
+    return vx, vy, wz
+
+
+def quadrature(profile: str, nr: int, nphi: int, k_x: float) -> PressureQuadrature:
+    fn = pressure_function(profile, RADIUS, peak=2e5, k_x=k_x)
+    return PressureQuadrature.from_polar(PolarMap.from_function(fn, RADIUS, edge_grid(nr, nphi)))
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--points", type=int, default=1000)
+    parser.add_argument("--nr", type=int, default=FRICTION_NR)
+    parser.add_argument("--nphi", type=int, default=FRICTION_NPHI)
+    parser.add_argument("--seed", type=int, default=1)
+    args = parser.parse_args(argv)
+    rng = np.random.default_rng(args.seed)
+    vx, vy, wz = kinematics(args.points, rng)
+    law = FrictionLaw(f=0.8)
+    print(
+        f"{args.points} kinematic points, grid {args.nr}x{args.nphi} (sine radial rule), "
+        f"reference grid 256x512"
+    )
+    print(f"{'map':<18}{'time (s)':>10}{'max |dF|/fN':>14}{'max |dM|/M0':>14}{'inside':>8}")
+    for profile, k_x in (
+        ("hertz", 0.0),
+        ("hertz", 0.13),
+        ("tire", 0.0),
+        ("uniform", 0.0),
+        ("paraboloid", 0.0),
+    ):
+        quad = quadrature(profile, args.nr, args.nphi, k_x)
+        fine = quadrature(profile, 256, 512, k_x)
+        friction_resultants(quad, vx[:8], vy[:8], wz[:8], law)  # warm up
+        t0 = time.perf_counter()
+        res = friction_resultants(quad, vx, vy, wz, law)
+        elapsed = time.perf_counter() - t0
+        ref = friction_resultants(fine, vx, vy, wz, law)
+        fn = law.f * fine.load
+        m0 = law.f * float(fine.sigma @ (np.hypot(fine.x, fine.y) * fine.dA))
+        dF = max(np.max(np.abs(res.Fx - ref.Fx)), np.max(np.abs(res.Fy - ref.Fy))) / fn
+        dM = np.max(np.abs(res.Mz - ref.Mz)) / m0
+        inside = np.count_nonzero(np.hypot(vx, vy) < np.abs(wz) * RADIUS)
+        name = f"{profile} k={k_x:g}"
+        print(f"{name:<18}{elapsed:>10.3f}{dF:>14.2e}{dM:>14.2e}{inside:>8d}")
+
+
+if __name__ == "__main__":
+    main()

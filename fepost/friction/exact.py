@@ -1,0 +1,321 @@
+"""Exact dry-friction resultants of a pressure map (THEORY.md §3), by quadrature.
+
+For a patch sliding at (v_x, v_y) (m/s) and spinning at ω_z (rad/s) the tire
+point (x, y) slides at w = (v_x − ω_z y, v_y + ω_z x) and carries the traction
+τ = −μσ (ŵ_x, α ŵ_y) of :class:`~fepost.friction.law.FrictionLaw`. The
+resultants on the tire are F = ∬ τ dA (N) and M_z = ∬ (x τ_y − y τ_x) dA (N·m)
+about the patch origin.
+
+Singularity subtraction
+-----------------------
+When ω_z ≠ 0 the direction field ŵ = sgn(ω_z)·ê_θ(p − p0) turns about the
+instantaneous centre of rotation p0 = (−v_y/ω_z, v_x/ω_z): bounded, but
+discontinuous at p0, which spoils any fixed quadrature when p0 lies inside the
+patch. With g = μσ (Pa) and g0 = g(p0) (μ at |w| = 0) we integrate
+
+    ∬ g ŵ dA = ∬ (g − g0) ŵ dA  +  g0 ∬_domain ŵ dA,
+
+the first term on the quadrature nodes (its integrand vanishes at p0, so it is
+continuous there) and the second analytically in polar coordinates about p0,
+with ρ_max(θ) the distance from p0 to the domain boundary along θ:
+
+    ∬ ê_θ dA = (−I_y, I_x),    I = ∫₀^{2π} (cos θ, sin θ) ρ_max²/2 dθ,
+    ∬ (α x ê_θ,y − y ê_θ,x) dA = α p0_x I_x + p0_y I_y + ∫ (α cos²θ + sin²θ) ρ_max³/3 dθ.
+
+ρ_max is analytic and periodic, so the periodic trapezoid converges spectrally;
+its strip of analyticity narrows like √δ as p0 nears the boundary (δ = 1 − q,
+q the ellipse level of p0), and the number of θ nodes grows accordingly
+(:func:`_theta_nodes`). The subtraction is applied only when p0 is inside the
+domain (when it is outside, the integrand is smooth on the patch).
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._arrays import frozen
+from ..errors import ArgumentError
+from .law import FrictionLaw
+from .quadrature import Ellipse, PressureQuadrature
+
+#: Elements (kinematic points × nodes) per chunk: 2^20 doubles = 8 MB per array,
+#: a handful of arrays per worker thread.
+CHUNK_ELEMENTS = 1 << 20
+
+#: Trapezoid nodes in θ: at least this many ...
+THETA_MIN = 64
+#: ... at most this many (p0 closer than ~1e-7 of the size to the boundary) ...
+THETA_MAX = 1 << 16
+#: ... and enough for exp(−THETA_DECAY) relative error given the analytic strip.
+THETA_DECAY = 25.0
+#: Finite-difference step for ∇(μσ) at the ICR, relative to the larger semi-axis.
+FD_STEP = 1e-4
+
+
+@dataclass(frozen=True)
+class Resultants:
+    """Friction resultants on the tire: ``Fx``, ``Fy`` (N) and ``Mz`` (N·m) about the
+    patch origin, one entry per kinematic point (shape of the broadcast inputs)."""
+
+    Fx: np.ndarray
+    Fy: np.ndarray
+    Mz: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("Fx", "Fy", "Mz"):
+            object.__setattr__(self, name, frozen(getattr(self, name)))
+
+    def to_dict(self) -> dict:
+        return {"Fx": self.Fx.tolist(), "Fy": self.Fy.tolist(), "Mz": self.Mz.tolist()}
+
+
+def _kinematics(vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
+    arrays = {}
+    for name, value, unit in (("vx", vx, "m/s"), ("vy", vy, "m/s"), ("wz", wz, "rad/s")):
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise ArgumentError(
+                f"{name} must be a number or an array of numbers ({unit}), got {value!r}"
+            ) from None
+        bad = ~np.isfinite(arr)
+        if np.any(bad):
+            where = np.argwhere(bad)[0]
+            at = f" at index {tuple(int(i) for i in where)}" if arr.ndim else ""
+            raise ArgumentError(
+                f"{name} must be finite ({unit}), got {float(arr[tuple(where)])!r}{at}"
+            )
+        arrays[name] = arr
+    shape = arrays["vx"].shape
+    for name in ("vy", "wz"):
+        try:
+            shape = np.broadcast_shapes(shape, arrays[name].shape)
+        except ValueError:
+            raise ArgumentError(
+                f"{name} has shape {arrays[name].shape}, which does not broadcast with {shape}"
+            ) from None
+    vx, vy, wz = (np.broadcast_to(arrays[n], shape).ravel() for n in ("vx", "vy", "wz"))
+    return vx, vy, wz, shape
+
+
+def _theta_nodes(domain: Ellipse, level: np.ndarray) -> np.ndarray:
+    """Trapezoid node counts (powers of two) for p0 at ellipse level q < 1."""
+    delta = np.maximum(1.0 - level, 1e-300)
+    aspect = max(domain.ax, domain.ay) / min(domain.ax, domain.ay)
+    need = THETA_DECAY * aspect / np.sqrt(2.0 * delta)
+    n = np.exp2(np.ceil(np.log2(np.maximum(need, THETA_MIN))))
+    return np.minimum(n, THETA_MAX).astype(int)
+
+
+def ray_integrals(domain: Ellipse, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+    """Polar moments of ``domain`` about inside points p0 = (px, py), shape (k, 9).
+
+    With c = cos θ, s = sin θ and ρ = ρ_max(θ), each column is ∫₀^{2π} · dθ of:
+    c ρ²/2, s ρ²/2 (m²); c² ρ³/3, cs ρ³/3, s² ρ³/3 (m³);
+    c³ ρ⁴/4, c²s ρ⁴/4, cs² ρ⁴/4, s³ ρ⁴/4 (m⁴).
+    """
+    px = np.asarray(px, float).ravel()
+    py = np.asarray(py, float).ravel()
+    out = np.empty((px.size, 9))
+    counts = _theta_nodes(domain, domain.level(px, py))
+    for n in np.unique(counts):
+        idx = np.flatnonzero(counts == n)
+        theta = np.arange(n) * (2.0 * np.pi / n)
+        c, s = np.cos(theta), np.sin(theta)
+        w = 2.0 * np.pi / n
+        trig2 = np.column_stack([c, s])
+        trig3 = np.column_stack([c * c, c * s, s * s])
+        trig4 = np.column_stack([c**3, c * c * s, c * s * s, s**3])
+        block = max(1, CHUNK_ELEMENTS // int(n))
+        for start in range(0, idx.size, block):
+            j = idx[start : start + block]
+            rho = domain.ray_length(px[j, None], py[j, None], theta[None, :])
+            r2 = rho * rho * w
+            out[j, 0:2] = (r2 / 2.0) @ trig2
+            r3 = r2 * rho
+            out[j, 2:5] = (r3 / 3.0) @ trig3
+            out[j, 5:9] = (r3 * rho / 4.0) @ trig4
+    return out
+
+
+@dataclass(frozen=True)
+class _Nodes:
+    """Per-node matrices the chunks share (read-only).
+
+    Columns multiplied by ŵ_x: g dA, g dA y | dA, dA x, dA y, dA xy, dA y²;
+    by ŵ_y: g dA, g dA x | dA, dA x, dA y, dA x², dA xy. (g = μσ without the
+    speed factor, Pa.) Columns after the bar serve the subtraction.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    bx: np.ndarray
+    by: np.ndarray
+
+
+def _nodes(quad: PressureQuadrature, law: FrictionLaw, sigma_ref: float) -> _Nodes:
+    x, y, da = quad.x, quad.y, quad.dA
+    g = law.f * law.pressure_factor(quad.sigma, sigma_ref) * quad.sigma * da
+    bx = np.column_stack([g, g * y, da, da * x, da * y, da * x * y, da * y * y])
+    by = np.column_stack([g, g * x, da, da * x, da * y, da * x * x, da * x * y])
+    return _Nodes(x, y, bx, by)
+
+
+def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.ndarray]:
+    """Sums over the nodes for one chunk of kinematic points: ŵ_x @ bx and ŵ_y @ by.
+
+    Columns 0, 1 carry the speed factor of μ; the others (plain dA) do not.
+    """
+    wx = np.multiply(wz[:, None], nodes.y[None, :])
+    np.subtract(vx[:, None], wx, out=wx)
+    wy = np.multiply(wz[:, None], nodes.x[None, :])
+    np.add(vy[:, None], wy, out=wy)
+    speed = np.hypot(wx, wy)
+    inv = np.divide(1.0, speed, out=np.zeros_like(speed), where=speed > 0)
+    wx *= inv
+    wy *= inv
+    ncol = nodes.bx.shape[1]
+    sx = np.empty((vx.size, ncol))
+    sy = np.empty((vx.size, ncol))
+    sx[:, 2:] = wx @ nodes.bx[:, 2:]
+    sy[:, 2:] = wy @ nodes.by[:, 2:]
+    if law.depends_on_speed:
+        factor = law.speed_factor(speed)
+        wx *= factor
+        wy *= factor
+    sx[:, :2] = wx @ nodes.bx[:, :2]
+    sy[:, :2] = wy @ nodes.by[:, :2]
+    return sx, sy
+
+
+def _g_and_gradient(quad, law, sigma_ref, px, py) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """g = μσ at |w| = 0 (Pa) and its gradient (Pa/m) at inside points, by differences.
+
+    Central differences of ``sigma_at`` with step ``FD_STEP``·size; a probe that
+    falls outside the domain is replaced by the centre value (one-sided difference).
+    """
+    d = quad.domain
+    h = FD_STEP * max(d.ax, d.ay)
+
+    def g(x, y):
+        s = np.asarray(quad.sigma_at(x, y), float)
+        return law.f * law.pressure_factor(s, sigma_ref) * s
+
+    g0 = g(px, py)
+    grads = []
+    for ex, ey in ((h, 0.0), (0.0, h)):
+        ip = d.level(px + ex, py + ey) < 1.0
+        im = d.level(px - ex, py - ey) < 1.0
+        gp = np.where(ip, g(px + ex, py + ey), g0)
+        gm = np.where(im, g(px - ex, py - ey), g0)
+        span = h * (ip.astype(float) + im.astype(float))
+        grads.append(np.divide(gp - gm, span, out=np.zeros_like(g0), where=span > 0))
+    return g0, grads[0], grads[1]
+
+
+def friction_resultants(
+    quad: PressureQuadrature,
+    vx,
+    vy,
+    wz,
+    law: FrictionLaw | None = None,
+    *,
+    subtract: bool | int = True,
+    threads: int | None = None,
+) -> Resultants:
+    """Exact friction force (N) and torque (N·m) on the tire for each kinematic point.
+
+    ``vx``, ``vy``: sliding velocity of the patch origin relative to the road (m/s);
+    ``wz``: spin about the road normal (rad/s); scalars or arrays that broadcast.
+    ``law``: the local friction law (default: Coulomb with f = 0.3).
+    ``subtract``: order of the ICR singularity subtraction (module docstring):
+    2 (or ``True``, default) removes g(p0) + ∇g(p0)·(p − p0), 1 only g(p0),
+    0 (or ``False``) integrates the raw discontinuous field (for studies only).
+    ``threads``: worker threads over chunks of kinematic points (default: CPU count).
+    """
+    if not isinstance(quad, PressureQuadrature):
+        raise ArgumentError(f"quad must be a PressureQuadrature, got {type(quad).__name__}")
+    law = FrictionLaw() if law is None else law
+    if not isinstance(law, FrictionLaw):
+        raise ArgumentError(f"law must be a FrictionLaw, got {type(law).__name__}")
+    order = {True: 2, False: 0}.get(subtract, subtract) if isinstance(subtract, bool) else subtract
+    if order not in (0, 1, 2):
+        raise ArgumentError(f"subtract must be True, False, 0, 1 or 2, got {subtract!r}")
+    if threads is not None and (
+        isinstance(threads, bool) or int(threads) != threads or threads < 1
+    ):
+        raise ArgumentError(f"threads must be a positive integer, got {threads!r}")
+    vx, vy, wz, shape = _kinematics(vx, vy, wz)
+    sigma_ref = law.reference_pressure(quad.mean_pressure) if law.pressure_coef else 1.0
+    nodes = _nodes(quad, law, sigma_ref)
+    k = vx.size
+    sx = np.zeros((k, nodes.bx.shape[1]))
+    sy = np.zeros((k, nodes.by.shape[1]))
+    block = max(1, CHUNK_ELEMENTS // max(1, quad.x.size))
+    starts = range(0, k, block)
+
+    def work(start: int) -> None:
+        sl = slice(start, start + block)
+        sx[sl], sy[sl] = _chunk(nodes, law, vx[sl], vy[sl], wz[sl])
+
+    workers = threads or os.cpu_count() or 1
+    if workers > 1 and len(starts) > 1:
+        with ThreadPoolExecutor(max_workers=min(workers, len(starts))) as pool:
+            list(pool.map(work, starts))
+    else:
+        for start in starts:
+            work(start)
+
+    alpha = law.anisotropy
+    fx = -sx[:, 0]
+    fy = -alpha * sy[:, 0]
+    mz = -(alpha * sy[:, 1] - sx[:, 1])
+
+    if order:
+        spin = wz != 0
+        p0x = np.zeros(k)
+        p0y = np.zeros(k)
+        p0x[spin] = -vy[spin] / wz[spin]
+        p0y[spin] = vx[spin] / wz[spin]
+        i = np.flatnonzero(spin & (quad.domain.level(p0x, p0y) < 1.0))
+        if i.size:
+            _subtract(fx, fy, mz, i, quad, law, sigma_ref, order, sx, sy, p0x, p0y, np.sign(wz))
+    return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))
+
+
+def _subtract(fx, fy, mz, i, quad, law, sigma_ref, order, sx, sy, p0x, p0y, sgn) -> None:
+    """In place, for the points ``i`` whose ICR p0 is inside: swap the node sums of
+    L ŵ, L = g0 + G·(p − p0), for their exact integrals over the domain."""
+    px, py = p0x[i], p0y[i]
+    if order == 2:
+        g0, gx, gy = _g_and_gradient(quad, law, sigma_ref, px, py)
+    else:
+        s0 = np.asarray(quad.sigma_at(px, py), float)
+        g0 = law.f * law.pressure_factor(s0, sigma_ref) * s0
+        gx = gy = np.zeros_like(g0)
+    alpha = law.anisotropy
+    c0 = g0 - gx * px - gy * py  # L = c0 + gx·x + gy·y
+    X = sx[i]  # columns 2..6: ŵx @ dA·(1, x, y, xy, y²)
+    Y = sy[i]  # columns 2..6: ŵy @ dA·(1, x, y, x², xy)
+    node_x = c0 * X[:, 2] + gx * X[:, 3] + gy * X[:, 4]
+    node_y = c0 * Y[:, 2] + gx * Y[:, 3] + gy * Y[:, 4]
+    node_m = alpha * (c0 * Y[:, 3] + gx * Y[:, 5] + gy * Y[:, 6]) - (
+        c0 * X[:, 4] + gx * X[:, 5] + gy * X[:, 6]
+    )
+    r = ray_integrals(quad.domain, px, py)
+    ix, iy, cc, cs, ss, qccc, qccs, qcss, qsss = r.T
+    s = sgn[i]
+    exact_x = s * (-g0 * iy - (gx * cs + gy * ss))
+    exact_y = s * (g0 * ix + gx * cc + gy * cs)
+    exact_m = s * (
+        g0 * (alpha * px * ix + py * iy + alpha * cc + ss)
+        + gx * (alpha * px * cc + py * cs + alpha * qccc + qcss)
+        + gy * (alpha * px * cs + py * ss + alpha * qccs + qsss)
+    )
+    fx[i] += node_x - exact_x
+    fy[i] += alpha * (node_y - exact_y)
+    mz[i] += node_m - exact_m
