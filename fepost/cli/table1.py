@@ -1,0 +1,123 @@
+"""``fepost table1 [--static S] [--rolling R] [--seed N] [--json PATH] [--source SRC] ...``.
+
+Without ``--static`` and ``--rolling`` the sample meshes ``meshes/static.vtu`` and
+``meshes/rolling.vtu`` beside the package are used (a one-line error names the
+missing file). With ``--static`` alone no rolling map is used (the sample rolling
+map belongs to another tire): k_x is then assumed (``--k-x``, default the paper's
+0.130) and the table says so.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from ..analysis import analyse
+from ..identify import DEFAULT_AMPLITUDE, DEFAULT_N_POINTS, DEFAULT_SPAN
+from ..output import write_json_atomic
+from ..table1 import DEFAULT_SEED, format_table, table1
+from ._common import add_input_options, analysis_kwargs, sample_mesh
+
+#: The committed seed of ``fepost table1`` (same as :data:`fepost.table1.DEFAULT_SEED`).
+SEED = DEFAULT_SEED
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "table1",
+        help="the paper's identification experiment (Table 1) on FE maps, with 95 % bounds",
+        description=(
+            "Make the friction curves of THEORY.md 4 from the coefficients of the FE maps, "
+            "add the paper's 20 % noise, fit them back and print theory | fitted | "
+            "95 % bounds | the paper's values."
+        ),
+    )
+    p.add_argument(
+        "--static", metavar="STATIC", help="static contact map (default: meshes/static.vtu)"
+    )
+    p.add_argument(
+        "--rolling",
+        metavar="ROLLING",
+        help="rolling contact map (default: meshes/rolling.vtu when --static is not given either)",
+    )
+    p.add_argument(
+        "--seed", type=int, default=SEED, metavar="S", help=f"noise seed (default {SEED})"
+    )
+    p.add_argument("--json", metavar="PATH", help="write the table as JSON")
+    p.add_argument(
+        "--source",
+        choices=("closed_form", "exact"),
+        default="closed_form",
+        help="test curves from the paper's closed forms (default) or the exact friction integrals",
+    )
+    p.add_argument(
+        "--friction",
+        type=float,
+        default=0.3,
+        metavar="F",
+        help="friction coefficient f (default 0.3)",
+    )
+    p.add_argument(
+        "--noise", choices=("uniform", "gaussian"), default="uniform", help="noise distribution"
+    )
+    p.add_argument(
+        "--amplitude",
+        type=float,
+        default=DEFAULT_AMPLITUDE,
+        metavar="A",
+        help=f"noise amplitude as a fraction of each curve's maximum (default {DEFAULT_AMPLITUDE})",
+    )
+    p.add_argument(
+        "--n-points",
+        type=int,
+        default=DEFAULT_N_POINTS,
+        metavar="N",
+        help=f"points per curve (default {DEFAULT_N_POINTS})",
+    )
+    p.add_argument(
+        "--span",
+        type=float,
+        default=DEFAULT_SPAN,
+        metavar="X",
+        help=f"largest psi and upsilon of the curves (default {DEFAULT_SPAN:g})",
+    )
+    p.add_argument(
+        "--k-x",
+        type=float,
+        metavar="K",
+        help="assumed k_x when no rolling map is used (default 0.130)",
+    )
+    add_input_options(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.static is None:
+        static = sample_mesh("static.vtu")
+        rolling = args.rolling if args.rolling is not None else sample_mesh("rolling.vtu")
+    else:
+        static, rolling = args.static, args.rolling
+    result = analyse(static, rolling, friction=args.friction, **analysis_kwargs(args))
+    t = table1(
+        result,
+        seed=args.seed,
+        source=args.source,
+        noise=args.noise,
+        amplitude=args.amplitude,
+        n_points=args.n_points,
+        span=args.span,
+        k_x=args.k_x,
+    )
+    print(f"static map: {result.static_field.source}")
+    if result.rolling_field is not None:
+        print(f"rolling map: {result.rolling_field.source}")
+    print(format_table(t))
+    if args.json:
+        d = t.to_dict()
+        d["inputs"] = {
+            "static": str(result.static_field.source),
+            "rolling": str(result.rolling_field.source)
+            if result.rolling_field is not None
+            else None,
+        }
+        write_json_atomic(args.json, d)
+    return 0
