@@ -1,0 +1,180 @@
+"""Figures 4–6: friction force and torque against the speed ratio.
+
+Each figure shows one quantity (F∥ against ψ = u/v, M_C and F⊥ against
+υ = v/u, with u = ω_z R) as plain arrays held in a :class:`CurveData`:
+
+* ``exact`` — the exact Coulomb integrals of the FE map (THEORY.md §3),
+* ``closed_form`` — the paper's square-root approximation with the map's
+  coefficients (THEORY.md §4),
+* ``test_x``, ``test_y`` — the noisy "test" points of the identification
+  experiment (THEORY.md §6),
+* ``fit`` with ``band_lo`` … ``band_hi`` — the curve fitted to those points and
+  its 95 % prediction band.
+
+Any of them but ``x`` and ``closed_form`` may be ``None``. The module computes
+nothing physical: the report assembles the arrays.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._arrays import frozen
+from ..errors import ArgumentError
+from . import theme
+
+_ARRAYS = ("x", "closed_form", "exact", "fit", "band_lo", "band_hi", "test_x", "test_y")
+
+
+@dataclass(frozen=True)
+class CurveData:
+    """One of Figures 4–6 as arrays (see the module docstring).
+
+    ``name`` is a short key (``F_parallel``, ``M_C``, ``F_perp``); ``x_name``
+    the abscissa (``psi`` or ``upsilon``, dimensionless); ``unit`` the unit of the
+    ordinates (``N`` or ``N m``). ``x``, ``closed_form``, ``exact``, ``fit``,
+    ``band_lo``, ``band_hi`` share one length; ``test_x``, ``test_y`` another.
+    """
+
+    name: str
+    title: str
+    x_name: str
+    x_label: str
+    y_label: str
+    unit: str
+    x: np.ndarray
+    closed_form: np.ndarray
+    exact: np.ndarray | None = None
+    fit: np.ndarray | None = None
+    band_lo: np.ndarray | None = None
+    band_hi: np.ndarray | None = None
+    test_x: np.ndarray | None = None
+    test_y: np.ndarray | None = None
+    labels: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name in _ARRAYS:
+            v = getattr(self, name)
+            if v is not None:
+                object.__setattr__(self, name, frozen(np.ravel(v)))
+        n = self.x.size
+        for name in ("closed_form", "exact", "fit", "band_lo", "band_hi"):
+            v = getattr(self, name)
+            if v is not None and v.size != n:
+                raise ArgumentError(f"{self.name}: {name} has {v.size} values, x has {n}")
+        if (self.test_x is None) != (self.test_y is None):
+            raise ArgumentError(f"{self.name}: give both test_x and test_y or neither")
+        if self.test_x is not None and self.test_x.size != self.test_y.size:
+            raise ArgumentError(
+                f"{self.name}: test_x has {self.test_x.size} values, test_y {self.test_y.size}"
+            )
+        if (self.band_lo is None) != (self.band_hi is None):
+            raise ArgumentError(f"{self.name}: give both band_lo and band_hi or neither")
+
+    def to_dict(self) -> dict:
+        d = {k: getattr(self, k) for k in ("name", "title", "x_name", "unit")}
+        for k in _ARRAYS:
+            v = getattr(self, k)
+            d[k] = None if v is None else v.tolist()
+        return d
+
+
+def plot_curve(data: CurveData, ax=None):
+    """Plot one of Figures 4–6; return the figure. Series carry ``gid`` =
+    their field name so tests can find them."""
+    import matplotlib.pyplot as plt
+
+    lab = {
+        "exact": "exact integral (FE map)",
+        "closed_form": "closed form (1.8)",
+        "test": "test points (20 % noise)",
+        "fit": "fitted (1.8)",
+        "band": "95 % prediction band",
+        **data.labels,
+    }
+    with theme.mpl_style():
+        if ax is None:
+            fig, ax = plt.subplots(layout="constrained")
+        else:
+            fig = ax.figure
+        if data.band_lo is not None:
+            ax.fill_between(
+                data.x,
+                data.band_lo,
+                data.band_hi,
+                color=theme.FIT_COLOUR,
+                alpha=0.15,
+                lw=0,
+                label=lab["band"],
+                gid="band",
+            )
+        if data.test_x is not None:
+            ax.plot(
+                data.test_x,
+                data.test_y,
+                "o",
+                ms=3.0,
+                color=theme.TEST_COLOUR,
+                alpha=0.7,
+                label=lab["test"],
+                gid="test",
+            )
+        if data.exact is not None:
+            ax.plot(
+                data.x,
+                data.exact,
+                color=theme.EXACT_COLOUR,
+                lw=2.0,
+                label=lab["exact"],
+                gid="exact",
+            )
+        ax.plot(
+            data.x,
+            data.closed_form,
+            color=theme.CLOSED_COLOUR,
+            lw=1.6,
+            ls="--",
+            label=lab["closed_form"],
+            gid="closed_form",
+        )
+        if data.fit is not None:
+            ax.plot(
+                data.x,
+                data.fit,
+                color=theme.FIT_COLOUR,
+                lw=1.4,
+                ls="-.",
+                label=lab["fit"],
+                gid="fit",
+            )
+        ax.set_xlabel(data.x_label)
+        ax.set_ylabel(data.y_label)
+        ax.set_title(data.title, fontsize=10)
+        ax.set_xlim(float(data.x[0]), float(data.x[-1]))
+        ax.axhline(0.0, color="black", lw=0.6)
+        ax.legend(loc="best")
+    return fig
+
+
+def curve_table(curves: Iterable[CurveData]) -> tuple[list[str], list[list]]:
+    """The curves in long form for ``curves.csv``: header and rows
+    (figure, x_name, series, x, value, unit)."""
+    header = ["figure", "x_name", "series", "x", "value", "unit"]
+    rows: list[list] = []
+    for c in curves:
+        for series in ("exact", "closed_form", "fit", "band_lo", "band_hi"):
+            y = getattr(c, series)
+            if y is not None:
+                rows += [
+                    [c.name, c.x_name, series, float(x), float(v), c.unit]
+                    for x, v in zip(c.x, y, strict=True)
+                ]
+        if c.test_x is not None:
+            rows += [
+                [c.name, c.x_name, "test", float(x), float(v), c.unit]
+                for x, v in zip(c.test_x, c.test_y, strict=True)
+            ]
+    return header, rows

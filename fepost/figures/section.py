@@ -1,0 +1,157 @@
+"""Figure 3: contact pressure along the diameters through the static centre of pressure.
+
+The values are the FE field itself, interpolated with the FE elements (linear
+triangles for nodal data, constant per face for face data) by VTK's probe
+filter on the flat patch mesh — not the resampled polar map. Points that fall
+outside the loaded faces carry no contact pressure (0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._arrays import frozen
+from ..errors import ArgumentError
+from ..patch import Patch
+from . import theme
+from .render import DEFAULT_INFLATION_PRESSURE, _check_pressure, patch_mesh
+
+#: Points per diameter.
+N_SECTION = 401
+
+
+def fe_pressure_at(patch: Patch, x, y) -> np.ndarray:
+    """FE contact pressure (Pa) at in-plane points (m, patch frame); 0 off the patch."""
+    import pyvista as pv
+
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    mesh = patch_mesh(patch, 1.0, 0.0)  # mm, flat; "sigma_over_P" = σ in Pa when P* = 1
+    probe = pv.PolyData(np.column_stack([x.ravel() * 1e3, y.ravel() * 1e3, np.zeros(x.size)]))
+    out = probe.sample(mesh, tolerance=1e-6 * max(patch.r_max * 1e3, 1e-12))
+    valid = np.asarray(out.point_data["vtkValidPointMask"], bool)
+    vals = np.asarray(out.point_data["sigma_over_P"], float)
+    return np.where(valid, vals, 0.0).reshape(x.shape)
+
+
+@dataclass(frozen=True)
+class SectionData:
+    """Pressure along the x and y diameters, dimensionless σ/P*.
+
+    ``s`` (mm) is the position along each diameter; ``static_x``, ``static_y``
+    (and ``rolling_x``, ``rolling_y`` when a rolling map is given) are σ/P* along
+    y = 0 and x = 0 respectively. ``inflation_pressure`` P* in Pa; ``R`` (mm) the
+    static r_max.
+    """
+
+    s: np.ndarray
+    static_x: np.ndarray
+    static_y: np.ndarray
+    rolling_x: np.ndarray | None
+    rolling_y: np.ndarray | None
+    inflation_pressure: float
+    R: float
+
+    def __post_init__(self) -> None:
+        for name in ("s", "static_x", "static_y", "rolling_x", "rolling_y"):
+            v = getattr(self, name)
+            if v is not None:
+                object.__setattr__(self, name, frozen(v))
+
+    def to_dict(self) -> dict:
+        d = {
+            "s_mm": self.s.tolist(),
+            "static_x": self.static_x.tolist(),
+            "static_y": self.static_y.tolist(),
+        }
+        if self.rolling_x is not None:
+            d.update({"rolling_x": self.rolling_x.tolist(), "rolling_y": self.rolling_y.tolist()})
+        d.update({"inflation_pressure": self.inflation_pressure, "R_mm": self.R})
+        return d
+
+
+def diameter_sections(
+    static: Patch,
+    rolling: Patch | None = None,
+    *,
+    inflation_pressure: float = DEFAULT_INFLATION_PRESSURE,
+    n: int = N_SECTION,
+    half_length: float | None = None,
+) -> SectionData:
+    """σ/P* along the x and y diameters through the static centre of pressure.
+
+    ``half_length`` (m) of the diameters (default 1.1 × the largest distance of a
+    patch node from the origin, so the curves reach zero).
+    """
+    p_star = _check_pressure(inflation_pressure)
+    if int(n) != n or n < 3:
+        raise ArgumentError(f"n must be an integer >= 3, got {n!r}")
+    patches = [static] + ([rolling] if rolling is not None else [])
+    if half_length is None:
+        half_length = 1.1 * max(float(np.max(np.hypot(p.xy[:, 0], p.xy[:, 1]))) for p in patches)
+    s = np.linspace(-half_length, half_length, int(n))
+    zero = np.zeros_like(s)
+
+    def along(p: Patch) -> tuple[np.ndarray, np.ndarray]:
+        vals = fe_pressure_at(p, np.r_[s, zero], np.r_[zero, s]) / p_star
+        return vals[: s.size], vals[s.size :]
+
+    sx, sy = along(static)
+    rx = ry = None
+    if rolling is not None:
+        rx, ry = along(rolling)
+    return SectionData(s * 1e3, sx, sy, rx, ry, p_star, static.r_max * 1e3)
+
+
+def plot_sections(data: SectionData, axes=None):
+    """Plot the x and y diameters (static solid, rolling dashed); return the figure.
+
+    ``axes``: a pair of matplotlib axes (x section, y section); default a new
+    figure with two side-by-side panels.
+    """
+    import matplotlib.pyplot as plt
+
+    with theme.mpl_style():
+        if axes is None:
+            fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.2), sharey=True, layout="constrained")
+        else:
+            fig = axes[0].figure
+        for ax, axis, st, ro in (
+            (axes[0], "x", data.static_x, data.rolling_x),
+            (axes[1], "y", data.static_y, data.rolling_y),
+        ):
+            ax.plot(
+                data.s, st, color=theme.STATIC_COLOUR, lw=1.8, label="static", gid=f"static_{axis}"
+            )
+            if ro is not None:
+                ax.plot(
+                    data.s,
+                    ro,
+                    color=theme.ROLLING_COLOUR,
+                    lw=1.8,
+                    ls="--",
+                    label="rolling",
+                    gid=f"rolling_{axis}",
+                )
+            for sgn in (-1, 1):
+                ax.axvline(sgn * data.R, color=theme.RMAX_COLOUR, lw=0.8, ls=":")
+            other = "y" if axis == "x" else "x"
+            ax.set_xlabel(f"{axis} (mm), along {other} = 0")
+            ax.set_title(
+                f"{axis} diameter" + (" (rolling direction)" if axis == "x" else " (lateral)")
+            )
+            ax.set_xlim(data.s[0], data.s[-1])
+            ax.set_ylim(bottom=0.0)
+        axes[0].set_ylabel(f"p / P*  (P* = {data.inflation_pressure / 1e3:.0f} kPa)")
+        axes[0].legend(loc="upper left")
+        axes[1].text(
+            data.R,
+            0.02,
+            " r_max",
+            color=theme.RMAX_COLOUR,
+            fontsize=8,
+            transform=axes[1].get_xaxis_transform(),
+        )
+    return fig

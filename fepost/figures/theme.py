@@ -1,0 +1,85 @@
+"""The fixed look of every fepost figure: window size, colours, fonts.
+
+Renders must be reproducible pixel for pixel on one machine (the image
+regression tests compare them with stored baselines), so the pyvista figures use
+a theme built here rather than the user's global theme, a fixed window size and
+a fixed camera, and the matplotlib figures use :func:`mpl_style`.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+#: Window size of the 3-D renders, pixels (width, height).
+WINDOW_SIZE = (1200, 900)
+#: Colour map of pressure, everywhere.
+CMAP = "viridis"
+#: Line colours: static, rolling, outline circle r_max, r_equiv, ellipse.
+STATIC_COLOUR = "#1f4e99"
+ROLLING_COLOUR = "#c0392b"
+RMAX_COLOUR = "#222222"
+REQUIV_COLOUR = "#7f7f7f"
+ELLIPSE_COLOUR = "#e67e22"
+EXACT_COLOUR = "#1f4e99"
+CLOSED_COLOUR = "#2ca02c"
+FIT_COLOUR = "#c0392b"
+TEST_COLOUR = "#555555"
+#: matplotlib figure size (inches) and resolution of the PNGs (dpi).
+MPL_FIGSIZE = (7.0, 4.6)
+MPL_DPI = 130
+
+_MPL_RC = {
+    "figure.figsize": MPL_FIGSIZE,
+    "figure.dpi": 100,
+    "savefig.dpi": MPL_DPI,
+    "font.size": 10,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "legend.fontsize": 8.5,
+    "legend.frameon": False,
+    "svg.fonttype": "none",
+    "svg.hashsalt": "fepost",
+}
+
+
+def use_headless_vtk() -> None:
+    """Prefer VTK's EGL window when there is no X display.
+
+    Without it VTK first tries X, logs "bad X server connection" on stderr and
+    then falls back to EGL; the preference only applies to windows created later.
+    """
+    if not os.environ.get("DISPLAY"):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+
+
+def pyvista_theme():
+    """A fresh :class:`pyvista.themes.DocumentTheme` with fepost's fixed settings."""
+    import pyvista as pv
+
+    theme = pv.themes.DocumentTheme()
+    theme.window_size = list(WINDOW_SIZE)
+    theme.background = "white"
+    theme.font.color = "black"
+    theme.font.family = "arial"
+    theme.font.size = 14
+    theme.font.title_size = 16
+    theme.font.label_size = 14
+    theme.cmap = CMAP
+    theme.anti_aliasing = None
+    theme.lighting = True
+    theme.smooth_shading = False
+    theme.show_scalar_bar = False
+    return theme
+
+
+@contextmanager
+def mpl_style() -> Iterator[None]:
+    """matplotlib rc settings of fepost figures (Agg backend assumed)."""
+    import matplotlib as mpl
+
+    with mpl.rc_context(_MPL_RC):
+        yield

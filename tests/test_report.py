@@ -1,0 +1,261 @@
+"""``fepost report``: every promised file, an HTML that matches the JSON, clean failures."""
+
+from __future__ import annotations
+
+import csv
+import json
+import re
+import shutil
+import subprocess
+import sys
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+
+from fepost.cli import main
+from fepost.synthetic import write_map
+
+REPO = Path(__file__).resolve().parents[1]
+SAMPLES = (REPO / "meshes" / "static.vtu", REPO / "meshes" / "rolling.vtu")
+PROMISED = (
+    "report.html",
+    "coefficients.json",
+    "table1.json",
+    "curves.csv",
+    "fig1_static.png",
+    "fig2_rolling.png",
+    "patch_plan.png",
+    "patch_plan.svg",
+    "patch_plan.pdf",
+    *(
+        f"{stem}.{ext}"
+        for stem in ("fig3_sections", "fig4_f_parallel", "fig5_torque", "fig6_f_perp")
+        for ext in ("png", "svg", "pdf")
+    ),
+)
+TABLE1_NAMES = ["f", "F0", "M0", "a", "m", "k_x"]
+
+
+class _Page(HTMLParser):
+    """Links and the numbers tagged with data-key / data-value."""
+
+    def __init__(self):
+        super().__init__()
+        self.refs: list[str] = []
+        self.values: dict[str, float] = {}
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        for key in ("src", "href"):
+            if a.get(key):
+                self.refs.append(a[key])
+        if "data-key" in a:
+            self.values[a["data-key"]] = float(a["data-value"])
+
+
+def _lookup(data, dotted: str):
+    for part in dotted.split("."):
+        data = data[int(part)] if isinstance(data, list) else data[part]
+    return data
+
+
+def _inputs(tmp_path) -> list[str]:
+    """The shipped sample meshes when they exist, else analytic stand-ins."""
+    if all(p.is_file() for p in SAMPLES):
+        return []
+    s = write_map(tmp_path / "static.vtu", "tire", radius=0.15, peak=6e5, n_rings=24)
+    r = write_map(tmp_path / "rolling.vtu", "tire", radius=0.15, peak=6e5, k_x=0.13, n_rings=24)
+    return [str(s), str(r)]
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("report")
+    out = tmp / "rep"
+    import io
+    from contextlib import redirect_stderr
+
+    err = io.StringIO()
+    inputs = _inputs(tmp)
+    with redirect_stderr(err):
+        code = main(["report", *inputs, "--out", str(out), "--seed", "3"])
+    return code, out, err.getvalue(), inputs
+
+
+@pytest.mark.slow
+def test_report_writes_every_promised_file(report):
+    code, out, _, _ = report
+    assert code == 0
+    for name in PROMISED:
+        assert (out / name).is_file(), name
+        assert (out / name).stat().st_size > 0, name
+    assert not [p.name for p in out.parent.iterdir() if p.name.startswith(".")], (
+        "temporary folder left behind"
+    )
+
+
+@pytest.mark.slow
+def test_report_progress_lines(report):
+    _, _, err, _ = report
+    lines = err.strip().splitlines()
+    steps = [ln for ln in lines if ln.startswith("[")]
+    assert steps and all(
+        re.fullmatch(r"\[\d+/\d+\] .+ \.\.\. done in \d+\.\d s", ln) for ln in steps
+    )
+    assert steps[-1].startswith(f"[{len(steps)}/{len(steps)}]")
+
+
+@pytest.mark.slow
+def test_report_html_references_only_existing_files(report):
+    _, out, _, _ = report
+    page = _Page()
+    page.feed((out / "report.html").read_text(encoding="utf-8"))
+    assert page.refs
+    for ref in page.refs:
+        assert not re.match(r"^[a-z]+:", ref), f"external reference {ref}"
+        assert (out / ref).is_file(), ref
+
+
+@pytest.mark.slow
+def test_report_numbers_equal_the_json(report):
+    _, out, _, _ = report
+    page = _Page()
+    page.feed((out / "report.html").read_text(encoding="utf-8"))
+    sources = {
+        "coefficients": json.loads((out / "coefficients.json").read_text()),
+        "table1": json.loads((out / "table1.json").read_text()),
+    }
+    checked = 0
+    for key, value in page.values.items():
+        src, path = key.split(".", 1)
+        assert value == _lookup(sources[src], path), key
+        checked += 1
+    coef = sources["coefficients"]
+    for key in ("N", "R", "F0", "M0", "a", "m", "k_x"):
+        assert page.values[f"coefficients.{key}"] == coef[key]
+    for i in range(6):
+        for part in ("theory", "fitted", "ci95.0", "ci95.1"):
+            assert f"table1.rows.{i}.{part}" in page.values
+    assert checked >= 40
+
+
+@pytest.mark.slow
+def test_report_json_contract(report):
+    _, out, _, _ = report
+    coef = json.loads((out / "coefficients.json").read_text())
+    for key in ("N", "R", "A", "F0", "M0", "a", "m", "b", "b1", "f", "k_x", "x_c", "N_fe", "patch"):
+        assert key in coef, key
+    t1 = json.loads((out / "table1.json").read_text())
+    assert [r["name"] for r in t1["rows"]] == TABLE1_NAMES
+    for r in t1["rows"]:
+        lo, hi = r["ci95"]
+        assert lo <= r["fitted"] <= hi
+    assert t1["rows"][1]["theory"] == coef["F0"]
+    assert t1["rows"][5]["theory"] == coef["k_x"]
+
+
+@pytest.mark.slow
+def test_report_curves_csv_matches_the_fit(report):
+    _, out, _, _ = report
+    with open(out / "curves.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    figures = {r["figure"] for r in rows}
+    assert figures == {"F_parallel", "M_C", "F_perp"}
+    for fig in figures:
+        series = {r["series"] for r in rows if r["figure"] == fig}
+        assert series == {"exact", "closed_form", "fit", "band_lo", "band_hi", "test"}
+    # The closed form at υ = 0 is M0 exactly.
+    coef = json.loads((out / "coefficients.json").read_text())
+    m0 = [float(r["value"]) for r in rows if r["figure"] == "M_C" and r["series"] == "closed_form"][
+        0
+    ]
+    assert m0 == pytest.approx(coef["M0"], rel=1e-12)
+
+
+@pytest.mark.slow
+def test_report_refuses_non_empty_folder_without_force(report, capsys):
+    _, out, _, inputs = report
+    before = sorted(p.name for p in out.iterdir())
+    code = main(["report", *inputs, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert (
+        err == f"fepost: error: {out}: folder exists and is not empty (use --force to replace it)\n"
+    )
+    assert sorted(p.name for p in out.iterdir()) == before
+
+
+@pytest.fixture
+def small_map(tmp_path):
+    return str(write_map(tmp_path / "small.vtu", "hertz", n_rings=8))
+
+
+def test_report_unwritable_folder(small_map, capsys):
+    code = main(["report", small_map, "--out", "/proc/fepost-report-test"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.startswith("fepost: error: /proc/fepost-report-test: cannot write in /proc (")
+    assert err.count("\n") == 1
+
+
+def test_report_parent_is_a_file(tmp_path, small_map, capsys):
+    (tmp_path / "afile").write_text("x")
+    out = tmp_path / "afile" / "rep"
+    code = main(["report", small_map, "--out", str(out)])
+    assert code == 2
+    assert (
+        capsys.readouterr().err
+        == f"fepost: error: {out}: parent folder {out.parent} does not exist\n"
+    )
+
+
+def test_report_bad_mesh_leaves_nothing(tmp_path, capsys):
+    bad = tmp_path / "bad.vtu"
+    bad.write_text("this is not a VTK file\n")
+    out = tmp_path / "rep"
+    code = main(["report", str(bad), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.startswith(f"fepost: error: {bad}") and err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.vtu"]
+
+
+def test_report_bad_inflation_pressure(tmp_path, small_map, capsys):
+    out = tmp_path / "rep"
+    code = main(["report", small_map, "--out", str(out), "--inflation-pressure", "0"])
+    assert code == 2
+    assert (
+        capsys.readouterr().err
+        == "fepost: error: --inflation-pressure must be a positive pressure in Pa, got 0.0\n"
+    )
+    assert not out.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.vtu"]
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+@pytest.mark.skipif(
+    shutil.which("chromium") is None and not Path("/usr/bin/chromium").is_file(),
+    reason="chromium not installed",
+)
+def test_report_screenshot(report, tmp_path):
+    _, out, _, _ = report
+    png = tmp_path / "shot.png"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            str(REPO / "scripts" / "screenshot_report.py"),
+            str(out / "report.html"),
+            str(png),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    head = png.read_bytes()[:24]
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    width = int.from_bytes(head[16:20], "big")
+    height = int.from_bytes(head[20:24], "big")
+    assert (width, height) == (1280, 4000)
