@@ -1,0 +1,99 @@
+"""CLI: python -m scripts.tiremodel build --case static|rolling|heavy|all [--coarse] [--out DIR]
+
+Every case is solved in a temporary folder; the exported files are moved into
+``--out`` only when all requested cases have succeeded, so a failed or
+interrupted run leaves existing results untouched. Problems (no ``ccx``, no
+convergence) are reported in one line on stderr with a non-zero exit status.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+from . import deck as dk
+from .solve import ModelError, find_ccx
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(
+        prog="python -m scripts.tiremodel", description=__doc__.splitlines()[0]
+    )
+    sub = ap.add_subparsers(dest="command", required=True)
+    b = sub.add_parser("build", help="mesh, solve with CalculiX and export sample results")
+    b.add_argument("--case", choices=[*dk.CASES, "all"], default="all")
+    b.add_argument("--coarse", action="store_true", help="cheap mesh (tests, quick looks)")
+    b.add_argument(
+        "--out", type=Path, default=REPO / "meshes", help="output folder (default: meshes/)"
+    )
+    b.add_argument("--keep", type=Path, default=None, help="also copy the CalculiX work files here")
+    b.add_argument("--threads", type=int, default=2)
+    b.add_argument("--debug", action="store_true", help="show tracebacks")
+    return ap
+
+
+def build(
+    cases: list[str], coarse: bool, out: Path, keep: Path | None = None, threads: int = 2
+) -> list[dict]:
+    from .export import write_case
+    from .geometry import TireParams, build_mesh, coarse_params
+    from .solve import solve_case
+
+    find_ccx()  # fail fast, before meshing
+    params = coarse_params() if coarse else TireParams()
+    mesh = build_mesh(params)
+    sides = []
+    with tempfile.TemporaryDirectory(prefix="tiremodel-") as tmp:
+        tmp = Path(tmp)
+        stage = tmp / "export"
+        for name in cases:
+            print(
+                f"tiremodel: solving {name} ({'coarse' if coarse else 'full'} mesh) ...",
+                file=sys.stderr,
+            )
+            try:
+                res = solve_case(mesh, dk.CASES[name], tmp / name, threads=threads)
+            finally:
+                if keep is not None and (tmp / name).exists():
+                    shutil.copytree(tmp / name, keep / name, dirs_exist_ok=True)
+            side = write_case(res, stage)
+            print(
+                f"tiremodel: {name}: reaction_z = {side['reaction_z']:.1f} N, "
+                f"CPRESS integral = {side['cpress_integral']:.1f} N, {side['runtime_s']:.0f} s",
+                file=sys.stderr,
+            )
+            sides.append(side)
+        out.mkdir(parents=True, exist_ok=True)
+        for f in sorted(stage.iterdir()):
+            tmp_target = out / (f.name + ".part")
+            shutil.copy2(f, tmp_target)
+            os.replace(tmp_target, out / f.name)
+    return sides
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    cases = list(dk.CASES) if args.case == "all" else [args.case]
+    try:
+        build(cases, args.coarse, args.out, args.keep, args.threads)
+    except ModelError as exc:
+        if args.debug:
+            raise
+        print(f"tiremodel: error: {exc}", file=sys.stderr)
+        return 1
+    except Exception as exc:  # noqa: BLE001 - one-line report for the CLI
+        if args.debug:
+            raise
+        print(f"tiremodel: error: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
