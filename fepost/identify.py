@@ -41,6 +41,10 @@ Statistics (all from scipy; nothing hand-rolled in the fit)
   (same weights), bounds where χ²_prof(θ_j) − χ²_min = s²·t²_{0.975, n−p}
   (the F(1, n − p) test). Flagged when an end differs from the Wald end by more
   than :data:`PROFILE_TOLERANCE` of the Wald half-width.
+* Curves: :meth:`Identification.prediction_band` gives the fitted curve with its
+  pointwise 95 % *prediction* band ŷ ± t·√(gᵀΣg + s²σ_c²) (parameter covariance
+  through the analytic Jacobian g, plus the curve's noise level);
+  :meth:`Identification.curve_stderr` the standard error √(gᵀΣg) of the mean curve.
 """
 
 from __future__ import annotations
@@ -184,6 +188,19 @@ class TestCurves:
             true = getattr(self, f"{name}_true")
             d[f"{name}_true"] = true.tolist() if true is not None else None
         return d
+
+
+def _abscissa(x) -> np.ndarray:
+    """ψ or υ values for evaluating a fitted curve: finite numbers, any shape."""
+    try:
+        arr = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ArgumentError(f"x must be an array of numbers, got {type(x).__name__}") from None
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        value = float(arr.flat[bad[0]])
+        raise ArgumentError(f"x must be finite, got {value!r} at index {int(bad[0])}")
+    return arr
 
 
 def _coefficient_values(coefficients) -> dict[str, float]:
@@ -350,6 +367,42 @@ def make_test_curves(
 # ---------------------------------------------------------------------------------
 # The model in the fit parameters θ
 # ---------------------------------------------------------------------------------
+def curve_model(name: str, x, values, R: float) -> tuple[np.ndarray, np.ndarray]:
+    """Closed-form curve ``name`` at ``x`` and its gradient in the parameters.
+
+    ``values``: (F0 (N), M0 (N·m), a, m, k_x), the order of :data:`PARAMETERS`;
+    ``x``: ψ for ``"f_parallel"``, υ for ``"torque"`` and ``"f_perp"``; ``R`` (m).
+    Returns y (N, N·m or N; shape of ``x``) and ∂y/∂(F0, M0, a, m, k_x) (shape of
+    ``x`` + (5,)), analytic:
+
+        F∥ = F0 g1,  g1 = (1 + a ψ²)^(-1/2)          ∂/∂a = −½ F0 ψ² g1³
+        M_C = M0 g2, g2 = (1 + m υ²)^(-1/2)          ∂/∂m = −½ M0 υ² g2³
+        F⊥ = k_x M0/(2R) g3, g3 = (1 + m υ²/4)^(-1/2)  ∂/∂m = −⅛ k_x M0/(2R) υ² g3³
+    """
+    x = np.asarray(x, float)
+    F0, M0, a, m, kx = (float(v) for v in values)
+    grad = np.zeros(x.shape + (len(PARAMETERS),))
+    x2 = x * x
+    if name == "f_parallel":
+        g = f_parallel_ratio(x, a)
+        grad[..., 0] = g
+        grad[..., 2] = -0.5 * F0 * x2 * g**3
+        return F0 * g, grad
+    if name == "torque":
+        g = torque_ratio(x, m)
+        grad[..., 1] = g
+        grad[..., 3] = -0.5 * M0 * x2 * g**3
+        return M0 * g, grad
+    if name == "f_perp":
+        c = 1.0 / (2.0 * R)
+        g = f_perpendicular_ratio(x, m)
+        grad[..., 1] = kx * c * g
+        grad[..., 3] = -0.125 * kx * M0 * c * x2 * g**3
+        grad[..., 4] = M0 * c * g
+        return kx * M0 * c * g, grad
+    raise ArgumentError(f"name must be one of {', '.join(CURVES)}, got {name!r}")
+
+
 @dataclass(frozen=True)
 class _Problem:
     psi: np.ndarray
@@ -376,34 +429,23 @@ class _Problem:
         F0, M0, a, m, kx = values
         return np.array([F0 / self.sF, M0 / self.sM, math.log(a), math.log(m), kx])
 
+    def _abscissae(self):
+        return zip(CURVES, (self.psi, self.ups, self.ups), strict=True)
+
     def model(self, theta) -> np.ndarray:
-        F0, M0, a, m, kx = self.natural(theta)
+        values = self.natural(theta)
         return np.concatenate(
-            [
-                F0 * f_parallel_ratio(self.psi, a),
-                M0 * torque_ratio(self.ups, m),
-                kx * M0 / (2.0 * self.R) * f_perpendicular_ratio(self.ups, m),
-            ]
+            [curve_model(name, x, values, self.R)[0] for name, x in self._abscissae()]
         )
 
     def jacobian(self, theta) -> np.ndarray:
-        """∂model/∂θ, (n, 5)."""
-        F0, M0, a, m, kx = self.natural(theta)
-        p2, u2 = self.psi**2, self.ups**2
-        g1 = 1.0 / np.sqrt(1.0 + a * p2)
-        g2 = 1.0 / np.sqrt(1.0 + m * u2)
-        g3 = 1.0 / np.sqrt(1.0 + 0.25 * m * u2)
-        c = 1.0 / (2.0 * self.R)
-        J = np.zeros((self.y.size, 5))
-        s1, s2, s3 = self.slices
-        J[s1, 0] = self.sF * g1
-        J[s1, 2] = -0.5 * F0 * a * p2 * g1**3
-        J[s2, 1] = self.sM * g2
-        J[s2, 3] = -0.5 * M0 * m * u2 * g2**3
-        J[s3, 1] = self.sM * kx * c * g3
-        J[s3, 3] = -0.5 * kx * M0 * c * 0.25 * m * u2 * g3**3
-        J[s3, 4] = M0 * c * g3
-        return J
+        """∂model/∂θ, (n, 5): ∂model/∂(F0, M0, a, m, k_x) times ∂(F0, M0, a, m, k_x)/∂θ."""
+        values = self.natural(theta)
+        dvalues_dtheta = np.array([self.sF, self.sM, values[2], values[3], 1.0])
+        grad = np.concatenate(
+            [curve_model(name, x, values, self.R)[1] for name, x in self._abscissae()]
+        )
+        return grad * dvalues_dtheta
 
 
 def _initial(prob: _Problem) -> np.ndarray:
@@ -508,6 +550,63 @@ class Identification:
         sd = np.sqrt(np.diag(self.covariance))
         with np.errstate(invalid="ignore", divide="ignore"):
             return frozen(self.covariance / np.outer(sd, sd))
+
+    def curve(self, name: str, x) -> np.ndarray:
+        """Fitted closed-form curve ``name`` (one of :data:`CURVES`) at ``x`` (ψ or υ).
+
+        Units: N for ``"f_parallel"`` and ``"f_perp"``, N·m for ``"torque"``.
+        """
+        return frozen(curve_model(name, _abscissa(x), self.values, self.R)[0])
+
+    def curve_stderr(self, name: str, x) -> np.ndarray:
+        """Standard error of the fitted curve at ``x``: √(gᵀΣg) (units of the curve).
+
+        g = ∂ŷ/∂(F0, M0, a, m, k_x) (analytic, :func:`curve_model`) and Σ =
+        :attr:`covariance` (delta method, linearised about the fit). This is the
+        uncertainty of the *mean* curve; ± t·curve_stderr is its confidence band.
+        NaN when the covariance is indeterminate.
+        """
+        _, g = curve_model(name, _abscissa(x), self.values, self.R)
+        var = np.einsum("...i,ij,...j->...", g, self.covariance, g)
+        return frozen(np.sqrt(np.maximum(var, 0.0)))
+
+    def prediction_band(
+        self, name: str, x, level: float = CONFIDENCE
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Fitted curve ``name`` at ``x`` and its pointwise prediction band: (ŷ, lo, hi).
+
+        A *prediction* band, not a confidence band: it holds a new measurement of
+        the curve at x (same noise as the fitted data) with probability ``level``,
+        pointwise (not simultaneously over x). Half-width t·√(gᵀΣg + s²σ_c²):
+
+        * gᵀΣg, the parameter uncertainty propagated through the Jacobian g =
+          ∂ŷ/∂(F0, M0, a, m, k_x) with the fit's covariance Σ (:meth:`curve_stderr`);
+        * s²σ_c², the noise variance of one measurement of curve c: σ_c from
+          :attr:`noise_sigma`, s² = :attr:`redchi` (the scale of the covariance,
+          which is 1 at the fixed point of the reweighting);
+        * t = Student-t quantile (1 + level)/2 with ν_c = n_c − h_c degrees of
+          freedom, those of the σ_c estimate (n_c points, h_c = :attr:`dof_share`).
+          The noise term dominates the variance; the Welch–Satterthwaite degrees
+          of freedom of the sum lie between ν_c and :attr:`dof`, so using ν_c errs
+          on the wide side (with :attr:`dof` instead, a band at 50 points per curve
+          covers about 94.5 % rather than 95 %).
+
+        For one curve with known shape and Gaussian noise this is the textbook
+        ŷ ± t s √(1 + xᵀ(XᵀX)⁻¹x); here it holds to first order in the parameter
+        errors. Units of the curve; NaN bounds when the covariance is indeterminate.
+        """
+        level = float(level)
+        if not (0.0 < level < 1.0):
+            raise ArgumentError(f"level must be a probability in (0, 1), got {level!r}")
+        if name not in CURVES:
+            raise ArgumentError(f"name must be one of {', '.join(CURVES)}, got {name!r}")
+        x = _abscissa(x)
+        y = self.curve(name, x)
+        var = self.curve_stderr(name, x) ** 2 + self.redchi * self.noise_sigma[name] ** 2
+        nu = max(self.residuals[name].size - self.dof_share[name], 0.5)  # as in fit_table1
+        t = float(special.stdtrit(nu, 0.5 + level / 2.0))
+        half = t * np.sqrt(var)
+        return y, frozen(y - half), frozen(y + half)
 
     def to_dict(self) -> dict:
         params = {

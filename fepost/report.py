@@ -3,28 +3,34 @@
 :func:`build_report` runs the pipeline on a static (and optionally a rolling) FE
 map and writes into ``out``:
 
-=====================  ==========================================================
-``report.html``        the report (opens from disk; figures linked relatively)
-``fig1_static.png``    Figure 1: static pressure over the FE patch (3-D)
-``fig2_rolling.png``   Figure 2: rolling pressure (3-D; with a rolling map)
-``fig3_sections.*``    Figure 3: pressure along the x and y diameters (PNG, SVG, PDF)
-``patch_plan.*``       the loaded region in plan with the circularity check
-``fig4_f_parallel.*``  Figure 4: F∥(ψ)
-``fig5_torque.*``      Figure 5: M_C(υ)
-``fig6_f_perp.*``      Figure 6: F⊥(υ) (with a rolling map)
-``coefficients.json``  :meth:`fepost.analysis.Analysis.to_dict`
-``table1.json``        Table 1 (INTERFACE.md: ``rows`` of name, theory, fitted, ci95)
-``curves.csv``         the curves of Figures 4–6 in long form
-=====================  ==========================================================
+==============================  ====================================================
+``report.html``                 the report (opens from disk; figures linked relatively)
+``fig1_static.png``             Figure 1: static pressure over the FE patch (3-D)
+``fig2_rolling.png``            Figure 2: rolling pressure (3-D; with a rolling map)
+``fig3_sections.*``             Figure 3: pressure along the x and y diameters
+                                (PNG, SVG, PDF)
+``patch_plan.*``                the loaded region in plan with the circularity check
+``fig4_f_parallel.*``           Figure 4: F∥(ψ)
+``fig5_torque.*``               Figure 5: M_C(υ)
+``fig6_f_perp.*``               Figure 6: F⊥(υ) (with a rolling map)
+``coefficients.json``           :meth:`fepost.analysis.Analysis.to_dict`
+``table1.json``                 :meth:`fepost.table1.Table1.to_dict` (INTERFACE.md:
+                                ``rows`` of name, theory, fitted, ci95)
+``closed_form_vs_exact.json``   :meth:`FrictionCurves.errors_dict`: largest gap
+                                between the closed forms and the exact integrals
+``curves.csv``                  the curves of Figures 4–6 in long form
+==============================  ====================================================
 
 Everything is written into a temporary folder beside ``out`` and moved into
 place only when every step succeeded (:func:`fepost.output.staged_folder`).
 
-Table 1 follows the paper's procedure (THEORY.md §6): the closed-form curves
-(1.8) with the map's coefficients, 20 % uniform noise, a joint least-squares fit
-(:func:`fepost.identify.fit_table1`). The same fit on noisy data made from the
-exact integrals (:func:`fepost.identify.approximation_bias`) shows the bias the
-approximation itself causes.
+Table 1 is :func:`fepost.table1.table1` with its defaults (the same call as
+``fepost table1``, so ``table1.json`` equals ``fepost table1 --json`` on the same
+inputs and seed, default :data:`fepost.table1.DEFAULT_SEED`): the closed-form
+curves (1.8) with the map's coefficients, 20 % uniform noise, a joint
+least-squares fit, and the same fit on exact-integral data for the bias of the
+approximation. Figures 4–6 show its test points and fitted curves with their
+95 % prediction band (:meth:`fepost.identify.Identification.prediction_band`).
 """
 
 from __future__ import annotations
@@ -35,41 +41,27 @@ import io
 import json
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from . import identify
 from .analysis import Analysis, analyse
 from .errors import ArgumentError
 from .output import staged_folder, to_json
+from .table1 import DEFAULT_SEED, Table1, table1
+
+if TYPE_CHECKING:
+    from .figures.curves import CurveData
 
 #: Inflation pressure P* (Pa) when neither the option nor the sidecar gives one: the paper's.
 DEFAULT_INFLATION_PRESSURE = 200e3
-#: Points of the dense curves of Figures 4–6, and their span of ψ and υ.
+#: Points of the dense curves of Figures 4–6 (on [0, the span of Table 1's test curves]).
 CURVE_POINTS = 201
-CURVE_SPAN = 5.0
-
-#: The paper's Table 1 (theory, fitted, 95 % bounds), THEORY.md §6.
-PAPER_TABLE1 = {
-    "f": (0.3, 0.301, (0.296, 0.305)),
-    "F0": (72219.0, 72370.0, (71200.0, 73530.0)),
-    "M0": (3215.0, 3252.0, (3182.0, 3322.0)),
-    "a": (0.690, 0.714, (0.603, 0.825)),
-    "m": (1.595, 1.607, (1.348, 1.867)),
-    "k_x": (0.130, 0.129, (0.128, 0.131)),
-}
-PAPER_NOTES = (
-    "N = 2.41e5 N with F0 = 72219 N fits f = 0.3, but M0/F0 = 0.045 m implies a patch radius near 7 cm, "
-    "far too small for that load at P* = 200 kPa.",
-    "m = 1.595 is impossible under sqrt(m) = 2A2/A3: that needs m >= 4 since A3 <= A2.",
-    "The text's 'm = 0.025 m, a = 0.052 m^1/2' conflicts with the table.",
-    "So the procedure and the table's structure are reproduced on our own FE maps and the paper's "
-    "numbers are shown beside ours, not forced.",
-)
-TABLE1_NAMES = ("f", "F0", "M0", "a", "m", "k_x")
-UNITS = {"f": "", "F0": "N", "M0": "N m", "a": "", "m": "", "k_x": "", "N": "N", "R": "m"}
 
 Progress = Callable[[int, int, str, float], None]
 
@@ -149,179 +141,133 @@ def resolve_inflation_pressure(option: float | None, analysis: Analysis) -> tupl
 # --------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class FrictionCurves:
-    """Exact, closed-form, test and fitted curves of Figures 4–6 and the fit behind them."""
+    """The curves of Figures 4–6 and how far the closed forms lie from the exact integrals.
 
-    curves: tuple  # of figures.CurveData
-    identification: object | None  # identify.Identification
-    test: object | None  # identify.TestCurves
-    bias: object | None  # identify.BiasReport
-    errors: dict  # closed-form vs exact: curve -> {max_abs_relative, at, scale}
-
-
-def _prediction_band(
-    ident, curve: str, x: np.ndarray, R: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Fitted curve and its 95 % prediction band: ŷ ± t·√(gᵀΣg + σ_c²).
-
-    g = ∂ŷ/∂(F0, M0, a, m, k_x) by central differences of the closed form,
-    Σ = the fit's covariance, σ_c the curve's estimated noise level.
+    ``curves``: one :class:`~fepost.figures.curves.CurveData` per figure (F∥, M_C and,
+    with a rolling map, F⊥); ``errors``: per curve, the largest |exact − closed form|
+    relative to the curve's scale (``max_abs_relative``), where (``at``, ψ or υ) and
+    the scale (N or N·m).
     """
-    from .friction.closed_form import f_parallel_ratio, f_perpendicular_ratio, torque_ratio
 
-    def model(p):
-        F0, M0, a, m, kx = p
-        if curve == "f_parallel":
-            return F0 * f_parallel_ratio(x, a)
-        if curve == "torque":
-            return M0 * torque_ratio(x, m)
-        return kx * M0 / (2.0 * R) * f_perpendicular_ratio(x, m)
+    curves: tuple[CurveData, ...]
+    errors: Mapping[str, Mapping[str, Any]]
 
-    p0 = np.asarray(ident.values, float)
-    y = model(p0)
-    g = np.zeros((x.size, p0.size))
-    for j in range(p0.size):
-        h = 1e-6 * max(abs(p0[j]), 1e-6)
-        dp = np.zeros_like(p0)
-        dp[j] = h
-        g[:, j] = (model(p0 + dp) - model(p0 - dp)) / (2.0 * h)
-    cov = np.asarray(ident.covariance, float)
-    var = np.einsum("ij,jk,ik->i", g, cov, g) + float(ident.noise_sigma[curve]) ** 2
-    half = float(ident.t_quantile) * np.sqrt(np.maximum(var, 0.0))
-    return y, y - half, y + half
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "curves", tuple(self.curves))
+        object.__setattr__(
+            self,
+            "errors",
+            MappingProxyType({k: MappingProxyType(dict(v)) for k, v in self.errors.items()}),
+        )
+
+    def errors_dict(self) -> dict:
+        """``errors`` as plain dicts (the report's ``closed_form_vs_exact.json``)."""
+        return {k: dict(v) for k, v in self.errors.items()}
 
 
-def friction_curves(analysis: Analysis, *, seed: int | None = 0) -> FrictionCurves:
-    """Assemble the arrays of Figures 4–6 (exact integrals, closed forms, test points, fit)."""
-    from . import identify
+def friction_curves(analysis: Analysis, table: Table1) -> FrictionCurves:
+    """Assemble the arrays of Figures 4–6 from the analysis and its Table 1.
+
+    Dense curves on :data:`CURVE_POINTS` values of ψ, υ in [0, ``table.span``]: the
+    exact Coulomb integrals over the static map (F∥, M_C) and the rolling map (F⊥);
+    the closed forms (1.8) with the theoretical coefficients of ``table``; the fitted
+    curves with their 95 % prediction band
+    (:meth:`fepost.identify.Identification.prediction_band`); and the noisy test
+    points of ``table.curves``. Figure 6 only with a rolling map.
+    """
     from .figures.curves import CurveData
-    from .friction.closed_form import f_parallel_ratio, f_perpendicular_ratio, torque_ratio
     from .friction.quadrature import PressureQuadrature
 
     c = analysis.coefficients
-    R = c.R
+    R = table.R
     quad = PressureQuadrature.from_polar(analysis.static_map)
-    rquad = (
-        PressureQuadrature.from_polar(analysis.rolling_map)
-        if analysis.rolling_map is not None
-        else None
-    )
-    x = np.linspace(0.0, CURVE_SPAN, CURVE_POINTS)
-    fpar_ex, torque_ex, fperp_ex = identify.exact_curves(
-        quad, x, x, R, rolling_quad=rquad, friction=c.f
-    )
-    fpar_cf = c.F0 * f_parallel_ratio(x, c.a)
-    torque_cf = c.M0 * torque_ratio(x, c.m)
-    has_roll = c.k_x is not None
-    fperp_cf = c.k_x * c.M0 / (2.0 * R) * f_perpendicular_ratio(x, c.m) if has_roll else None
-
-    ident = test = bias = None
-    fits: dict[str, tuple] = {}
-    if has_roll:
-        test = identify.make_test_curves(
-            "closed_form", c, n_points=identify.DEFAULT_N_POINTS, span=CURVE_SPAN, seed=seed
+    rolling_map = analysis.rolling_map
+    rquad = PressureQuadrature.from_polar(rolling_map) if rolling_map is not None else None
+    has_roll = rquad is not None
+    x = np.linspace(0.0, table.span, CURVE_POINTS)
+    exact = dict(
+        zip(
+            identify.CURVES,
+            identify.exact_curves(quad, x, x, R, rolling_quad=rquad, friction=c.f),
+            strict=True,
         )
-        ident = identify.fit_table1(test, c.N)
-        bias = identify.approximation_bias(c, quad, rolling_quad=rquad, span=CURVE_SPAN, seed=seed)
-        for name in identify.CURVES:
-            fits[name] = _prediction_band(ident, name, x, R)
-
-    def errs(exact, closed, scale):
-        d = np.abs(np.asarray(exact) - np.asarray(closed))
-        i = int(np.argmax(d))
-        return {"max_abs_relative": float(d[i] / scale), "at": float(x[i]), "scale": float(scale)}
-
-    errors = {
-        "f_parallel": errs(fpar_ex, fpar_cf, c.F0) | {"x_name": "psi", "scale_name": "F0"},
-        "torque": errs(torque_ex, torque_cf, c.M0) | {"x_name": "upsilon", "scale_name": "M0"},
+    )
+    theory = [table.row(name).theory for name in identify.PARAMETERS]
+    closed = {name: identify.curve_model(name, x, theory, R)[0] for name in identify.CURVES}
+    scales = {
+        "f_parallel": ("psi", "F0", theory[0]),
+        "torque": ("upsilon", "M0", theory[1]),
+        "f_perp": ("upsilon", "|k_x| M0 / 2R", abs(theory[4]) * theory[1] / (2.0 * R)),
     }
-    if has_roll and c.k_x != 0:
-        errors["f_perp"] = errs(fperp_ex, fperp_cf, abs(c.k_x) * c.M0 / (2 * R)) | {
-            "x_name": "upsilon",
-            "scale_name": "|k_x| M0 / 2R",
+    shown = ("f_parallel", "torque") + (("f_perp",) if has_roll else ())
+    errors = {}
+    for key in shown:
+        x_name, scale_name, scale = scales[key]
+        if scale == 0:
+            continue
+        d = np.abs(exact[key] - closed[key])
+        i = int(np.argmax(d))
+        errors[key] = {
+            "max_abs_relative": float(d[i] / scale),
+            "at": float(x[i]),
+            "scale": float(scale),
+            "x_name": x_name,
+            "scale_name": scale_name,
         }
-
-    def curve(name, key, title, x_name, x_label, y_label, unit, exact, closed):
-        fit = fits.get(key)
-        tx = ty = None
-        if test is not None:
-            tx, ty = test.data(key)
-        return CurveData(
-            name=name,
-            title=title,
-            x_name=x_name,
-            x_label=x_label,
-            y_label=y_label,
-            unit=unit,
-            x=x,
-            closed_form=closed,
-            exact=exact,
-            fit=None if fit is None else fit[0],
-            band_lo=None if fit is None else fit[1],
-            band_hi=None if fit is None else fit[2],
-            test_x=tx,
-            test_y=ty,
-        )
-
-    curves = [
-        curve(
-            "F_parallel",
-            "f_parallel",
-            "Figure 4: longitudinal friction force F∥ against ψ = u/v",
-            "psi",
-            "ψ = ω_z R / v",
-            "F∥ (N)",
-            "N",
-            fpar_ex,
-            fpar_cf,
-        ),
-        curve(
-            "M_C",
-            "torque",
-            "Figure 5: friction torque M_C against υ = v/u",
-            "upsilon",
-            "υ = v / (ω_z R)",
-            "M_C (N·m)",
-            "N m",
-            torque_ex,
-            torque_cf,
-        ),
-    ]
-    if has_roll:
+    fit = table.identification
+    curves = []
+    for key in shown:
+        name, title, x_name, x_label, y_label, unit = _FIGURES[key]
+        y, lo, hi = fit.prediction_band(key, x)
+        test_x, test_y = table.curves.data(key)
         curves.append(
-            curve(
-                "F_perp",
-                "f_perp",
-                "Figure 6: lateral friction force F⊥ against υ = v/u (rolling map)",
-                "upsilon",
-                "υ = v / (ω_z R)",
-                "F⊥ = −F_y (N)",
-                "N",
-                fperp_ex,
-                fperp_cf,
+            CurveData(
+                name=name,
+                title=title,
+                x_name=x_name,
+                x_label=x_label,
+                y_label=y_label,
+                unit=unit,
+                x=x,
+                closed_form=closed[key],
+                exact=exact[key],
+                fit=y,
+                band_lo=lo,
+                band_hi=hi,
+                test_x=test_x,
+                test_y=test_y,
             )
         )
-    return FrictionCurves(tuple(curves), ident, test, bias, errors)
+    return FrictionCurves(tuple(curves), errors)
 
 
-def table1_rows(analysis: Analysis, ident) -> list[dict]:
-    """Table 1 rows (INTERFACE.md): name, theory, fitted, ci95, plus the paper's values."""
-    c = analysis.coefficients
-    theory = {"f": c.f, "F0": c.F0, "M0": c.M0, "a": c.a, "m": c.m, "k_x": c.k_x}
-    rows = []
-    for name in TABLE1_NAMES:
-        lo, hi = ident.interval(name)
-        pt, pf, pci = PAPER_TABLE1[name]
-        rows.append(
-            {
-                "name": name,
-                "theory": float(theory[name]),
-                "fitted": float(ident.value(name)),
-                "ci95": [float(lo), float(hi)],
-                "unit": UNITS[name],
-                "paper": {"theory": pt, "fitted": pf, "ci95": list(pci)},
-            }
-        )
-    return rows
+#: Figures 4–6: curve -> (figure name, title, x name, x label, y label, unit).
+_FIGURES = {
+    "f_parallel": (
+        "F_parallel",
+        "Figure 4: longitudinal friction force F∥ against ψ = u/v",
+        "psi",
+        "ψ = ω_z R / v",
+        "F∥ (N)",
+        "N",
+    ),
+    "torque": (
+        "M_C",
+        "Figure 5: friction torque M_C against υ = v/u",
+        "upsilon",
+        "υ = v / (ω_z R)",
+        "M_C (N·m)",
+        "N m",
+    ),
+    "f_perp": (
+        "F_perp",
+        "Figure 6: lateral friction force F⊥ against υ = v/u (rolling map)",
+        "upsilon",
+        "υ = v / (ω_z R)",
+        "F⊥ = −F_y (N)",
+        "N",
+    ),
+}
 
 
 # --------------------------------------------------------------------------------------
@@ -416,7 +362,7 @@ def _html(ctx: dict) -> str:
             )
         )
     else:
-        rows.append(("rolling map", "none (no k_x, no Figure 2, no Figure 6, no Table 1)"))
+        rows.append(("rolling map", "none (no Figure 2, no Figure 6; Table 1 assumes k_x)"))
     rows += [
         ("friction coefficient f", f"{c.f:g}"),
         ("inflation pressure P*", f"{ctx['p_star'] / 1e3:g} kPa ({_esc(ctx['p_star_source'])})"),
@@ -458,10 +404,10 @@ def _html(ctx: dict) -> str:
             f"<tr><th>{_esc(key)}</th>{_num(coef[key], 'coefficients.' + key)}<td>{_esc(unit)}</td>"
             f"<td>{_esc(d)}</td></tr>\n"
         )
-    for k in range(4):
+    for j in range(4):
         w(
-            f"<tr><th>A{k}</th>{_num(coef['A'][k], f'coefficients.A.{k}')}<td>Pa</td>"
-            f"<td>∫₀¹ σ̄₀(ρ) ρ^{k} dρ</td></tr>\n"
+            f"<tr><th>A{j}</th>{_num(coef['A'][j], f'coefficients.A.{j}')}<td>Pa</td>"
+            f"<td>∫₀¹ σ̄₀(ρ) ρ^{j} dρ</td></tr>\n"
         )
     if coef.get("reaction_z") is not None:
         w(
@@ -504,60 +450,65 @@ def _html(ctx: dict) -> str:
             w(ctx["figure_html"][key])
 
     # Table 1
+    t1 = ctx["table1"]
+    settings = t1["settings"]
+    noise = t1["noise_description"]
     w("<h2>Table 1: identification from noisy test curves</h2>\n")
-    rows = ctx["table1"]["rows"]
-    if rows:
-        noise = ctx["table1"]["noise"]
+    w(
+        "<p>The paper's procedure (THEORY.md §6), as <code>fepost table1</code> runs it: "
+        f"the {_esc(settings['source'].replace('_', '-'))} curves with this map's coefficients, "
+        f"perturbed by {_esc(noise['kind'])} noise of amplitude {noise['fraction']:.0%} of each "
+        f"curve's maximum (seed {_esc(settings['seed'])}), {settings['n_points_per_curve']} points "
+        f"per curve on [0, {settings['span']:g}], fitted jointly by nonlinear least squares; "
+        f"f = F0/N. Bounds are Wald 95 % bounds. k_x theory: {_esc(settings['k_x_source'])}.</p>\n"
+    )
+    w(
+        "<table>\n<tr><th rowspan='2'>coef</th><th colspan='3'>this map</th><th colspan='3'>the paper's Table 1</th>"
+        "</tr>\n<tr><th>theory</th><th>fitted</th><th>95 % bounds</th><th>theory</th><th>fitted</th>"
+        "<th>95 % bounds</th></tr>\n"
+    )
+    for i, r in enumerate(t1["rows"]):
+        lo, hi = r["ci95"]
+        pp = r["paper"]
         w(
-            "<p>The paper's procedure (THEORY.md §6): the closed-form curves (1.8) with this map's coefficients, "
-            f"perturbed by uniform noise of amplitude {noise['fraction']:.0%} of each curve's maximum "
-            f"(seed {_esc(noise['seed'])}), {ctx['table1']['n_points']} points, fitted jointly by nonlinear least "
-            "squares; f = F0/N. Bounds are Wald 95 % bounds.</p>\n"
+            f"<tr><th>{_esc(r['name'])}{' (' + _esc(r['unit']) + ')' if r['unit'] else ''}</th>"
+            f"{_num(r['theory'], f'table1.rows.{i}.theory')}{_num(r['fitted'], f'table1.rows.{i}.fitted')}"
+            f"<td class='num'><span data-key='table1.rows.{i}.ci95.0' data-value='{lo!r}'>{lo:.5g}</span>, "
+            f"<span data-key='table1.rows.{i}.ci95.1' data-value='{hi!r}'>{hi:.5g}</span></td>"
+            f"<td class='num'>{pp['theory']:g}</td><td class='num'>{pp['fitted']:g}</td>"
+            f"<td class='num'>{pp['ci95'][0]:g}, {pp['ci95'][1]:g}</td></tr>\n"
         )
-        w(
-            "<table>\n<tr><th rowspan='2'>coef</th><th colspan='3'>this map</th><th colspan='3'>the paper's Table 1</th>"
-            "</tr>\n<tr><th>theory</th><th>fitted</th><th>95 % bounds</th><th>theory</th><th>fitted</th>"
-            "<th>95 % bounds</th></tr>\n"
-        )
-        for i, r in enumerate(rows):
-            lo, hi = r["ci95"]
-            pp = r["paper"]
-            w(
-                f"<tr><th>{_esc(r['name'])}{' (' + _esc(r['unit']) + ')' if r['unit'] else ''}</th>"
-                f"{_num(r['theory'], f'table1.rows.{i}.theory')}{_num(r['fitted'], f'table1.rows.{i}.fitted')}"
-                f"<td class='num'><span data-key='table1.rows.{i}.ci95.0' data-value='{lo!r}'>{lo:.5g}</span>, "
-                f"<span data-key='table1.rows.{i}.ci95.1' data-value='{hi!r}'>{hi:.5g}</span></td>"
-                f"<td class='num'>{pp['theory']:g}</td><td class='num'>{pp['fitted']:g}</td>"
-                f"<td class='num'>{pp['ci95'][0]:g}, {pp['ci95'][1]:g}</td></tr>\n"
-            )
-        w(
-            "</table>\n<p><b>The paper's numbers are not self-consistent</b> (THEORY.md §6):</p>\n<ul>\n"
-        )
-        for n in PAPER_NOTES:
+    w("</table>\n")
+    notes = t1["notes"]
+    w("<ul>\n")
+    for n in notes:
+        if not n.startswith("paper:"):
             w(f"<li class='note'>{_esc(n)}</li>\n")
-        w("</ul>\n")
-        b = ctx["table1"].get("approximation_bias")
-        if b:
+    w("</ul>\n<p><b>The paper's numbers are not self-consistent</b> (THEORY.md §6):</p>\n<ul>\n")
+    for n in notes:
+        if n.startswith("paper:"):
+            w(f"<li class='note'>{_esc(n.removeprefix('paper:').strip())}</li>\n")
+    w("</ul>\n")
+    b = t1.get("exact_bias")
+    if b:
+        w(
+            "<p>Going further: the same fit on data made from the <em>exact</em> integrals (noise-free, then with "
+            "the same noise). The noise-free fit's departure from the asymptotic values is the bias the "
+            "square-root approximation itself causes.</p>\n<table>\n<tr><th>coef</th><th>asymptotic</th>"
+            "<th>fit to exact, noise-free</th><th>relative bias</th><th>fit to exact + noise</th>"
+            "<th>95 % bounds</th><th>bounds hold the asymptotic value</th></tr>\n"
+        )
+        for name in ("F0", "M0", "a", "m", "k_x"):
+            nz = b["noisy_fit"][name]
             w(
-                "<p>Going further: the same fit on data made from the <em>exact</em> integrals (noise-free, then with "
-                "the same noise). The noise-free fit's departure from the asymptotic values is the bias the "
-                "square-root approximation itself causes.</p>\n<table>\n<tr><th>coef</th><th>asymptotic</th>"
-                "<th>fit to exact, noise-free</th><th>relative bias</th><th>fit to exact + noise</th>"
-                "<th>95 % bounds</th><th>bounds hold the asymptotic value</th></tr>\n"
+                f"<tr><th>{name}</th>{_num(b['theory'][name], f'table1.exact_bias.theory.{name}')}"
+                f"{_num(b['noise_free_fit'][name], f'table1.exact_bias.noise_free_fit.{name}')}"
+                f"{_num(b['relative_bias'][name], f'table1.exact_bias.relative_bias.{name}', '{:+.2%}')}"
+                f"{_num(nz['value'], f'table1.exact_bias.noisy_fit.{name}.value')}"
+                f"<td class='num'>{nz['ci95'][0]:.5g}, {nz['ci95'][1]:.5g}</td>"
+                f"<td>{'yes' if b['noisy_ci_covers_theory'][name] else '<b>no</b>'}</td></tr>\n"
             )
-            for name in ("F0", "M0", "a", "m", "k_x"):
-                nz = b["noisy_fit"][name]
-                w(
-                    f"<tr><th>{name}</th>{_num(b['theory'][name], f'table1.approximation_bias.theory.{name}')}"
-                    f"{_num(b['noise_free_fit'][name], f'table1.approximation_bias.noise_free_fit.{name}')}"
-                    f"{_num(b['relative_bias'][name], f'table1.approximation_bias.relative_bias.{name}', '{:+.2%}')}"
-                    f"{_num(nz['value'], f'table1.approximation_bias.noisy_fit.{name}.value')}"
-                    f"<td class='num'>{nz['ci95'][0]:.5g}, {nz['ci95'][1]:.5g}</td>"
-                    f"<td>{'yes' if b['noisy_ci_covers_theory'][name] else '<b>no</b>'}</td></tr>\n"
-                )
-            w("</table>\n")
-    else:
-        w(f"<p>{_esc(ctx['table1'].get('note', 'not computed'))}</p>\n")
+        w("</table>\n")
 
     # Closed form vs exact
     w("<h2>Closed forms against the exact integrals</h2>\n")
@@ -567,8 +518,9 @@ def _html(ctx: dict) -> str:
         "<th>max |exact − closed form| / scale</th><th>at</th><th>scale</th></tr>\n"
     )
     for key, e in ctx["errors"].items():
+        cell = _num(e["max_abs_relative"], f"closed_form_vs_exact.{key}.max_abs_relative", "{:.3f}")
         w(
-            f"<tr><th>{_esc(key)}</th>{_num(e['max_abs_relative'], f'table1.closed_form_vs_exact.{key}.max_abs_relative', '{:.3f}')}"
+            f"<tr><th>{_esc(key)}</th>{cell}"
             f"<td>{_esc(e['x_name'])} = {e['at']:.3g}</td><td>{_esc(e['scale_name'])}</td></tr>\n"
         )
     w(
@@ -618,7 +570,7 @@ def build_report(
     force: bool = False,
     friction: float = 0.3,
     inflation_pressure: float | None = None,
-    seed: int | None = 0,
+    seed: int | None = DEFAULT_SEED,
     analysis_kwargs: dict | None = None,
     progress: Progress | None = None,
 ) -> ReportResult:
@@ -626,7 +578,8 @@ def build_report(
 
     ``static``, ``rolling``: FE exports (paths) or :class:`~fepost.field.ContactField`;
     ``friction``: f; ``inflation_pressure``: P* in Pa (default: the static mesh's
-    sidecar key ``inflation_pressure``, else 200 kPa); ``seed``: noise of Table 1;
+    sidecar key ``inflation_pressure``, else 200 kPa); ``seed``: noise of Table 1
+    (default :data:`fepost.table1.DEFAULT_SEED`, as ``fepost table1``);
     ``analysis_kwargs``: passed to :func:`fepost.analysis.analyse`;
     ``progress(k, n, step, seconds)``: called after each step.
     Raises :class:`~fepost.errors.OutputError` when ``out`` exists and is not
@@ -650,7 +603,7 @@ def build_report(
     if inflation_pressure is not None:
         _check_inflation_option(inflation_pressure)
     has_roll = rolling is not None
-    steps = _Steps(total=7 + (1 if has_roll else 0), progress=progress)
+    steps = _Steps(total=8 + (1 if has_roll else 0), progress=progress)
     with staged_folder(out, force=force) as tmp:
         a = steps.run(
             "read and analyse the FE maps",
@@ -729,7 +682,8 @@ def build_report(
             names[1:],
         )
 
-        fc = steps.run("exact friction integrals and Table 1 fit", friction_curves, a, seed=seed)
+        t = steps.run("Table 1 (identification fit and exact-data bias)", table1, a, seed=seed)
+        fc = steps.run("exact friction integrals (Figures 4-6)", friction_curves, a, t)
 
         def curve_figs():
             out_names = []
@@ -764,34 +718,24 @@ def build_report(
         def write_data():
             coef = a.to_dict()
             (tmp / "coefficients.json").write_text(to_json(coef) + "\n")
-            if fc.identification is not None:
-                t1 = {
-                    "rows": table1_rows(a, fc.identification),
-                    "procedure": "closed-form curves (1.8) + uniform noise 0.2*max per curve, joint least squares",
-                    "noise": dict(fc.test.noise),
-                    "n_points": int(fc.test.n_points),
-                    "N": a.coefficients.N,
-                    "R": a.coefficients.R,
-                    "fit": fc.identification.to_dict(),
-                    "approximation_bias": fc.bias.to_dict() if fc.bias is not None else None,
-                    "paper_notes": list(PAPER_NOTES),
-                }
-            else:
-                t1 = {"rows": [], "note": "Table 1 needs a rolling map (k_x); none was given"}
-            t1["closed_form_vs_exact"] = fc.errors
-            t1 = json.loads(to_json(t1))
-            (tmp / "table1.json").write_text(json.dumps(t1, indent=2) + "\n")
+            t1_text = to_json(t.to_dict())
+            (tmp / "table1.json").write_text(t1_text + "\n")
+            errors_text = to_json(fc.errors_dict())
+            (tmp / "closed_form_vs_exact.json").write_text(errors_text + "\n")
             header, rows = curve_table(fc.curves)
             with open(tmp / "curves.csv", "w", newline="") as fh:
                 wr = csv.writer(fh)
                 wr.writerow(header)
                 wr.writerows(rows)
-            all_files = sorted(files + ["coefficients.json", "table1.json", "curves.csv"])
+            all_files = sorted(
+                files
+                + ["coefficients.json", "table1.json", "closed_form_vs_exact.json", "curves.csv"]
+            )
             ctx = {
                 "analysis": a,
                 "coef_json": json.loads(to_json(coef)),
-                "table1": t1,
-                "errors": fc.errors,
+                "table1": json.loads(t1_text),
+                "errors": json.loads(errors_text),
                 "figure_html": figs,
                 "files": all_files,
                 "p_star": p_star,

@@ -1,13 +1,12 @@
 """Figures: image regression for the pyvista renders, data-level checks for matplotlib.
 
-The baselines live in ``tests/image_cache/`` (regenerate with
+The baselines live in ``tests/image_cache/`` (pytest-pyvista's ``image_cache_dir``
+in pyproject.toml; regenerate with
 ``pytest tests/test_figures.py --reset_image_cache`` after a deliberate change
 and look at the new images before committing them).
 """
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import matplotlib
 import numpy as np
@@ -36,19 +35,8 @@ from fepost.patch import build_patch  # noqa: E402
 from fepost.synthetic import disc_mesh, write_map  # noqa: E402
 
 pyvista.OFF_SCREEN = True
-IMAGE_CACHE = Path(__file__).parent / "image_cache"
 RADIUS = 0.15  # m
 PEAK = 6e5  # Pa
-
-
-@pytest.fixture(autouse=True)
-def _image_cache_dir(pytestconfig):
-    """Point pytest-pyvista at tests/image_cache (the CLI option wins over the ini)."""
-    old = pytestconfig.option.image_cache_dir
-    if old is None:
-        pytestconfig.option.image_cache_dir = str(IMAGE_CACHE)
-    yield
-    pytestconfig.option.image_cache_dir = old
 
 
 @pytest.fixture(scope="module")

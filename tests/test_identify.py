@@ -8,6 +8,13 @@ Tolerances:
   plus ~1e-7 quadrature error of the 48 x 96 edge grid, measured).
 * AGREE = 1e-6: our fit against scipy.optimize.curve_fit on the same weighted problem
   (two solvers stopping at ~1e-8 relative changes).
+* BAND_AGREE = 1e-5: prediction band against one built from curve_fit's covariance and
+  a finite-difference gradient; limited by the covariance agreement (1e-5 on the
+  standard errors, test_agrees_with_scipy_curve_fit).
+* Monte-Carlo (300 seeded Gaussian data sets, 50 points per curve):
+  COVERAGE_TOL = 0.006, 4 x the measured standard error (0.0015) of the mean coverage;
+  STD_TOL = 0.16, 4 x the relative standard error 1/sqrt(2(M - 1)) = 0.041 of a
+  sample standard deviation from M = 300 fits.
 """
 
 from __future__ import annotations
@@ -15,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy import stats
-from scipy.optimize import curve_fit
+from scipy.optimize import approx_fprime, curve_fit
 
 from fepost import analytic
 from fepost.errors import ArgumentError, DataError, FitError, FitWarning
@@ -24,6 +31,7 @@ from fepost.identify import (
     PARAMETERS,
     TestCurves,
     approximation_bias,
+    curve_model,
     exact_curves,
     fit_table1,
     lag1_autocorrelation,
@@ -37,6 +45,10 @@ IDENTITY = 1e-12
 RECOVERY = 1e-8
 TABLE_TOL = 5e-7
 AGREE = 1e-6
+BAND_AGREE = 1e-5
+MC_FITS = 300
+COVERAGE_TOL = 0.006
+STD_TOL = 0.16
 
 R, PEAK, FRICTION, K_X = 0.1, 2.0e5, 0.3, 0.13
 
@@ -225,6 +237,129 @@ def test_noise_levels_estimated_per_curve(truth):
     assert fit.redchi == pytest.approx(1.0, rel=1e-4)
 
 
+# --- fitted curves and their prediction band ------------------------------------------
+def test_fitted_curve_is_data_minus_residuals(truth):
+    c = make_test_curves("closed_form", truth, seed=7)
+    fit = fit_table1(c, truth["N"], profile=False)
+    for name in ("f_parallel", "torque", "f_perp"):
+        x, y = c.data(name)
+        scale = np.max(np.abs(y))
+        np.testing.assert_allclose(
+            fit.curve(name, x), y - fit.residuals[name], rtol=IDENTITY, atol=IDENTITY * scale
+        )
+
+
+def test_prediction_band_against_scipy(truth):
+    """Band from curve_fit's covariance, a finite-difference gradient and the t-quantile
+    with the n_c - h_c degrees of freedom of each curve's noise estimate."""
+    c = make_test_curves("closed_form", truth, seed=7)
+    fit = fit_table1(c, truth["N"], profile=False)
+    names = ("f_parallel", "torque", "f_perp")
+    n = c.psi.size
+
+    def curve(name, x, F0, M0, a, m, kx):
+        if name == "f_parallel":
+            return F0 / np.sqrt(1 + a * x**2)
+        if name == "torque":
+            return M0 / np.sqrt(1 + m * x**2)
+        return kx * M0 / (2 * R) / np.sqrt(1 + 0.25 * m * x**2)
+
+    def model(i, *p):
+        return np.concatenate([curve(k, c.data(k)[0], *p) for k in names])[i.astype(int)]
+
+    y = np.concatenate([c.f_parallel, c.torque, c.f_perp])
+    sig = np.repeat([fit.noise_sigma[k] for k in names], n)
+    p0 = [truth[k] for k in PARAMETERS]
+    popt, pcov = curve_fit(
+        model, np.arange(3 * n), y, p0=p0, sigma=sig, absolute_sigma=False, xtol=1e-14, ftol=1e-14
+    )
+    s2 = np.sum(((model(np.arange(3 * n), *popt) - y) / sig) ** 2) / (y.size - len(PARAMETERS))
+    x = np.linspace(0.0, 7.0, 29)  # beyond the data too
+    for j, name in enumerate(names):
+        xd = c.data(name)[0]
+
+        def grad(at, name=name):
+            return approx_fprime(popt, lambda p: curve(name, at, *p), 1e-7 * np.abs(popt))
+
+        # leverage of the curve's own points: h_c = sum_i w_i^2 g_i^T (J_w^T J_w)^-1 g_i
+        gd = grad(xd)
+        h = np.einsum("ij,jk,ik->", gd, pcov / s2, gd) / fit.noise_sigma[name] ** 2
+        t = stats.t.ppf(0.975, n - h)
+        g = grad(x)
+        yhat = curve(name, x, *popt)
+        half = t * np.sqrt(np.einsum("ij,jk,ik->i", g, pcov, g) + s2 * sig[j * n] ** 2)
+        ours, lo, hi = fit.prediction_band(name, x)
+        np.testing.assert_allclose(ours, yhat, rtol=AGREE, atol=AGREE * np.max(np.abs(yhat)))
+        np.testing.assert_allclose(hi - ours, half, rtol=BAND_AGREE)
+        np.testing.assert_allclose(ours - lo, half, rtol=BAND_AGREE)
+        se = np.sqrt(np.einsum("ij,jk,ik->i", g, pcov, g))
+        np.testing.assert_allclose(
+            fit.curve_stderr(name, x), se, rtol=BAND_AGREE, atol=BAND_AGREE * se.max()
+        )
+
+
+def test_curve_model_gradient_is_the_derivative(truth):
+    """Analytic gradient against central differences (step 1e-6 relative: error ~1e-10)."""
+    values = np.array([truth[k] for k in PARAMETERS])
+    x = np.linspace(0, 5, 11)
+    for name in ("f_parallel", "torque", "f_perp"):
+        _, g = curve_model(name, x, values, R)
+        for j in range(len(PARAMETERS)):
+            h = 1e-6 * values[j]
+            up, dn = values.copy(), values.copy()
+            up[j] += h
+            dn[j] -= h
+            fd = (curve_model(name, x, up, R)[0] - curve_model(name, x, dn, R)[0]) / (2 * h)
+            scale = np.max(np.abs(curve_model(name, x, values, R)[0])) / values[j]
+            np.testing.assert_allclose(g[:, j], fd, rtol=1e-7, atol=1e-7 * scale)
+
+
+@pytest.mark.slow
+def test_prediction_band_monte_carlo(truth):
+    """Independent check by simulation: MC_FITS data sets with Gaussian noise of known
+    std. (1) Across fits, the scatter of the fitted curve matches curve_stderr (the
+    delta method); (2) the band holds a new measurement 95 % of the time: per fit,
+    P(lo <= y_true + e <= hi) for e ~ N(0, std^2) in closed form, averaged."""
+    names = ("f_parallel", "torque", "f_perp")
+    yhat = {k: [] for k in names}
+    var = {k: [] for k in names}
+    cover = {k: [] for k in names}
+    for seed in range(MC_FITS):
+        c = make_test_curves("closed_form", truth, seed=seed, noise="gaussian")
+        fit = fit_table1(c, truth["N"], profile=False)
+        for name in names:
+            x, _ = c.data(name)
+            true = getattr(c, f"{name}_true")
+            std = c.noise["std"][name]
+            y, lo, hi = fit.prediction_band(name, x)
+            yhat[name].append(y)
+            var[name].append(fit.curve_stderr(name, x) ** 2)
+            cover[name].append(
+                stats.norm.cdf((hi - true) / std) - stats.norm.cdf((lo - true) / std)
+            )
+    for name in names:
+        ratio = np.std(yhat[name], axis=0, ddof=1) / np.sqrt(np.mean(var[name], axis=0))
+        np.testing.assert_allclose(ratio, 1.0, atol=STD_TOL, err_msg=name)
+        assert np.mean(cover[name]) == pytest.approx(0.95, abs=COVERAGE_TOL), name
+
+
+def test_prediction_band_bad_arguments(truth):
+    fit = fit_table1(make_test_curves("closed_form", truth, seed=1), truth["N"], profile=False)
+    with pytest.raises(ArgumentError, match=r"^level must be a probability in \(0, 1\), got 1\.0$"):
+        fit.prediction_band("torque", [0.0], level=1)
+    with pytest.raises(
+        ArgumentError, match=r"^name must be one of f_parallel, torque, f_perp, got 'fx'$"
+    ):
+        fit.prediction_band("fx", [0.0])
+    with pytest.raises(ArgumentError, match=r"^x must be finite, got nan at index 1$"):
+        fit.curve_stderr("torque", [0.0, np.nan])
+    # a wider level gives a wider band around the same curve
+    y90, lo90, hi90 = fit.prediction_band("f_perp", [0.0, 2.0], level=0.90)
+    y99, lo99, hi99 = fit.prediction_band("f_perp", [0.0, 2.0], level=0.99)
+    np.testing.assert_array_equal(y90, y99)
+    assert np.all(lo99 < lo90) and np.all(hi90 < hi99)
+
+
 # --- bad input ---------------------------------------------------------------------------
 def _curves(n, **over):
     grid = np.linspace(0, 3, n)
@@ -303,6 +438,8 @@ def test_degenerate_design_warns_and_gives_nan_intervals():
     assert not fit.determinate
     assert np.all(np.isnan(fit.ci95)) and np.all(np.isnan(fit.f_ci95))
     assert fit.profile_ci95 == {}
+    y, lo, hi = fit.prediction_band("torque", [0.0, 1.0])
+    assert np.all(np.isfinite(y)) and np.all(np.isnan(lo)) and np.all(np.isnan(hi))
 
 
 # --- the approximation's own bias (exact-integral data) ------------------------------------

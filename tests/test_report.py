@@ -15,6 +15,7 @@ import pytest
 
 from fepost.cli import main
 from fepost.synthetic import write_map
+from fepost.table1 import DEFAULT_SEED
 
 REPO = Path(__file__).resolve().parents[1]
 SAMPLES = (REPO / "meshes" / "static.vtu", REPO / "meshes" / "rolling.vtu")
@@ -22,6 +23,7 @@ PROMISED = (
     "report.html",
     "coefficients.json",
     "table1.json",
+    "closed_form_vs_exact.json",
     "curves.csv",
     "fig1_static.png",
     "fig2_rolling.png",
@@ -123,8 +125,8 @@ def test_report_numbers_equal_the_json(report):
     page = _Page()
     page.feed((out / "report.html").read_text(encoding="utf-8"))
     sources = {
-        "coefficients": json.loads((out / "coefficients.json").read_text()),
-        "table1": json.loads((out / "table1.json").read_text()),
+        name: json.loads((out / f"{name}.json").read_text())
+        for name in ("coefficients", "table1", "closed_form_vs_exact")
     }
     checked = 0
     for key, value in page.values.items():
@@ -137,6 +139,8 @@ def test_report_numbers_equal_the_json(report):
     for i in range(6):
         for part in ("theory", "fitted", "ci95.0", "ci95.1"):
             assert f"table1.rows.{i}.{part}" in page.values
+    for curve in ("f_parallel", "torque", "f_perp"):
+        assert f"closed_form_vs_exact.{curve}.max_abs_relative" in page.values
     assert checked >= 40
 
 
@@ -184,6 +188,70 @@ def test_report_refuses_non_empty_folder_without_force(report, capsys):
         err == f"fepost: error: {out}: folder exists and is not empty (use --force to replace it)\n"
     )
     assert sorted(p.name for p in out.iterdir()) == before
+
+
+@pytest.mark.slow
+def test_report_table1_json_is_fepost_table1(report, tmp_path):
+    """The report's table1.json is Table1.to_dict() (what fepost table1 --json writes,
+    less its "inputs"), for the same inputs and seed."""
+    _, out, _, inputs = report
+    sample = ["--static", inputs[0], "--rolling", inputs[1]] if inputs else []
+    cli_json = tmp_path / "t1.json"
+    assert main(["table1", *sample, "--seed", "3", "--json", str(cli_json)]) == 0
+    expected = json.loads(cli_json.read_text())
+    assert expected.pop("inputs")
+    assert json.loads((out / "table1.json").read_text()) == expected
+
+
+@pytest.mark.slow
+def test_report_figures_show_the_table1_fit(report):
+    """Figures 4-6 plot Table 1's own fit (no second fit): at psi = upsilon = 0 each
+    fitted closed form equals its fitted amplitude in table1.json, inside its band."""
+    _, out, _, _ = report
+    t1 = json.loads((out / "table1.json").read_text())
+    with open(out / "curves.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    p = {k: v["value"] for k, v in t1["fit"]["parameters"].items()}
+    amplitude = {
+        "F_parallel": p["F0"],
+        "M_C": p["M0"],
+        "F_perp": p["k_x"] * p["M0"] / (2 * t1["settings"]["R"]),
+    }
+    for fig, expected in amplitude.items():
+
+        def series(name, fig=fig):
+            return [
+                (float(r["x"]), float(r["value"]))
+                for r in rows
+                if r["figure"] == fig and r["series"] == name
+            ]
+
+        fit, lo, hi = series("fit"), series("band_lo"), series("band_hi")
+        assert fit[0] == (0.0, pytest.approx(expected, rel=1e-12)), fig
+        assert all(a[1] < b[1] < c[1] for a, b, c in zip(lo, fit, hi, strict=True)), fig
+        assert len(series("test")) == t1["settings"]["n_points_per_curve"], fig
+
+
+@pytest.mark.slow
+def test_report_and_table1_agree_on_analytic_maps(tmp_path):
+    """Task: `fepost report` and `fepost table1 --json`, both with their default seed,
+    give identical Table 1 rows on the same analytic meshes."""
+    import io
+    from contextlib import redirect_stderr, redirect_stdout
+
+    s = write_map(tmp_path / "static.vtu", "tire", radius=0.15, peak=6e5, n_rings=12)
+    r = write_map(tmp_path / "rolling.vtu", "tire", radius=0.15, peak=6e5, k_x=0.13, n_rings=12)
+    out, cli_json = tmp_path / "rep", tmp_path / "t1.json"
+    with redirect_stderr(io.StringIO()), redirect_stdout(io.StringIO()):
+        assert main(["report", str(s), str(r), "--out", str(out)]) == 0
+        assert (
+            main(["table1", "--static", str(s), "--rolling", str(r), "--json", str(cli_json)]) == 0
+        )
+    from_report = json.loads((out / "table1.json").read_text())
+    from_table1 = json.loads(cli_json.read_text())
+    assert from_report["settings"]["seed"] == from_table1["settings"]["seed"] == DEFAULT_SEED
+    assert [row["name"] for row in from_report["rows"]] == TABLE1_NAMES
+    assert from_report["rows"] == from_table1["rows"]
 
 
 @pytest.fixture

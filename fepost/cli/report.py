@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from ..report import build_report
+from ..table1 import DEFAULT_SEED
 from ._common import add_input_options, analysis_kwargs, sample_mesh
 
 
@@ -43,7 +44,11 @@ def add_parser(sub) -> None:
         help="inflation pressure P* in Pa for sigma/P* (default: sidecar 'inflation_pressure', else 200e3)",
     )
     p.add_argument(
-        "--seed", type=int, default=0, metavar="S", help="seed of the Table 1 noise (default 0)"
+        "--seed",
+        type=int,
+        default=DEFAULT_SEED,
+        metavar="S",
+        help=f"seed of the Table 1 noise (default {DEFAULT_SEED}, as fepost table1)",
     )
     add_input_options(p)
     p.set_defaults(func=run)
