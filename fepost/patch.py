@@ -32,7 +32,9 @@ Repaired with a warning: NaN away from the patch and small negative values
 from __future__ import annotations
 
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -40,6 +42,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ._arrays import frozen
 from .errors import ArgumentError, PatchError, PatchWarning, PressureError, PressureWarning
+from .facesums import FaceSums, face_sums, load_outside, triangle_areas
 from .field import ContactField
 
 DEFAULT_THRESHOLD = 1e-6
@@ -120,7 +123,7 @@ class Patch:
         """Pressure per node (face data spread to nodes by area)."""
         if self.location == "point":
             return self.values
-        area = _areas(self.xy, self.triangles)
+        area = triangle_areas(self.xy, self.triangles)
         num = np.zeros(len(self.xy))
         den = np.zeros(len(self.xy))
         for k in range(3):
@@ -153,42 +156,6 @@ class Patch:
             "source": self.source,
             "dropped_fragments": self.dropped_fragments,
         }
-
-
-def _corners(xy: np.ndarray, tri: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Corner coordinates x, y of every triangle, each (m, 3)."""
-    return xy[:, 0][tri], xy[:, 1][tri]
-
-
-def _areas(xy: np.ndarray, tri: np.ndarray, corners=None) -> np.ndarray:
-    x, y = corners if corners is not None else _corners(xy, tri)
-    return 0.5 * np.abs((x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (y[:, 1] - y[:, 0]) * (x[:, 2] - x[:, 0]))
-
-
-def _rowsum(a: np.ndarray) -> np.ndarray:
-    return a[:, 0] + a[:, 1] + a[:, 2]
-
-
-def face_integrals(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str, corners=None, area=None):
-    """Exact ∬σ dA, ∬σ x dA, ∬σ y dA per face for a linear (point) or constant (cell) field.
-
-    Returns (load, moment_x, moment_y), each of shape (m,).
-    """
-    x, y = corners if corners is not None else _corners(xy, tri)
-    if area is None:
-        area = _areas(xy, tri, (x, y))
-    if location == "point":
-        s = values[tri]  # (m, 3)
-        ssum = _rowsum(s)
-        load = area * ssum / 3.0
-        w = area / 12.0
-        mx = w * (ssum * _rowsum(x) + _rowsum(s * x))
-        my = w * (ssum * _rowsum(y) + _rowsum(s * y))
-    else:
-        load = area * values
-        mx = load * _rowsum(x) / 3.0
-        my = load * _rowsum(y) / 3.0
-    return load, mx, my
 
 
 def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
@@ -247,15 +214,17 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
 
 def _loaded_faces(fld: ContactField, v: np.ndarray, thr: float) -> np.ndarray:
     if fld.location == "point":
-        return np.any(v[fld.triangles] > thr, axis=1)
+        hot = (v > thr)[fld.triangles]
+        return hot[:, 0] | hot[:, 1] | hot[:, 2]
     return v > thr
 
 
 def _components(tri: np.ndarray, n_points: int) -> tuple[int, np.ndarray]:
     """Connected components of faces sharing a node; returns (count, label per face)."""
     # two edges per triangle connect its three nodes
-    rows = np.concatenate([tri[:, 0], tri[:, 1]])
-    cols = np.concatenate([tri[:, 1], tri[:, 2]])
+    idx = np.int32 if n_points < 2**31 - 1 else np.int64
+    rows = np.concatenate([tri[:, 0], tri[:, 1]]).astype(idx)
+    cols = np.concatenate([tri[:, 1], tri[:, 2]]).astype(idx)
     graph = coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n_points, n_points))
     n, node_labels = connected_components(graph, directed=False)
     face_labels = node_labels[tri[:, 0]]
@@ -270,9 +239,9 @@ def _components(tri: np.ndarray, n_points: int) -> tuple[int, np.ndarray]:
 def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     w = weights / weights.sum()
     c = w @ points
-    d = (points - c) * np.sqrt(w)[:, None]
-    _, _, vt = np.linalg.svd(d, full_matrices=False)
-    n = vt[2]
+    d = points - c
+    _, vecs = np.linalg.eigh(d.T @ (d * w[:, None]))
+    n = vecs[:, 0]
     k = int(np.argmax(np.abs(n)))
     if n[k] < 0:
         n = -n
@@ -297,52 +266,44 @@ def _axes(normal: np.ndarray, rolling_axis) -> np.ndarray:
     return np.vstack([x, y, normal])
 
 
-def _second_moments(corners, area: np.ndarray):
-    """Area, centroid and covariance of the union of triangles (exact)."""
-    A = area.sum()
-    x, y = corners
-    sx, sy = _rowsum(x), _rowsum(y)
-    cen = np.array([area @ sx, area @ sy]) / (3.0 * A)
-    x = x - cen[0]
-    y = y - cen[1]
-    sx, sy = sx - 3 * cen[0], sy - 3 * cen[1]
-    # ∫ q_i q_j dA over a triangle = A/12 (Σ_k q_ki q_kj + (Σ_k q_ki)(Σ_k q_kj))
-    cxx = area @ (_rowsum(x * x) + sx * sx)
-    cyy = area @ (_rowsum(y * y) + sy * sy)
-    cxy = area @ (_rowsum(x * y) + sx * sy)
-    cov = np.array([[cxx, cxy], [cxy, cyy]]) / (12.0 * A)
-    return A, cen, cov
+class _Geometry(NamedTuple):
+    points: np.ndarray
+    triangles: np.ndarray
+    values: np.ndarray
+    base: Frame
+    local: np.ndarray
+    sums: FaceSums
 
 
-# 7-point degree-5 rule on the reference triangle (barycentric coords, weights sum to 1)
-_A1, _B1 = 0.059715871789770, 0.470142064105115
-_A2, _B2 = 0.797426985353087, 0.101286507323456
-_TRI_BARY = np.array(
-    [[1 / 3, 1 / 3, 1 / 3], [_A1, _B1, _B1], [_B1, _A1, _B1], [_B1, _B1, _A1], [_A2, _B2, _B2], [_B2, _A2, _B2], [_B2, _B2, _A2]]
-)
-_TRI_W = np.array([0.225, *([0.132394152788506] * 3), *([0.125939180544827] * 3)])
-
-
-def _load_outside(xy, tri, values, location, radius, area, load) -> float:
-    """Share of the load outside the circle of ``radius`` about the origin.
-
-    Faces wholly inside contribute nothing, faces wholly outside their exact
-    load; faces that straddle the circle are integrated with a 7-point rule.
-    """
-    total = load.sum()
-    if total <= 0:
-        return 0.0
-    r = np.hypot(xy[:, 0], xy[:, 1])[tri]
-    out_all = r.min(axis=1) > radius
-    cut = (r.max(axis=1) > radius) & ~out_all
-    share = load[out_all].sum()
-    if cut.any():
-        t = tri[cut]
-        pts = np.einsum("qk,mkd->mqd", _TRI_BARY, xy[t])
-        sig = values[t] @ _TRI_BARY.T if location == "point" else np.repeat(values[cut][:, None], len(_TRI_W), axis=1)
-        dl = sig * _TRI_W[None, :] * area[cut][:, None]
-        share += dl[np.hypot(pts[..., 0], pts[..., 1]) > radius].sum()
-    return float(share / total)
+def _geometry(fld, tri, fvals, v, thr, frame, rolling_axis) -> _Geometry:
+    """Compact the loaded faces, fit the plane (unless ``frame``) and integrate."""
+    used_mask = np.zeros(fld.n_points, bool)
+    used_mask[tri.ravel()] = True
+    if used_mask.all():
+        pts, tri_local, nvals = fld.points, tri, (v if fld.location == "point" else fvals)
+    else:
+        used = np.flatnonzero(used_mask)
+        remap = np.cumsum(used_mask) - 1
+        tri_local = remap[tri]
+        pts = fld.points[used]
+        nvals = v[used] if fld.location == "point" else fvals
+    if frame is None:
+        if fld.location == "point":
+            wmask = nvals > thr
+            cpts, w = pts[wmask], nvals[wmask]
+        else:
+            cpts, w = pts, np.ones(len(pts))
+        if len(cpts) < 3:
+            raise PatchError(f"{fld.source}: the contact patch has fewer than 3 loaded nodes")
+        c, normal = _plane(cpts, w)
+        base = Frame(origin=c, axes=_axes(normal, rolling_axis))
+    else:
+        base = frame
+    local = base.to_local(pts)
+    sums = face_sums(local[:, :2], tri_local, nvals, fld.location)
+    if not sums.N > 0:
+        raise PatchError(f"{fld.source}: the contact patch carries no load")
+    return _Geometry(pts, tri_local, nvals, base, local, sums)
 
 
 def build_patch(
@@ -369,20 +330,20 @@ def build_patch(
     v, peak = _validate_values(fld)
     thr = threshold * peak
     loaded = _loaded_faces(fld, v, thr)
-    tri = fld.triangles[loaded]
-    fvals = v[loaded] if fld.location == "cell" else v
+    if loaded.all():
+        tri, fvals = fld.triangles, v
+    else:
+        tri = fld.triangles[loaded]
+        fvals = v[loaded] if fld.location == "cell" else v
 
-    # connected components of the loaded region
-    ncomp, labels = _components(tri, fld.n_points)
+    # connectivity (scipy) runs beside the geometry pass (numpy, GIL released)
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        job = pool.submit(_components, tri, fld.n_points)
+        geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
+        ncomp, labels = job.result()
     dropped = 0
     if ncomp > 1:
-        pts2 = fld.points
-        # approximate load per component from 3D face areas
-        p = pts2[tri]
-        a3 = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-        fl = a3 * (fvals[tri].mean(axis=1) if fld.location == "point" else fvals)
-        comp_load = np.bincount(labels, weights=fl, minlength=ncomp)
-        share = comp_load / comp_load.sum()
+        share = np.bincount(labels, weights=geo.sums.load, minlength=ncomp) / geo.sums.N
         big = np.flatnonzero(share > FRAGMENT_SHARE)
         if big.size > 1:
             parts = ", ".join(f"{s:.0%}" for s in sorted(share[big], reverse=True))
@@ -390,76 +351,43 @@ def build_patch(
                 f"{fld.source}: {big.size} separate contact patches (load shares {parts}); "
                 "dual wheels or a split patch? fepost analyses one patch at a time: crop the mesh"
             )
-        keep = labels == big[0]
+        main = int(np.argmax(share))
+        keep = labels == main
         dropped = int(ncomp - 1)
         warnings.warn(
             f"{fld.source}: dropped {dropped} small loaded fragment(s) carrying "
-            f"{1 - share[big[0]]:.2%} of the load",
+            f"{1 - share[main]:.2%} of the load",
             PatchWarning,
             stacklevel=2,
         )
         tri = tri[keep]
         if fld.location == "cell":
             fvals = fvals[keep]
-
-    used_mask = np.zeros(fld.n_points, bool)
-    used_mask[tri.ravel()] = True
-    if used_mask.all():
-        pts, tri_local = fld.points, tri
-        used = slice(None)
-    else:
-        used = np.flatnonzero(used_mask)
-        remap = np.cumsum(used_mask) - 1
-        tri_local = remap[tri]
-        pts = fld.points[used]
-    nvals = v[used] if fld.location == "point" else fvals
-
-    if frame is None:
-        if fld.location == "point":
-            wmask = nvals > thr
-            cpts, w = pts[wmask], nvals[wmask]
-        else:
-            cpts = pts
-            w = np.ones(len(pts))
-        if len(cpts) < 3:
-            raise PatchError(f"{fld.source}: the contact patch has fewer than 3 loaded nodes")
-        c, normal = _plane(cpts, w)
-        axes = _axes(normal, rolling_axis)
-        base = Frame(origin=c, axes=axes)
-    else:
-        base = frame
-    local = base.to_local(pts)
+        geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
+    pts, tri_local, nvals, base, local, sums = geo
     xy = local[:, :2]
-    corners = _corners(xy, tri_local)
-    area_f = _areas(xy, tri_local, corners)
-    load, mx, my = face_integrals(xy, tri_local, nvals, fld.location, corners, area_f)
-    N = float(load.sum())
-    if not N > 0:
-        raise PatchError(f"{fld.source}: the contact patch carries no load")
-    cop = np.array([mx.sum() / N, my.sum() / N])
+    N = sums.N
+    cop = sums.centre_of_pressure
+    height = local[:, 2]
     if frame is None:
-        origin = base.to_global(cop[None, :])[0]
-        # keep the origin on the plane: to_global gives z = 0 in the local frame
+        origin = base.to_global(cop[None, :])[0]  # on the plane: local z = 0
         fr = Frame(origin=origin, axes=base.axes)
         xy = xy - cop
-        height = local[:, 2]
         cop_rel = (0.0, 0.0)
+        cen = sums.centroid - cop
     else:
         fr = frame
-        height = local[:, 2]
         cop_rel = (float(cop[0]), float(cop[1]))
-
-    if frame is None:
-        corners = (corners[0] - cop[0], corners[1] - cop[1])
-    area, cen, cov = _second_moments(corners, area_f)
-    evals, evecs = np.linalg.eigh(cov)
+        cen = sums.centroid
+    area = sums.A
+    evals, evecs = np.linalg.eigh(sums.covariance())
     evals = np.clip(evals, 0.0, None)
     semi = 2.0 * np.sqrt(evals[::-1])  # major, minor
     major = evecs[:, 1]
     angle = float(np.arctan2(major[1], major[0]))
     angle = (angle + np.pi / 2) % np.pi - np.pi / 2
     aspect = float(semi[0] / semi[1]) if semi[1] > 0 else np.inf
-    r_max = float(np.max(np.hypot(xy[:, 0], xy[:, 1])))
+    r_max = float(np.sqrt(np.max(xy[:, 0] ** 2 + xy[:, 1] ** 2)))
     r_equiv = float(np.sqrt(area / np.pi))
     if fld.location == "point":
         wmask = nvals > thr
@@ -472,7 +400,7 @@ def build_patch(
             f"{rms:.3g} m = {rms / r_equiv:.1%} of its radius, limit {PLANARITY_TOL:.0%}); "
             "are the coordinates undeformed? try --displacement NAME"
         )
-    outside = _load_outside(xy, tri_local, nvals, fld.location, r_equiv, area_f, load)
+    outside = load_outside(xy, tri_local, nvals, fld.location, r_equiv, sums)
     circular = bool(aspect <= 1.0 + ASPECT_TOL and r_max / r_equiv <= RMAX_TOL)
     notes = []
     if not circular:

@@ -226,6 +226,8 @@ def _direct_faces(data: pv.DataSet) -> tuple[np.ndarray, np.ndarray] | None:
     if not np.all(is_tri | is_quad):
         return None
     conn = np.asarray(data.cell_connectivity, np.int64)
+    if is_tri.all() and conn.size == 3 * types.size:
+        return conn.reshape(-1, 3), np.arange(types.size)
     off = np.asarray(data.cell_offsets, np.int64)[:-1]
     ids = np.arange(types.size)
     parts, src = [], []

@@ -22,8 +22,7 @@ from .polar import PolarGrid, PolarMap
 
 def _surface(patch: Patch) -> pv.PolyData:
     pts = np.column_stack([patch.xy, np.zeros(len(patch.xy))])
-    faces = np.column_stack([np.full(len(patch.triangles), 3), patch.triangles]).ravel()
-    mesh = pv.PolyData(pts, faces=faces)
+    mesh = pv.PolyData.from_regular_faces(pts, patch.triangles)
     if patch.location == "point":
         mesh.point_data["p"] = patch.values
     else:
