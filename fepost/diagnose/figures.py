@@ -1,0 +1,137 @@
+"""Figures of a diagnosis (matplotlib, no pyplot state; callers save or embed them).
+
+* :func:`plot_predicted_vs_measured` — one panel per channel: the simulation
+  (grey) and the named extension's held-out predictions (colour) against the
+  measurement, with the identity line.
+* :func:`plot_residuals` — residuals in % of the channel scale (f₀N, f₀NR)
+  against sliding speed, speed ratio, sliding direction, spin sign and (when
+  they vary) load and roll: structure shows as a trend or a step, noise as a
+  flat band.
+* :func:`plot_candidates` — ΔBIC of every candidate against the simulation.
+
+Each function takes an optional figure or axes and returns it; none calls show().
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .measured import CHANNELS
+from .result import Diagnosis
+
+UNITS = {"Fx": "N", "Fy": "N", "Mz": "N·m"}
+BEFORE = "0.55"
+AFTER = "tab:blue"
+
+
+def plot_predicted_vs_measured(diag: Diagnosis, axes=None):
+    """Predicted against measured per channel; returns the axes (3,)."""
+    if axes is None:
+        fig = Figure(figsize=(12, 4.2), layout="constrained")
+        axes = fig.subplots(1, 3)
+    meas = diag.data.forces
+    before = diag.predictions["before"]
+    after = diag.predictions["after_heldout"]
+    for c, ax in enumerate(axes):
+        ch = CHANNELS[c]
+        rb = np.sqrt(np.mean(((meas[:, c] - before[:, c]) / diag.scales[c]) ** 2))
+        ra = np.sqrt(np.mean(((meas[:, c] - after[:, c]) / diag.scales[c]) ** 2))
+        ax.scatter(meas[:, c], before[:, c], s=9, c=BEFORE, label=f"simulation (rmse {rb:.3g})")
+        if diag.cause != "none":
+            ax.scatter(
+                meas[:, c],
+                after[:, c],
+                s=9,
+                c=AFTER,
+                alpha=0.7,
+                label=f"{diag.cause}, held-out (rmse {ra:.3g})",
+            )
+        lo = min(meas[:, c].min(), before[:, c].min())
+        hi = max(meas[:, c].max(), before[:, c].max())
+        ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
+        ax.set_xlabel(f"measured {ch} ({UNITS[ch]})")
+        ax.set_ylabel(f"predicted {ch} ({UNITS[ch]})")
+        ax.set_title(ch)
+        ax.legend(fontsize=7, loc="upper left")
+    axes[0].figure.suptitle(f"predicted vs measured — cause: {diag.cause} (rmse in scaled units)")
+    return axes
+
+
+def _columns(diag: Diagnosis) -> list[str]:
+    cols = []
+    for name, x in diag.variables.items():
+        ok = np.isfinite(x)
+        if np.unique(x[ok]).size >= 2:
+            cols.append(name)
+    return cols
+
+
+def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
+    """Residuals (% of scale) against the kinematic variables; returns the figure."""
+    cols = _columns(diag)
+    if fig is None:
+        fig = Figure(figsize=(3.0 * len(cols) + 1, 8), layout="constrained")
+    axes = np.atleast_2d(fig.subplots(3, len(cols), sharey="row", squeeze=False))
+    meas = diag.data.forces
+    rb = 100 * (meas - diag.predictions["before"]) / diag.scales
+    ra = 100 * (meas - diag.predictions["after_heldout"]) / diag.scales
+    rng = np.random.default_rng(0)
+    for j, name in enumerate(cols):
+        x = np.array(diag.variables[name], float)
+        if np.unique(x[np.isfinite(x)]).size <= 3:  # categorical: jitter
+            x = x + rng.uniform(-0.15, 0.15, x.size)
+        for c in range(3):
+            ax = axes[c, j]
+            ax.axhline(0.0, color="k", lw=0.6)
+            ax.scatter(x, rb[:, c], s=6, c=BEFORE, label="simulation")
+            if diag.cause != "none":
+                ax.scatter(x, ra[:, c], s=6, c=AFTER, alpha=0.7, label=diag.cause)
+            if c == 2:
+                ax.set_xlabel(name)
+            if j == 0:
+                ax.set_ylabel(f"{CHANNELS[c]} residual (% of f0N{'R' if c == 2 else ''})")
+            st = diag.residuals["before"][CHANNELS[c]]
+            if j == 0:
+                ax.set_title(
+                    f"{CHANNELS[c]}: {st['verdict']} (p={st['p_adjusted']:.2g})",
+                    fontsize=8,
+                    loc="left",
+                )
+    axes[0, -1].legend(fontsize=7, loc="upper right")
+    fig.suptitle(
+        "residuals (measured − predicted) vs kinematics: flat band = noise, trend or step = structure"
+    )
+    return fig
+
+
+def plot_candidates(diag: Diagnosis, ax=None):
+    """ΔBIC of every candidate against the simulation (negative is better); returns the axes."""
+    if ax is None:
+        ax = Figure(figsize=(7, 3.6), layout="constrained").subplots()
+    names = [s.name for s in diag.candidates]
+    vals = [s.delta_bic for s in diag.candidates]
+    colours = ["tab:green" if s.admissible else "0.7" for s in diag.candidates]
+    y = np.arange(len(names))[::-1]
+    ax.barh(y, vals, color=colours)
+    ax.set_yticks(y, names, fontsize=8)
+    ax.axvline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("ΔBIC vs the simulation (green: admissible; negative = better)")
+    ax.set_title(f"candidates — cause: {diag.cause}")
+    return ax
+
+
+def save_figures(diag: Diagnosis, folder) -> list[str]:
+    """Write the three figures as PNG into ``folder``; returns the file names."""
+    from pathlib import Path
+
+    folder = Path(folder)
+    out = []
+    axes = plot_predicted_vs_measured(diag)
+    axes[0].figure.savefig(folder / "predicted_vs_measured.png", dpi=110)
+    out.append("predicted_vs_measured.png")
+    plot_residuals(diag).savefig(folder / "residuals.png", dpi=100)
+    out.append("residuals.png")
+    plot_candidates(diag).figure.savefig(folder / "candidates.png", dpi=110)
+    out.append("candidates.png")
+    return out

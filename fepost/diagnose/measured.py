@@ -1,0 +1,273 @@
+"""Measured rig data: the friction CSV of INTERFACE.md, read and validated.
+
+Columns (SI, header row, one row per test point; other columns are ignored):
+
+=========== ==========================================================
+``vx, vy``  sliding velocity of the patch origin against the road, m/s
+``wz``      spin about the road normal, rad/s
+``Fx, Fy``  friction force of the road on the tire, N (patch frame)
+``Mz``      friction torque on the tire about the patch origin, N·m
+``N``       optional normal load of the point, N (default: the simulation's)
+``roll``    optional −1, 0 or +1 (default 0): which pressure map applies
+=========== ==========================================================
+
+Blank lines and lines whose first non-blank character is ``#`` are skipped
+(before and after the header). Every problem is a one-line
+:class:`~fepost.errors.DataError` naming the file, the line and the column.
+
+:func:`check_plausible` compares the data with the simulation (units, dead
+channels, rolling rows without a rolling map) once f, N and R are known.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._arrays import frozen
+from ..errors import DataError, FepostWarning
+
+REQUIRED = ("vx", "vy", "wz", "Fx", "Fy", "Mz")
+OPTIONAL = ("N", "roll")
+CHANNELS = ("Fx", "Fy", "Mz")
+
+#: Fewest test points diagnose accepts: 5-fold cross-validation keeps ≥ 4 points
+#: per held-out fold, and the richest candidate (f + 3 offsets + 3 channel
+#: variances = 7 parameters) is then fitted to ≥ 48 observations (16 rows × 3).
+MIN_ROWS = 20
+
+#: |F|/(f·N) above this is not a friction force in N (kN given as N, or N·m in
+#: a force column): error. The largest physical value is about 1 (α ≤ 2 allows 2).
+UNITS_ERROR_RATIO = 4.0
+#: max |F|/(f·N) below this over the rows that slide: forces look like kN: warning.
+UNITS_SMALL_RATIO = 0.02
+
+
+class UnitsWarning(FepostWarning):
+    """Measured values are implausible in size for SI units."""
+
+
+@dataclass(frozen=True)
+class MeasuredData:
+    """Rig test points (SI). Arrays have one entry per row; ``N`` is None when absent.
+
+    ``lines`` are the 1-based line numbers of the rows in the source file.
+    """
+
+    vx: np.ndarray
+    vy: np.ndarray
+    wz: np.ndarray
+    Fx: np.ndarray
+    Fy: np.ndarray
+    Mz: np.ndarray
+    N: np.ndarray | None = None
+    roll: np.ndarray | None = None
+    lines: np.ndarray | None = None
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        n = np.size(self.vx)
+        for name in ("vx", "vy", "wz", "Fx", "Fy", "Mz", "N"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            arr = frozen(np.ravel(value))
+            if arr.size != n:
+                raise DataError(f"{name} must have {n} entries like vx, got {arr.size}")
+            if not np.all(np.isfinite(arr)):
+                raise DataError(f"{name} must be finite, got a non-finite entry")
+            object.__setattr__(self, name, arr)
+        roll = np.zeros(n, int) if self.roll is None else np.ravel(self.roll)
+        if roll.size != n:
+            raise DataError(f"roll must have {n} entries like vx, got {roll.size}")
+        if not np.all(np.isin(roll, (-1, 0, 1))):
+            raise DataError(
+                f"roll must be -1, 0 or +1, got {sorted(set(roll.tolist()) - {-1, 0, 1})}"
+            )
+        object.__setattr__(self, "roll", frozen(roll, dtype=int))
+        lines = np.arange(1, n + 1) if self.lines is None else np.ravel(self.lines)
+        object.__setattr__(self, "lines", frozen(lines, dtype=int))
+        if self.N is not None and np.any(self.N <= 0):
+            i = int(np.flatnonzero(self.N <= 0)[0])
+            raise DataError(
+                f"{self._where(i)}, column N: load must be positive (N), got {float(self.N[i])!r}"
+            )
+
+    def _where(self, i: int) -> str:
+        src = f"{self.source}: " if self.source else ""
+        return f"{src}line {int(self.lines[i])}"
+
+    def __len__(self) -> int:
+        return int(self.vx.size)
+
+    @property
+    def forces(self) -> np.ndarray:
+        """(n, 3) array of the measured Fx, Fy (N) and Mz (N·m)."""
+        return np.column_stack([self.Fx, self.Fy, self.Mz])
+
+    def loads(self, default: float) -> np.ndarray:
+        """Per-row normal load (N): the ``N`` column, or ``default`` where absent."""
+        return np.full(len(self), float(default)) if self.N is None else np.array(self.N)
+
+    def to_dict(self) -> dict:
+        d = {
+            name: getattr(self, name).tolist()
+            for name in ("vx", "vy", "wz", "Fx", "Fy", "Mz", "roll")
+        }
+        d["N"] = None if self.N is None else self.N.tolist()
+        d["source"] = self.source
+        return d
+
+
+def _number(text: str, where: str, column: str) -> float:
+    cell = text.strip()
+    try:
+        value = float(cell)
+    except ValueError:
+        shown = cell if cell else "an empty cell"
+        raise DataError(f"{where}, column {column}: not a number: {shown!r}") from None
+    if not np.isfinite(value):
+        raise DataError(f"{where}, column {column}: not a finite number: {cell!r}")
+    return value
+
+
+def parse_csv(text: str, source: str = "") -> MeasuredData:
+    """Parse the CSV ``text`` (see the module docstring); ``source`` names it in messages."""
+    src = f"{source}: " if source else ""
+    rows: list[tuple[int, list[str]]] = []
+    for lineno, line in enumerate(io.StringIO(text), start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        fields = next(csv.reader([line.rstrip("\r\n")]))
+        rows.append((lineno, fields))
+    if not rows:
+        raise DataError(f"{src}no header row: the file is empty or only comments")
+    head_line, header = rows[0]
+    names = [h.strip() for h in header]
+    seen: dict[str, int] = {}
+    for j, name in enumerate(names):
+        if name in seen and name in REQUIRED + OPTIONAL:
+            raise DataError(f"{src}line {head_line}: column {name!r} appears twice in the header")
+        seen.setdefault(name, j)
+    missing = [c for c in REQUIRED if c not in seen]
+    if missing:
+        got = ", ".join(repr(n) for n in names if n) or "none"
+        raise DataError(f"{src}missing column(s) {', '.join(missing)} in the header (found {got})")
+    wanted = [c for c in REQUIRED + OPTIONAL if c in seen]
+    values: dict[str, list[float]] = {c: [] for c in wanted}
+    lines = []
+    for lineno, fields in rows[1:]:
+        where = f"{src}line {lineno}"
+        if len(fields) < len(names) and any(seen[c] >= len(fields) for c in wanted):
+            raise DataError(f"{where}: {len(fields)} fields, the header has {len(names)}")
+        for c in wanted:
+            values[c].append(_number(fields[seen[c]], where, c))
+        lines.append(lineno)
+    if not lines:
+        raise DataError(f"{src}no data rows after the header")
+    roll = None
+    if "roll" in values:
+        raw = np.array(values["roll"])
+        bad = ~np.isin(raw, (-1.0, 0.0, 1.0))
+        if np.any(bad):
+            i = int(np.flatnonzero(bad)[0])
+            raise DataError(
+                f"{src}line {lines[i]}, column roll: must be -1, 0 or 1, got {raw[i]:g}"
+            )
+        roll = raw.astype(int)
+    return MeasuredData(
+        vx=values["vx"], vy=values["vy"], wz=values["wz"],
+        Fx=values["Fx"], Fy=values["Fy"], Mz=values["Mz"],
+        N=values.get("N"), roll=roll, lines=lines, source=source,
+    )  # fmt: skip
+
+
+def read_measured(path) -> MeasuredData:
+    """Read a measured-friction CSV file (see the module docstring)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise DataError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DataError(
+            f"{path}: cannot read the measured data ({exc.__class__.__name__})"
+        ) from None
+    return parse_csv(text, source=str(path))
+
+
+def write_csv(data: MeasuredData, path, comment: str = "") -> None:
+    """Write ``data`` in the INTERFACE CSV format (``#`` comment lines first)."""
+    path = Path(path)
+    out = io.StringIO()
+    for line in comment.splitlines():
+        out.write(f"# {line}\n")
+    cols = ["vx", "vy", "wz", "Fx", "Fy", "Mz"] + (["N"] if data.N is not None else []) + ["roll"]
+    out.write(",".join(cols) + "\n")
+    arrays = [getattr(data, c) for c in cols]
+    for i in range(len(data)):
+        out.write(
+            ",".join(
+                f"{a[i]:.10g}" if c != "roll" else str(int(a[i]))
+                for c, a in zip(cols, arrays, strict=True)
+            )
+            + "\n"
+        )
+    path.write_text(out.getvalue(), encoding="utf-8")
+
+
+def check_plausible(
+    data: MeasuredData, *, friction: float, load: float, radius: float, has_rolling: bool
+) -> None:
+    """Reject or flag data that cannot be compared with the simulation.
+
+    ``friction`` is the nominal f, ``load`` the simulation's N (N), ``radius``
+    its R (m). Errors (:class:`DataError`): fewer than :data:`MIN_ROWS` rows;
+    a channel that is zero in every row (dead sensor); roll = ±1 rows when no
+    rolling map was given (the static map would silently stand in for it);
+    |Fx|, |Fy| above ``UNITS_ERROR_RATIO``·f·N or |Mz| above that times f·N·R
+    in any row (wrong units). Warning (:class:`UnitsWarning`): the largest force
+    of the sliding rows is below ``UNITS_SMALL_RATIO``·f·N (kN given as N?).
+    """
+    src = f"{data.source}: " if data.source else ""
+    n = len(data)
+    if n < MIN_ROWS:
+        raise DataError(
+            f"{src}{n} test points are too few: the candidate models and the 5-fold check need at least {MIN_ROWS}"
+        )
+    for c in CHANNELS:
+        if np.all(getattr(data, c) == 0.0):
+            raise DataError(
+                f"{src}column {c} is zero in every row: a dead channel cannot be diagnosed"
+            )
+    rolling_rows = int(np.count_nonzero(data.roll != 0))
+    if rolling_rows and not has_rolling:
+        raise DataError(
+            f"{src}column roll: {rolling_rows} rows have roll = ±1 but no rolling map was given (--rolling)"
+        )
+    loads = data.loads(load)
+    fn = friction * loads
+    for c, scale, unit in (("Fx", fn, "f·N"), ("Fy", fn, "f·N"), ("Mz", fn * radius, "f·N·R")):
+        ratio = np.abs(getattr(data, c)) / scale
+        i = int(np.argmax(ratio))
+        if ratio[i] > UNITS_ERROR_RATIO:
+            raise DataError(
+                f"{src}line {int(data.lines[i])}, column {c}: |{c}| is {ratio[i]:.3g} x {unit} "
+                f"(f = {friction:g}, N = {loads[i]:.6g} N, R = {radius:.4g} m): wrong units?"
+            )
+    sliding = np.hypot(data.vx, data.vy) > 0
+    if np.any(sliding):
+        top = float(np.max(np.hypot(data.Fx, data.Fy)[sliding] / fn[sliding]))
+        if top < UNITS_SMALL_RATIO:
+            warnings.warn(
+                f"{src}columns Fx, Fy: the largest sliding force is {top:.3g} x f·N: "
+                "forces in kN rather than N, or the wrong load?",
+                UnitsWarning,
+                stacklevel=2,
+            )

@@ -1,0 +1,253 @@
+"""Synthetic rig data with one hidden effect, made by the exact integrals.
+
+:func:`rig_programme` lays out a realistic rig programme: several sliding
+directions, several absolute speeds at the same speed ratios ε = |v|/(|ω|R),
+both spin signs, pure spin and pure sliding (optionally several loads and both
+rolling directions). :func:`synthesize` computes Fx, Fy, Mz at those points
+with :func:`~fepost.friction.exact.friction_resultants` on a fine quadrature of a
+pressure map (48 × 96 nodes, four times the fit grid's), with one effect of
+:data:`fepost.diagnose.causes.CAUSES` hidden in it, and adds Gaussian noise of
+``noise`` × (range of each clean channel).
+
+The effects are applied here independently of the diagnosis's own models:
+through :class:`~fepost.friction.law.FrictionLaw` for the friction laws,
+:meth:`~fepost.friction.quadrature.PressureQuadrature.stretched`/``shifted`` for
+the geometry, offsets added in N and N·m; loads by scaling the map's pressure;
+the reversed rolling map (roll = −1) by mirroring the kinematics and the
+resultants (vx, ω_z, Fx, Mz change sign) rather than the map.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._arrays import frozen
+from ..errors import ArgumentError
+from ..friction.exact import friction_resultants
+from ..friction.law import FrictionLaw
+from ..friction.quadrature import PressureQuadrature, edge_grid
+from ..polar import PolarMap
+from .causes import CAUSES
+from .measured import MeasuredData
+from .simulation import regrid
+
+#: Spin speeds u = |ω|R of the programme (m/s): several absolute speeds per ratio.
+SPEEDS = (0.1, 0.3, 1.0)
+#: Speed ratios ε = |v|/u of the combined points.
+RATIOS = (0.25, 0.5, 0.75, 1.0, 1.5, 2.5)
+#: Sliding directions (number, evenly spaced from 0).
+DIRECTIONS = 8
+#: Grid of the generator's quadrature.
+GEN_NR, GEN_NPHI = 48, 96
+
+#: Parameters of each hidden effect, with the no-effect values.
+EFFECT_PARAMETERS = {
+    "none": {},
+    "friction_level": {"f": None},
+    "pressure_dependent_friction": {"c_p": 0.0},
+    "speed_dependent_friction": {"c_v": 0.0},
+    "elliptic_patch": {"s": 1.0},
+    "anisotropic_friction": {"alpha": 1.0},
+    "pressure_shift": {"dx": 0.0, "dy": 0.0},
+    "sensor_offset": {"offset_Fx": 0.0, "offset_Fy": 0.0, "offset_Mz": 0.0},
+}
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """Test points: vx, vy (m/s), wz (rad/s), roll (−1/0/+1), load factor λ = N/N_sim."""
+
+    vx: np.ndarray
+    vy: np.ndarray
+    wz: np.ndarray
+    roll: np.ndarray
+    load_factor: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("vx", "vy", "wz", "load_factor"):
+            object.__setattr__(self, name, frozen(getattr(self, name)))
+        object.__setattr__(self, "roll", frozen(self.roll, dtype=int))
+
+
+def rig_programme(
+    radius: float,
+    n: int = 400,
+    *,
+    seed: int = 0,
+    speeds=SPEEDS,
+    ratios=RATIOS,
+    directions: int = DIRECTIONS,
+    rolls=(0,),
+    loads=None,
+) -> Kinematics:
+    """``n`` test points for a patch of ``radius`` m (see the module docstring).
+
+    The full programme is every (ratio, direction, spin speed, spin sign) at the
+    combined points, pure spin at every speed and sign (×4 replicates) and pure
+    sliding in every direction at every speed (×2). ``n`` points are drawn from it
+    without replacement (the whole programme first, then random repeats when
+    ``n`` is larger). ``rolls`` and ``loads`` (factors of the simulation's N) are
+    dealt out evenly at random.
+    """
+    if not (np.isfinite(radius) and radius > 0):
+        raise ArgumentError(f"radius must be a positive length in m, got {radius!r}")
+    if int(n) != n or n < 1:
+        raise ArgumentError(f"n must be a positive integer, got {n!r}")
+    rng = np.random.default_rng(seed)
+    angles = np.arange(directions) * (2.0 * np.pi / directions)
+    rows = []
+    for u in speeds:
+        for sign in (-1.0, 1.0):
+            wz = sign * u / radius
+            for eps in ratios:
+                for a in angles:
+                    rows.append((eps * u * np.cos(a), eps * u * np.sin(a), wz))
+            rows.extend([(0.0, 0.0, wz)] * 4)
+        for a in angles:
+            rows.extend([(u * np.cos(a), u * np.sin(a), 0.0)] * 2)
+    pool = np.array(rows)
+    order = rng.permutation(len(pool))
+    if n > len(pool):
+        order = np.concatenate([order, rng.integers(0, len(pool), n - len(pool))])
+    pick = pool[order[:n]]
+    rolls = np.asarray(rolls, int)
+    roll = rng.permutation(np.resize(rolls, n))
+    factors = (
+        np.ones(n) if loads is None else rng.permutation(np.resize(np.asarray(loads, float), n))
+    )
+    return Kinematics(pick[:, 0], pick[:, 1], pick[:, 2], roll, factors)
+
+
+@dataclass(frozen=True)
+class SyntheticData:
+    """Synthetic rig data: the CSV content (``data``), the hidden effect and its truth."""
+
+    data: MeasuredData
+    effect: str
+    truth: dict
+    clean: np.ndarray
+    noise_sd: np.ndarray
+    friction: float
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "clean", frozen(self.clean))
+        object.__setattr__(self, "noise_sd", frozen(self.noise_sd))
+
+    def to_dict(self) -> dict:
+        return {
+            "effect": self.effect,
+            "truth": dict(self.truth),
+            "noise_sd": self.noise_sd.tolist(),
+            "friction": self.friction,
+            **self.meta,
+        }
+
+
+def _fine_quad(pmap: PolarMap) -> PressureQuadrature:
+    return PressureQuadrature.from_polar(regrid(pmap, edge_grid(GEN_NR, GEN_NPHI)))
+
+
+def _scaled(quad: PressureQuadrature, lam: float) -> PressureQuadrature:
+    if lam == 1.0:
+        return quad
+    inner = quad.sigma_at
+    return PressureQuadrature(
+        quad.x,
+        quad.y,
+        quad.dA,
+        quad.sigma * lam,
+        quad.domain,
+        lambda x, y: lam * inner(x, y),
+        quad.source,
+    )
+
+
+def synthesize(
+    static: PolarMap,
+    effect: str = "none",
+    params: dict | None = None,
+    *,
+    rolling: PolarMap | None = None,
+    friction: float = 0.3,
+    n: int = 400,
+    noise: float = 0.015,
+    seed: int = 0,
+    rolls=None,
+    loads=None,
+    kinematics: Kinematics | None = None,
+) -> SyntheticData:
+    """Rig data over ``static`` (and ``rolling``) maps with ``effect`` hidden in it.
+
+    ``params`` gives the effect's parameters (names as in
+    :data:`EFFECT_PARAMETERS`; the friction level of every effect but
+    ``friction_level`` is ``friction``). ``noise`` is the Gaussian noise SD as a
+    fraction of each clean channel's range (max − min). ``rolls`` defaults to
+    (−1, 0, 1) when a rolling map is given, else (0,); ``loads`` are load factors
+    (default: every row at the simulation's N, and no ``N`` column).
+    """
+    if effect not in CAUSES:
+        raise ArgumentError(f"effect must be one of {', '.join(CAUSES)}, got {effect!r}")
+    params = dict(params or {})
+    known = EFFECT_PARAMETERS[effect]
+    unknown = set(params) - set(known)
+    if unknown:
+        raise ArgumentError(
+            f"unknown parameter(s) {sorted(unknown)} for effect {effect!r}; expected {sorted(known)}"
+        )
+    missing = [k for k in known if k not in params]
+    if missing:
+        raise ArgumentError(f"effect {effect!r} needs parameter(s) {missing}")
+    if not (np.isfinite(noise) and noise >= 0):
+        raise ArgumentError(f"noise must be a non-negative fraction, got {noise!r}")
+    if rolls is None:
+        rolls = (-1, 0, 1) if rolling is not None else (0,)
+    if rolling is None and any(r != 0 for r in rolls):
+        raise ArgumentError("rolls other than 0 need a rolling map")
+    quads = {0: _fine_quad(static)}
+    if rolling is not None:
+        quads[1] = _fine_quad(rolling)
+    N_sim = quads[0].load
+    R = static.radius
+    kin = kinematics or rig_programme(R, n, seed=seed, rolls=rolls, loads=loads)
+    f = float(params.get("f", friction))
+    law = FrictionLaw(
+        f=f,
+        pressure_coef=float(params.get("c_p", 0.0)),
+        speed_coef=float(params.get("c_v", 0.0)),
+        anisotropy=float(params.get("alpha", 1.0)),
+        pressure_ref=quads[0].mean_pressure,
+    )
+    s = float(params.get("s", 1.0))
+    dx, dy = float(params.get("dx", 0.0)), float(params.get("dy", 0.0))
+    clean = np.empty((kin.vx.size, 3))
+    for r in np.unique(kin.roll):
+        mirror = r < 0
+        base = quads[1 if r else 0]
+        base_load = base.load
+        sx = -1.0 if mirror else 1.0
+        for lam in np.unique(kin.load_factor):
+            idx = np.flatnonzero((kin.roll == r) & (kin.load_factor == lam))
+            # Rows without a load column carry each map as given (λ = 1).
+            quad = base if loads is None else _scaled(base, lam * N_sim / base_load)
+            if s != 1.0:
+                quad = quad.stretched(s)
+            if dx or dy:
+                quad = quad.shifted(sx * dx, dy)  # mirrored kinematics: the shift mirrors too
+            res = friction_resultants(quad, sx * kin.vx[idx], kin.vy[idx], sx * kin.wz[idx], law)
+            clean[idx] = np.column_stack([sx * res.Fx, res.Fy, sx * res.Mz])
+    if effect == "sensor_offset":
+        clean = clean + np.array([params["offset_Fx"], params["offset_Fy"], params["offset_Mz"]])
+    rng = np.random.default_rng(None if seed is None else [seed, 7])
+    sd = noise * (clean.max(axis=0) - clean.min(axis=0))
+    meas = clean + rng.normal(size=clean.shape) * sd
+    loads_col = None if loads is None else kin.load_factor * N_sim
+    data = MeasuredData(
+        vx=kin.vx, vy=kin.vy, wz=kin.wz, Fx=meas[:, 0], Fy=meas[:, 1], Mz=meas[:, 2],
+        N=loads_col, roll=kin.roll, source=f"synthetic:{effect}",
+    )  # fmt: skip
+    truth = {"f": f, **{k: float(v) for k, v in params.items() if k != "f"}}
+    meta = {"N": N_sim, "R": R, "n": int(kin.vx.size), "seed": seed, "noise": noise}
+    return SyntheticData(data, effect, truth, clean, sd, friction, meta)
