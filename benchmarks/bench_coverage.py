@@ -76,9 +76,7 @@ def main() -> int:
     ap.add_argument("--seeds", type=int, default=2000)
     ap.add_argument("--noise", choices=("uniform", "gaussian"), default="uniform")
     ap.add_argument("--n-points", type=int, default=50)
-    ap.add_argument(
-        "--profile", action="store_true", help="also check the profile bounds of a and m"
-    )
+    ap.add_argument("--profile", action="store_true", help="also check the profile bounds of a and m")
     args = ap.parse_args()
     se = np.sqrt(0.95 * 0.05 / args.seeds)
     print(

@@ -53,23 +53,20 @@ def grid_accuracy() -> None:
             out.append(np.column_stack([r.Fx, r.Fy, r.Mz / R]) / quad.load)
         err = np.abs(out[0] - out[1]).max(axis=0)
         print(
-            f"  {profile:<11} max |dFx|, |dFy| /fN = {err[0]:.2e}, {err[1]:.2e};  max |dMz|/fNR = {err[2]:.2e}"
+            f"  {profile:<11} max |dFx|, |dFy| /fN = {err[0]:.2e}, {err[1]:.2e};  "
+            f"max |dMz|/fNR = {err[2]:.2e}"
         )
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=400)
-    parser.add_argument(
-        "--coverage", type=int, default=0, help="seeds per cause for the coverage study"
-    )
+    parser.add_argument("--coverage", type=int, default=0, help="seeds per cause for the coverage study")
     args = parser.parse_args(argv)
     grid_accuracy()
     R = 0.12
     pmap = PolarMap.from_function(pressure_function("tire", R, peak=2.5e5), R, PolarGrid.make())
-    print(
-        f"\ndiagnose, {args.points} points, tire map, loads 0.7/1.0/1.3, all 8 candidates + 5-fold CV:"
-    )
+    print(f"\ndiagnose, {args.points} points, tire map, loads 0.7/1.0/1.3, all 8 candidates + 5-fold CV:")
     times = []
     for i, (effect, params) in enumerate(CASES):
         syn = synthesize(pmap, effect, params, n=args.points, seed=500 + i, loads=(0.7, 1.0, 1.3))
@@ -77,13 +74,12 @@ def main(argv: list[str] | None = None) -> None:
         d = diagnose(pmap, syn.data, friction=0.3, seed=500 + i)
         times.append(time.perf_counter() - t)
         print(
-            f"  {effect:<28} -> {d.cause:<28} {times[-1]:6.1f} s  ({d.info['exact_evaluations']} exact evaluations)"
+            f"  {effect:<28} -> {d.cause:<28} {times[-1]:6.1f} s  "
+            f"({d.info['exact_evaluations']} exact evaluations)"
         )
     print(f"  wall time: max {max(times):.1f} s, mean {np.mean(times):.1f} s (requirement: < 60 s)")
     if args.coverage:
-        print(
-            f"\ncoverage of the 95 % intervals over {args.coverage} seeds (fit of the true cause only):"
-        )
+        print(f"\ncoverage of the 95 % intervals over {args.coverage} seeds (fit of the true cause only):")
         sim = simulation_from_maps(pmap, friction=0.3)
         for effect, params in CASES[1:]:
             hits = total = 0

@@ -66,9 +66,7 @@ def main(argv: list[str] | None = None) -> None:
     fp = args.seeds - named["none"]
     lo, hi = wilson(fp, args.seeds)
     print()
-    print(
-        f"false positives: {fp}/{args.seeds} = {fp / args.seeds:.1%} (Wilson 95 % CI {lo:.1%} .. {hi:.1%})"
-    )
+    print(f"false positives: {fp}/{args.seeds} = {fp / args.seeds:.1%} (Wilson 95 % CI {lo:.1%} .. {hi:.1%})")
     print(f"causes named: {dict(named)}")
     print(f"passed the nesting LRT alone (per candidate): {dict(passed_lrt)}")
     print(f"diagnose time per data set: median {np.median(times):.1f} s, max {np.max(times):.1f} s")

@@ -28,9 +28,7 @@ RADIUS = 0.1  # m
 def kinematics(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Random (vx, vy, wz): ICR at distance ~U(0, 2)·R in a random direction."""
     wz = rng.choice([-1.0, 1.0], n) * rng.uniform(0.5, 20.0, n)  # rad/s
-    dist = RADIUS * np.concatenate(
-        [rng.uniform(0.0, 1.0, n // 2), rng.uniform(1.0, 3.0, n - n // 2)]
-    )
+    dist = RADIUS * np.concatenate([rng.uniform(0.0, 1.0, n // 2), rng.uniform(1.0, 3.0, n - n // 2)])
     ang = rng.uniform(0.0, 2.0 * np.pi, n)
     p0x, p0y = dist * np.cos(ang), dist * np.sin(ang)
     vx, vy = wz * p0y, -wz * p0x  # p0 = (−vy/ω, vx/ω)

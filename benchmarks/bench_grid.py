@@ -30,7 +30,10 @@ def study(path: Path) -> None:
     ref_grid = PolarGrid.make(512, 1024)
     ref = coefficients_from_moments(moments(resample(patch, ref_grid, radius=patch.r_max)))
     print(f"\n{path.name}: {len(patch.xy):,} nodes, N_fe = {patch.N_fe:.6g} N, R = {patch.r_max:.4g} m")
-    print(f"{'rule':>9} {'nr x nphi':>10} {'N/N_fe-1':>10} {'M0 err':>9} {'a err':>9} {'m err':>9} {'time s':>7}")
+    print(
+        f"{'rule':>9} {'nr x nphi':>10} {'N/N_fe-1':>10} {'M0 err':>9} "
+        f"{'a err':>9} {'m err':>9} {'time s':>7}"
+    )
     for rule in ("trapezoid", "gauss"):
         for nr in (16, 32, 64, 128, 256):
             g = PolarGrid.make(nr + (rule == "trapezoid"), 2 * nr, rule)
@@ -38,7 +41,10 @@ def study(path: Path) -> None:
             c = coefficients_from_moments(moments(resample(patch, g, radius=patch.r_max)))
             dt = time.perf_counter() - t
             e = [abs(getattr(c, k) / getattr(ref, k) - 1) for k in ("M0", "a", "m")]
-            print(f"{rule:>9} {nr:>4} x {2 * nr:<4} {c.N / patch.N_fe - 1:>+10.1e} {e[0]:>9.1e} {e[1]:>9.1e} {e[2]:>9.1e} {dt:>7.3f}")
+            print(
+                f"{rule:>9} {nr:>4} x {2 * nr:<4} {c.N / patch.N_fe - 1:>+10.1e} "
+                f"{e[0]:>9.1e} {e[1]:>9.1e} {e[2]:>9.1e} {dt:>7.3f}"
+            )
 
 
 def main() -> None:

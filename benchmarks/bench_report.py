@@ -35,9 +35,7 @@ def main(argv=None) -> int:
         if args.inputs:
             static, rolling = (args.inputs + [None])[:2]
             label = " ".join(args.inputs)
-        elif (REPO / "meshes" / "static.vtu").is_file() and (
-            REPO / "meshes" / "rolling.vtu"
-        ).is_file():
+        elif (REPO / "meshes" / "static.vtu").is_file() and (REPO / "meshes" / "rolling.vtu").is_file():
             static, rolling = REPO / "meshes" / "static.vtu", REPO / "meshes" / "rolling.vtu"
             label = "sample meshes meshes/static.vtu meshes/rolling.vtu"
         else:

@@ -31,9 +31,7 @@ def analytic_pair(folder: Path) -> tuple[Path, Path]:
 
     paths = []
     for name, k in (("static", 0.0), ("rolling", 0.13)):
-        disc = pyvista.Disc(
-            center=(0, 0, 0), inner=0.0, outer=0.1, r_res=40, c_res=160
-        ).triangulate()
+        disc = pyvista.Disc(center=(0, 0, 0), inner=0.0, outer=0.1, r_res=40, c_res=160).triangulate()
         x, y = disc.points[:, 0], disc.points[:, 1]
         disc.point_data["CPRESS"] = analytic.pressure_function("hertz", 0.1, 2.0e5, k_x=k)(x, y)
         p = folder / f"{name}.vtu"
@@ -98,23 +96,14 @@ def main() -> int:
         t3 = time.perf_counter()
 
         print(f"inputs: {label}")
-        print(
-            f"  static  {static}: {a.static_field.n_points} points, {a.static_field.n_faces} faces"
-        )
+        print(f"  static  {static}: {a.static_field.n_points} points, {a.static_field.n_faces} faces")
         if a.rolling_field is not None:
-            print(
-                f"  rolling {rolling}: {a.rolling_field.n_points} points, "
-                f"{a.rolling_field.n_faces} faces"
-            )
+            print(f"  rolling {rolling}: {a.rolling_field.n_points} points, {a.rolling_field.n_faces} faces")
         nr, nphi = a.grid.shape
         print(
-            f"polar grid: {a.grid.rule}, {nr} x {nphi} = {nr * nphi} nodes "
-            "(exact friction integrals on it)"
+            f"polar grid: {a.grid.rule}, {nr} x {nphi} = {nr * nphi} nodes (exact friction integrals on it)"
         )
-        print(
-            f"test curves: {t.curves.psi.size} + 2 x {t.curves.upsilon.size} = "
-            f"{t.curves.n_points} points"
-        )
+        print(f"test curves: {t.curves.psi.size} + 2 x {t.curves.upsilon.size} = {t.curves.n_points} points")
         print(
             f"fepost table1 end to end (fresh process, {args.repeat} runs): "
             f"median {statistics.median(times):.2f} s, max {max(times):.2f} s "

@@ -46,10 +46,16 @@ class Analysis:
         d = self.coefficients.to_dict()
         d["N_fe"] = self.static_patch.N_fe
         d["patch"] = self.static_patch.to_dict()
-        d["R_definition"] = "r_max: smallest circle about the static centre of pressure holding every loaded point"
+        d["R_definition"] = (
+            "r_max: smallest circle about the static centre of pressure holding every loaded point"
+        )
         d["reaction_z"] = self.static_field.reaction_z
         d["grid"] = {"rule": self.grid.rule, "nr": self.grid.shape[0], "nphi": self.grid.shape[1]}
-        d["static"] = {"source": self.static_field.source, "field": self.static_field.field, "step": self.static_field.step}
+        d["static"] = {
+            "source": self.static_field.source,
+            "field": self.static_field.field,
+            "step": self.static_field.step,
+        }
         if self.rolling_patch is not None:
             rf = self.rolling_field
             d["rolling"] = {

@@ -49,9 +49,7 @@ def profile(name: str) -> Callable[[np.ndarray], np.ndarray]:
     try:
         base = _PROFILES[name]
     except KeyError:
-        raise ArgumentError(
-            f"profile must be one of {', '.join(_PROFILES)}, got {name!r}"
-        ) from None
+        raise ArgumentError(f"profile must be one of {', '.join(_PROFILES)}, got {name!r}") from None
 
     def f(rho):
         rho = np.asarray(rho, float)

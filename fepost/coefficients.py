@@ -61,12 +61,21 @@ class Coefficients:
             "m_over_R2": self.m / self.R**2,
         }
         if self.k_x is not None:
-            d.update({"k_x": self.k_x, "x_c": self.x_c, "N_rolling": self.N_rolling, "k_x_over_R": self.k_x / self.R})
+            d.update(
+                {
+                    "k_x": self.k_x,
+                    "x_c": self.x_c,
+                    "N_rolling": self.N_rolling,
+                    "k_x_over_R": self.k_x / self.R,
+                }
+            )
         d.update(self.extra)
         return d
 
 
-def coefficients_from_moments(static: Moments, rolling: Moments | None = None, friction: float = 0.3) -> Coefficients:
+def coefficients_from_moments(
+    static: Moments, rolling: Moments | None = None, friction: float = 0.3
+) -> Coefficients:
     """Coefficients from the static map's moments (and the rolling map's, for k_x)."""
     if not (np.isfinite(friction) and friction > 0):
         raise ArgumentError(f"friction must be a positive number, got {friction!r}")
@@ -84,6 +93,17 @@ def coefficients_from_moments(static: Moments, rolling: Moments | None = None, f
         k_x = R * x_c / static.x2
         n_roll = rolling.N
     return Coefficients(
-        N=static.N, R=R, A=A, F0=F0, M0=M0, a=a, m=m, b=m / 4.0, b1=M0 / 2.0, f=friction,
-        k_x=k_x, x_c=x_c, N_rolling=n_roll,
+        N=static.N,
+        R=R,
+        A=A,
+        F0=F0,
+        M0=M0,
+        a=a,
+        m=m,
+        b=m / 4.0,
+        b1=M0 / 2.0,
+        f=friction,
+        k_x=k_x,
+        x_c=x_c,
+        N_rolling=n_roll,
     )

@@ -109,7 +109,9 @@ def face_sums(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str
     def work(sl: slice) -> np.ndarray:
         t = tri[sl]
         x, y = X[t], Y[t]
-        a = 0.5 * np.abs((x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (y[:, 1] - y[:, 0]) * (x[:, 2] - x[:, 0]))
+        a = 0.5 * np.abs(
+            (x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (y[:, 1] - y[:, 0]) * (x[:, 2] - x[:, 0])
+        )
         sx, sy = _rowsum(x), _rowsum(y)
         if location == "point":
             s = values[t]
@@ -127,8 +129,15 @@ def face_sums(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str
         w = a / 12.0
         return np.array(
             [
-                ld.sum(), mx, my, a.sum(), a @ sx / 3.0, a @ sy / 3.0,
-                w @ (_rowsum(x * x) + sx * sx), w @ (_rowsum(y * y) + sy * sy), w @ (_rowsum(x * y) + sx * sy),
+                ld.sum(),
+                mx,
+                my,
+                a.sum(),
+                a @ sx / 3.0,
+                a @ sy / 3.0,
+                w @ (_rowsum(x * x) + sx * sx),
+                w @ (_rowsum(y * y) + sy * sy),
+                w @ (_rowsum(x * y) + sx * sy),
             ]
         )
 

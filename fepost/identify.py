@@ -158,9 +158,7 @@ class TestCurves:
             raise DataError(f"R must be a positive finite radius in m, got {self.R!r}")
         object.__setattr__(self, "R", float(self.R))
         if self.truth is not None:
-            object.__setattr__(
-                self, "truth", MappingProxyType({k: float(v) for k, v in self.truth.items()})
-            )
+            object.__setattr__(self, "truth", MappingProxyType({k: float(v) for k, v in self.truth.items()}))
         object.__setattr__(self, "noise", MappingProxyType(dict(self.noise)))
 
     @property
@@ -434,17 +432,13 @@ class _Problem:
 
     def model(self, theta) -> np.ndarray:
         values = self.natural(theta)
-        return np.concatenate(
-            [curve_model(name, x, values, self.R)[0] for name, x in self._abscissae()]
-        )
+        return np.concatenate([curve_model(name, x, values, self.R)[0] for name, x in self._abscissae()])
 
     def jacobian(self, theta) -> np.ndarray:
         """∂model/∂θ, (n, 5): ∂model/∂(F0, M0, a, m, k_x) times ∂(F0, M0, a, m, k_x)/∂θ."""
         values = self.natural(theta)
         dvalues_dtheta = np.array([self.sF, self.sM, values[2], values[3], 1.0])
-        grad = np.concatenate(
-            [curve_model(name, x, values, self.R)[1] for name, x in self._abscissae()]
-        )
+        grad = np.concatenate([curve_model(name, x, values, self.R)[1] for name, x in self._abscissae()])
         return grad * dvalues_dtheta
 
 
@@ -652,9 +646,7 @@ class Identification:
         }
 
 
-def _solve(
-    prob: _Problem, theta0, w, max_nfev, fixed: int | None = None, value: float | None = None
-):
+def _solve(prob: _Problem, theta0, w, max_nfev, fixed: int | None = None, value: float | None = None):
     """least_squares on the weighted residuals; optionally with θ[fixed] = value."""
     if fixed is None:
 
@@ -692,9 +684,7 @@ def _solve(
         max_nfev=max_nfev,
     )
     if res.status <= 0 or not np.all(np.isfinite(res.x)):
-        raise FitError(
-            f"least-squares fit did not converge ({res.message.strip()}, nfev={res.nfev})"
-        )
+        raise FitError(f"least-squares fit did not converge ({res.message.strip()}, nfev={res.nfev})")
     return res
 
 
@@ -870,9 +860,7 @@ def fit_table1(
             )
             prof[name] = (plo, phi)
             half = 0.5 * (ci[j, 1] - ci[j, 0])
-            agree[name] = bool(
-                max(abs(plo - ci[j, 0]), abs(phi - ci[j, 1])) <= PROFILE_TOLERANCE * half
-            )
+            agree[name] = bool(max(abs(plo - ci[j, 0]), abs(phi - ci[j, 1])) <= PROFILE_TOLERANCE * half)
     resid = {name: -res.fun[s] / w[s] for name, s in zip(CURVES, slices, strict=True)}
     return Identification(
         values=values,
@@ -976,8 +964,7 @@ class BiasReport:
             "bias": {n: self.bias(n) for n in names},
             "relative_bias": {n: self.relative_bias(n) for n in names},
             "noisy_fit": {
-                n: {"value": self.noisy.value(n), "ci95": list(self.noisy.interval(n))}
-                for n in names
+                n: {"value": self.noisy.value(n), "ci95": list(self.noisy.interval(n))} for n in names
             },
             "noisy_ci_covers_theory": dict(self.covered),
             "residual_structure": {k: dict(v) for k, v in self.structure.items()},
@@ -1038,6 +1025,4 @@ def approximation_bias(
         lo, hi = fit1.interval(name)
         covered[name] = bool(lo <= c[name] <= hi)
     theory = {k: c[k] for k in ("F0", "M0", "a", "m", "k_x")}
-    return BiasReport(
-        theory=theory, noise_free=fit0, noisy=fit1, structure=structure, covered=covered
-    )
+    return BiasReport(theory=theory, noise_free=fit0, noisy=fit1, structure=structure, covered=covered)

@@ -55,4 +55,11 @@ def moments(pmap: PolarMap) -> Moments:
         x2 = pmap.integrate(x * x) / N
     else:
         cen, x2 = (0.0, 0.0), 0.0
-    return Moments(N=N, A=A, centroid=(float(cen[0]), float(cen[1])), x2=float(x2), spin=pmap.integrate(r), radius=pmap.radius)
+    return Moments(
+        N=N,
+        A=A,
+        centroid=(float(cen[0]), float(cen[1])),
+        x2=float(x2),
+        spin=pmap.integrate(r),
+        radius=pmap.radius,
+    )

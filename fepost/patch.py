@@ -166,8 +166,7 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
     peak = float(np.max(v[finite]))
     if peak <= 0.0:
         raise PressureError(
-            f"{fld.source}: pressure array {fld.field!r} is zero or negative everywhere "
-            "(no contact)"
+            f"{fld.source}: pressure array {fld.field!r} is zero or negative everywhere (no contact)"
         )
     if not finite.all():
         bad = ~finite

@@ -167,5 +167,7 @@ class PolarMap:
         i1 = np.clip(np.searchsorted(rho_n, rho), 1, rho_n.size - 1)
         i0 = i1 - 1
         ti = np.clip((rho - rho_n[i0]) / (rho_n[i1] - rho_n[i0]), 0.0, 1.0)
-        val = (1 - ti) * ((1 - tj) * s[i0, j0] + tj * s[i0, j1]) + ti * ((1 - tj) * s[i1, j0] + tj * s[i1, j1])
+        val = (1 - ti) * ((1 - tj) * s[i0, j0] + tj * s[i0, j1]) + ti * (
+            (1 - tj) * s[i1, j0] + tj * s[i1, j1]
+        )
         return np.where(rho <= 1.0, val, 0.0)

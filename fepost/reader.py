@@ -100,7 +100,9 @@ def _read_vtk(path: Path, step: int | None) -> tuple[pv.DataSet, int | None, flo
         except Exception as exc:  # VTK/pyvista raise a zoo of types for corrupt input
             raise InputFileError(f"{path}: cannot read {path.suffix} file ({_first_line(exc)})") from None
     if err.messages and (data is None or data.n_points == 0):
-        raise InputFileError(f"{path}: corrupt or truncated {path.suffix} file ({_first_line(err.messages[0])})")
+        raise InputFileError(
+            f"{path}: corrupt or truncated {path.suffix} file ({_first_line(err.messages[0])})"
+        )
     return data, None, None
 
 
@@ -209,7 +211,9 @@ def _pick_field(path: Path, data: pv.DataSet, field: str | None) -> tuple[str, i
         if len(specific) == 1:
             return specific[0], None, catalogue[specific[0]]
         cand = ", ".join(f"{n} ({catalogue[n]})" for n in hits)
-        raise FieldError(f"{path}: several candidate contact-pressure arrays: {cand}; choose one with --field")
+        raise FieldError(
+            f"{path}: several candidate contact-pressure arrays: {cand}; choose one with --field"
+        )
     return hits[0], None, catalogue[hits[0]]
 
 
@@ -253,9 +257,7 @@ def _extract(data: pv.DataSet, name: str, location: str) -> tuple[np.ndarray, np
     if isinstance(data, pv.PolyData):
         surf = data
     else:
-        surf = data.extract_surface(
-            pass_pointid=False, pass_cellid=False, algorithm="dataset_surface"
-        )
+        surf = data.extract_surface(pass_pointid=False, pass_cellid=False, algorithm="dataset_surface")
     surf = surf.triangulate()
     if surf.n_lines or surf.n_verts:
         surf = surf.extract_cells_by_type(pv.CellType.TRIANGLE).extract_surface(algorithm="dataset_surface")
@@ -314,8 +316,7 @@ def read_contact(
     reader = _READERS.get(suffix)
     if reader is None:
         raise InputFileError(
-            f"{path}: unknown format {path.suffix or '(no suffix)'!r}; "
-            f"supported: {', '.join(_READERS)}"
+            f"{path}: unknown format {path.suffix or '(no suffix)'!r}; supported: {', '.join(_READERS)}"
         )
     if path.stat().st_size == 0:
         raise InputFileError(f"{path}: empty file")

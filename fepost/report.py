@@ -110,9 +110,7 @@ def _check_inflation_option(option) -> float:
     except (TypeError, ValueError):
         p = math.nan
     if not (math.isfinite(p) and p > 0):
-        raise ArgumentError(
-            f"--inflation-pressure must be a positive pressure in Pa, got {option!r}"
-        )
+        raise ArgumentError(f"--inflation-pressure must be a positive pressure in Pa, got {option!r}")
     return p
 
 
@@ -290,9 +288,7 @@ def _save_mpl(fig, folder: Path, stem: str) -> list[str]:
 def _render(patch, path: Path, *, title: str, p_star: float, height_scale: float, clim) -> None:
     from .figures.render import pressure_surface
 
-    pl = pressure_surface(
-        patch, inflation_pressure=p_star, title=title, height_scale=height_scale, clim=clim
-    )
+    pl = pressure_surface(patch, inflation_pressure=p_star, title=title, height_scale=height_scale, clim=clim)
     try:
         pl.screenshot(str(path))
     finally:
@@ -432,9 +428,7 @@ def _html(ctx: dict) -> str:
         ("load_outside_r_equiv", ""),
         ("planarity_rms", "m"),
     ):
-        w(
-            f"<tr><th>{_esc(key)}</th>{_num(pd[key], 'coefficients.patch.' + key)}<td>{_esc(unit)}</td></tr>\n"
-        )
+        w(f"<tr><th>{_esc(key)}</th>{_num(pd[key], 'coefficients.patch.' + key)}<td>{_esc(unit)}</td></tr>\n")
     w(
         f"<tr><th>r_max / r_equiv</th>{_num(pd['r_max'] / pd['r_equiv'], None, '{:.4f}')}"
         "<td></td></tr>\n</table>\n"
@@ -551,9 +545,7 @@ def _figure(src: str, caption: str, extra: list[str] | None = None) -> str:
     if extra:
         links = (
             " ("
-            + ", ".join(
-                f"<a href='{_esc(e)}'>{_esc(e.rsplit('.', 1)[1].upper())}</a>" for e in extra
-            )
+            + ", ".join(f"<a href='{_esc(e)}'>{_esc(e.rsplit('.', 1)[1].upper())}</a>" for e in extra)
             + ")"
         )
     return (
@@ -708,9 +700,7 @@ def build_report(
             "with this map's coefficients; grey points: the noisy test data of Table 1; red dash-dot: the "
             "fitted curve with its 95 % prediction band (shaded)."
         )
-        for cd, names in zip(
-            fc.curves, steps.run("Figures 4-6 (friction curves)", curve_figs), strict=True
-        ):
+        for cd, names in zip(fc.curves, steps.run("Figures 4-6 (friction curves)", curve_figs), strict=True):
             files += names
             key, cap = caps[cd.name]
             figs[key] = _figure(names[0], cap + common, names[1:])
@@ -728,8 +718,7 @@ def build_report(
                 wr.writerow(header)
                 wr.writerows(rows)
             all_files = sorted(
-                files
-                + ["coefficients.json", "table1.json", "closed_form_vs_exact.json", "curves.csv"]
+                files + ["coefficients.json", "table1.json", "closed_form_vs_exact.json", "curves.csv"]
             )
             ctx = {
                 "analysis": a,

@@ -123,7 +123,10 @@ def write_map(
         point_data[k] = np.ascontiguousarray(v, dtype=np.float64)
     ctype = "triangle" if cells.shape[1] == 3 else "quad"
     mesh = meshio.Mesh(
-        np.ascontiguousarray(pts, dtype=np.float64), [(ctype, cells)], point_data=point_data, cell_data=cell_data
+        np.ascontiguousarray(pts, dtype=np.float64),
+        [(ctype, cells)],
+        point_data=point_data,
+        cell_data=cell_data,
     )
     suffix = path.suffix.lower()
     if suffix in (".e", ".exo"):
@@ -164,8 +167,15 @@ def write_exodus(
     times = list(range(nsteps)) if times is None else times
     etype = {3: "TRI3", 4: "QUAD4"}[cells.shape[1]]
     e = pyexodus.exodus(
-        str(path), mode="w", title="fepost verification map", numDims=3, numNodes=len(points),
-        numElems=len(cells), numBlocks=1, numNodeSets=0, numSideSets=0,
+        str(path),
+        mode="w",
+        title="fepost verification map",
+        numDims=3,
+        numNodes=len(points),
+        numElems=len(cells),
+        numBlocks=1,
+        numNodeSets=0,
+        numSideSets=0,
     )
     try:
         e.put_coords(points[:, 0], points[:, 1], points[:, 2])

@@ -160,8 +160,7 @@ class Table1:
                 "span": self.span,
                 "R": self.R,
                 "R_definition": (
-                    "r_max: smallest circle about the static centre of pressure "
-                    "holding every loaded point"
+                    "r_max: smallest circle about the static centre of pressure holding every loaded point"
                 ),
                 "N": self.N,
                 "k_x_source": self.k_x_source,
@@ -221,16 +220,13 @@ def format_table(t: Table1) -> str:
     sig = ", ".join(f"{k} {v:.4g}" for k, v in fit.noise_sigma.items())
     out += [
         "",
-        f"fit: chi2/dof = {fit.redchi:.3g} (dof {fit.dof}), "
-        f"noise levels estimated per curve: {sig}",
+        f"fit: chi2/dof = {fit.redchi:.3g} (dof {fit.dof}), noise levels estimated per curve: {sig}",
         "'!' = the 95 % bounds miss the theoretical value; "
         "'*' = profile and Wald bounds differ by more than 10 % of the half-width",
     ]
     if t.bias is not None:
         b = t.bias
-        rel = ", ".join(
-            f"{n} {100 * b.relative_bias(n):+.1f} %" for n in ("F0", "M0", "a", "m", "k_x")
-        )
+        rel = ", ".join(f"{n} {100 * b.relative_bias(n):+.1f} %" for n in ("F0", "M0", "a", "m", "k_x"))
         st = b.structure
         errs = ", ".join(f"{k} {v['max_abs_error_relative']:.3f}" for k, v in st.items())
         ac = ", ".join(f"{k} {v['lag1_autocorrelation']:.2f}" for k, v in st.items())
@@ -244,11 +240,7 @@ def format_table(t: Table1) -> str:
             f"  largest |exact - fitted closed form| / curve max: {errs}",
             f"  residual lag-1 autocorrelation {ac}; runs test p {rp} (systematic, not noise)",
             "  with the paper's noise, the 95 % bounds miss the asymptotic value of: "
-            + (
-                ", ".join(missed)
-                if missed
-                else "none (the noise hides the bias at this sample size)"
-            ),
+            + (", ".join(missed) if missed else "none (the noise hides the bias at this sample size)"),
         ]
     out += [""] + [f"note: {n}" for n in t.notes]
     return "\n".join(out)
@@ -281,15 +273,11 @@ def table1(
     c = analysis.coefficients
     if c.k_x is not None:
         if k_x is not None:
-            raise ArgumentError(
-                "k_x must be None when the analysis has a rolling map (k_x comes from it)"
-            )
+            raise ArgumentError("k_x must be None when the analysis has a rolling map (k_x comes from it)")
         kx, kx_source = float(c.k_x), "rolling map, k_x = R x_c / <x^2>"
         rolling_map = analysis.rolling_map
         if rolling_map is None:
-            raise ArgumentError(
-                "analysis has k_x but no rolling_map; run analyse with the rolling map"
-            )
+            raise ArgumentError("analysis has k_x but no rolling_map; run analyse with the rolling map")
         rolling_quad = PressureQuadrature.from_polar(rolling_map)
     else:
         kx = PAPER_K_X if k_x is None else float(k_x)
@@ -343,16 +331,13 @@ def table1(
             )
         )
     notes = [
-        f"theory: a, m from the moments (asymptotic values), R = r_max = {c.R:.5g} m; "
-        "f = F0/N with N known",
+        f"theory: a, m from the moments (asymptotic values), R = r_max = {c.R:.5g} m; f = F0/N with N known",
         "bounds: Wald, t-quantile on the covariance (theta = F0, M0, ln a, ln m, k_x; "
         "curves weighted by their own noise level estimated from the residuals); "
         "profile bounds by re-fits for a and m",
     ]
     if source == "exact":
-        notes.append(
-            "source exact: the fitted values carry the approximation's bias as well as noise"
-        )
+        notes.append("source exact: the fitted values carry the approximation's bias as well as noise")
     if c.k_x is None:
         notes.append(f"k_x: {kx_source}")
     notes.extend(PAPER_NOTES)

@@ -34,7 +34,9 @@ def disc(path, values_fn=None, z_fn=None, field="CPRESS", extra=None, location="
     pd = {field: val} if location == "point" else {}
     cd = {field: [val[tri].mean(axis=1)]} if location == "cell" else {}
     pd.update(extra or {})
-    meshio.write(path, meshio.Mesh(np.column_stack([p2, z]), [("triangle", tri)], point_data=pd, cell_data=cd))
+    meshio.write(
+        path, meshio.Mesh(np.column_stack([p2, z]), [("triangle", tri)], point_data=pd, cell_data=cd)
+    )
     return path
 
 
@@ -70,7 +72,12 @@ def test_empty_file(capsys, tmp_path):
 
 def test_no_pressure_array_lists_arrays(capsys, tmp_path):
     p = disc(tmp_path / "m.vtu", field="temperature")
-    run_bad(capsys, tmp_path, [p], r"m\.vtu: no contact-pressure array found .*arrays found: temperature \(point\)")
+    run_bad(
+        capsys,
+        tmp_path,
+        [p],
+        r"m\.vtu: no contact-pressure array found .*arrays found: temperature \(point\)",
+    )
 
 
 def test_several_candidates(capsys, tmp_path):
@@ -78,14 +85,30 @@ def test_several_candidates(capsys, tmp_path):
     p2, tri = disc_mesh(12)
     val = 1 - (p2**2).sum(1)
     meshio.write(
-        p, meshio.Mesh(np.column_stack([p2, 0 * val]), [("triangle", tri)], point_data={"CPRESS": val, "ContactPressure": val})
+        p,
+        meshio.Mesh(
+            np.column_stack([p2, 0 * val]),
+            [("triangle", tri)],
+            point_data={"CPRESS": val, "ContactPressure": val},
+        ),
     )
-    run_bad(capsys, tmp_path, [p], r"m\.vtu: several candidate contact-pressure arrays: CPRESS \(point\), ContactPressure \(point\); choose one with --field")
+    run_bad(
+        capsys,
+        tmp_path,
+        [p],
+        r"m\.vtu: several candidate contact-pressure arrays: CPRESS \(point\), "
+        r"ContactPressure \(point\); choose one with --field",
+    )
 
 
 def test_named_field_missing(capsys, tmp_path):
     p = disc(tmp_path / "m.vtu")
-    run_bad(capsys, tmp_path, [p, "--field", "PRESS"], r"m\.vtu: no array named 'PRESS'; arrays found: CPRESS \(point\)")
+    run_bad(
+        capsys,
+        tmp_path,
+        [p, "--field", "PRESS"],
+        r"m\.vtu: no array named 'PRESS'; arrays found: CPRESS \(point\)",
+    )
 
 
 def test_all_zero(capsys, tmp_path):
@@ -99,7 +122,12 @@ def test_nan_inside_patch(capsys, tmp_path):
         v[0] = np.nan  # the centre node
         return v
 
-    run_bad(capsys, tmp_path, [disc(tmp_path / "m.vtu", values_fn=vals)], r"m\.vtu: 1 NaN/inf pressure values inside the contact patch")
+    run_bad(
+        capsys,
+        tmp_path,
+        [disc(tmp_path / "m.vtu", values_fn=vals)],
+        r"m\.vtu: 1 NaN/inf pressure values inside the contact patch",
+    )
 
 
 def test_negative_pressure(capsys, tmp_path):
@@ -120,7 +148,12 @@ def test_two_patches(capsys, tmp_path):
     cells = np.vstack([tri, tri + len(p2)])
     path = tmp_path / "dual.vtu"
     meshio.write(path, meshio.Mesh(pts, [("triangle", cells)], point_data={"CPRESS": np.r_[val, 0.8 * val]}))
-    run_bad(capsys, tmp_path, [path], r"dual\.vtu: 2 separate contact patches \(load shares 56%, 44%\); dual wheels")
+    run_bad(
+        capsys,
+        tmp_path,
+        [path],
+        r"dual\.vtu: 2 separate contact patches \(load shares 56%, 44%\); dual wheels",
+    )
 
 
 def test_bad_friction_argument(capsys, tmp_path):

@@ -56,18 +56,14 @@ def _close_figures():
 # ---------------------------------------------------------------- Figures 1 and 2
 def test_figure1_static(maps, verify_image_cache):
     hs = default_height_scale(maps.static_patch, maps.rolling_patch)
-    pl = pressure_surface(
-        maps.static_patch, title="Figure 1: static contact pressure", height_scale=hs
-    )
+    pl = pressure_surface(maps.static_patch, title="Figure 1: static contact pressure", height_scale=hs)
     assert tuple(pl.window_size) == (1200, 900)
     pl.show()
 
 
 def test_figure2_rolling(maps, verify_image_cache):
     hs = default_height_scale(maps.static_patch, maps.rolling_patch)
-    pl = pressure_surface(
-        maps.rolling_patch, title="Figure 2: rolling contact pressure", height_scale=hs
-    )
+    pl = pressure_surface(maps.rolling_patch, title="Figure 2: rolling contact pressure", height_scale=hs)
     pl.show()
 
 
@@ -114,9 +110,7 @@ def test_sections_interpolate_the_fe_field_exactly_for_a_linear_field():
     inside = np.abs(s + ox) < 0.95 * RADIUS
     np.testing.assert_allclose(sec.static_x[inside], 2.0 + (s[inside] + ox) / RADIUS, rtol=1e-9)
     inside_y = np.hypot(ox, s) < 0.95 * RADIUS
-    np.testing.assert_allclose(
-        sec.static_y[inside_y], np.full(inside_y.sum(), 2.0 + ox / RADIUS), rtol=1e-9
-    )
+    np.testing.assert_allclose(sec.static_y[inside_y], np.full(inside_y.sum(), 2.0 + ox / RADIUS), rtol=1e-9)
     outside = np.hypot(s, 0) > 1.01 * RADIUS + abs(ox)
     assert np.all(sec.static_x[outside] == 0.0)
     assert sec.rolling_x is None
@@ -166,9 +160,7 @@ def test_patch_plan_title_says_not_circular(tmp_path):
     fig = plot_patch_plan(a.static_patch)
     assert fig.axes[0].get_title().startswith("Loaded region — NOT circular: aspect 2.0")
     e = [ln for ln in fig.axes[0].get_lines() if ln.get_gid() == "ellipse"][0]
-    assert np.ptp(e.get_xdata()) == pytest.approx(
-        2 * a.static_patch.ellipse_axes[0] * 1e3, rel=1e-3
-    )
+    assert np.ptp(e.get_xdata()) == pytest.approx(2 * a.static_patch.ellipse_axes[0] * 1e3, rel=1e-3)
 
 
 # ---------------------------------------------------------------- Figures 4-6

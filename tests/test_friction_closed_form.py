@@ -183,7 +183,5 @@ def test_rolling_shift_of_shifted_map():
 
 
 def test_approximation_error_validates_upsilon():
-    with pytest.raises(
-        ArgumentError, match=r"^upsilon must hold at least 2 positive finite values"
-    ):
+    with pytest.raises(ArgumentError, match=r"^upsilon must hold at least 2 positive finite values"):
         approximation_error(make_quad("hertz"), F, upsilon=[1.0, -1.0])

@@ -332,16 +332,12 @@ def test_threads_and_chunks_do_not_change_results(monkeypatch):
 
 
 def test_nan_kinematics_rejected():
-    with pytest.raises(
-        ArgumentError, match=r"^vy must be finite \(m/s\), got nan at index \(1,\)$"
-    ):
+    with pytest.raises(ArgumentError, match=r"^vy must be finite \(m/s\), got nan at index \(1,\)$"):
         friction_resultants(make_quad(nr=8, nphi=16), [1.0, 2.0], [0.0, np.nan], 1.0)
 
 
 def test_mismatched_shapes_rejected():
-    with pytest.raises(
-        ArgumentError, match=r"^wz has shape \(4,\), which does not broadcast with \(3,\)$"
-    ):
+    with pytest.raises(ArgumentError, match=r"^wz has shape \(4,\), which does not broadcast with \(3,\)$"):
         friction_resultants(make_quad(nr=8, nphi=16), np.zeros(3), 0.0, np.zeros(4))
 
 
@@ -383,9 +379,7 @@ def test_quadrature_transforms_preserve_load_and_compose_sigma_at():
         assert other.load == pytest.approx(quad.load, rel=IDENTITY)
         assert other.contact_area == pytest.approx(quad.contact_area, rel=IDENTITY)
         # Nodes map to nodes, where the bilinear interpolation is exact.
-        np.testing.assert_allclose(
-            other.sigma_at(other.x, other.y), other.sigma, rtol=1e-9, atol=1e-6
-        )
+        np.testing.assert_allclose(other.sigma_at(other.x, other.y), other.sigma, rtol=1e-9, atol=1e-6)
     assert quad.stretched(1.3).domain.ax == pytest.approx(0.13)
     with pytest.raises(ValueError):
         quad.x[0] = 0.0

@@ -175,16 +175,12 @@ def test_agrees_with_scipy_curve_fit(truth):
 
     y = np.concatenate([c.f_parallel, c.torque, c.f_perp])
     p0 = [truth[k] for k in PARAMETERS]
-    popt, pcov = curve_fit(
-        model, x, y, p0=p0, sigma=sig, absolute_sigma=False, xtol=1e-14, ftol=1e-14
-    )
+    popt, pcov = curve_fit(model, x, y, p0=p0, sigma=sig, absolute_sigma=False, xtol=1e-14, ftol=1e-14)
     np.testing.assert_allclose(fit.values, popt, rtol=AGREE)
     sd = np.sqrt(np.diag(pcov))
     np.testing.assert_allclose(np.sqrt(np.diag(fit.covariance)), sd, rtol=1e-5)
     # off-diagonals, scaled (the F∥ and M_C blocks are uncorrelated: exact zeros vs 1e-16)
-    np.testing.assert_allclose(
-        fit.covariance / np.outer(sd, sd), pcov / np.outer(sd, sd), atol=1e-6
-    )
+    np.testing.assert_allclose(fit.covariance / np.outer(sd, sd), pcov / np.outer(sd, sd), atol=1e-6)
     # 95 % bounds: t-quantile x s.e.; linear in F0, M0, k_x, in log space for a and m
     t = stats.t.ppf(0.975, y.size - len(PARAMETERS))
     half = 0.5 * (fit.ci95[:, 1] - fit.ci95[:, 0])
@@ -293,9 +289,7 @@ def test_prediction_band_against_scipy(truth):
         np.testing.assert_allclose(hi - ours, half, rtol=BAND_AGREE)
         np.testing.assert_allclose(ours - lo, half, rtol=BAND_AGREE)
         se = np.sqrt(np.einsum("ij,jk,ik->i", g, pcov, g))
-        np.testing.assert_allclose(
-            fit.curve_stderr(name, x), se, rtol=BAND_AGREE, atol=BAND_AGREE * se.max()
-        )
+        np.testing.assert_allclose(fit.curve_stderr(name, x), se, rtol=BAND_AGREE, atol=BAND_AGREE * se.max())
 
 
 def test_curve_model_gradient_is_the_derivative(truth):
@@ -334,9 +328,7 @@ def test_prediction_band_monte_carlo(truth):
             y, lo, hi = fit.prediction_band(name, x)
             yhat[name].append(y)
             var[name].append(fit.curve_stderr(name, x) ** 2)
-            cover[name].append(
-                stats.norm.cdf((hi - true) / std) - stats.norm.cdf((lo - true) / std)
-            )
+            cover[name].append(stats.norm.cdf((hi - true) / std) - stats.norm.cdf((lo - true) / std))
     for name in names:
         ratio = np.std(yhat[name], axis=0, ddof=1) / np.sqrt(np.mean(var[name], axis=0))
         np.testing.assert_allclose(ratio, 1.0, atol=STD_TOL, err_msg=name)
@@ -347,9 +339,7 @@ def test_prediction_band_bad_arguments(truth):
     fit = fit_table1(make_test_curves("closed_form", truth, seed=1), truth["N"], profile=False)
     with pytest.raises(ArgumentError, match=r"^level must be a probability in \(0, 1\), got 1\.0$"):
         fit.prediction_band("torque", [0.0], level=1)
-    with pytest.raises(
-        ArgumentError, match=r"^name must be one of f_parallel, torque, f_perp, got 'fx'$"
-    ):
+    with pytest.raises(ArgumentError, match=r"^name must be one of f_parallel, torque, f_perp, got 'fx'$"):
         fit.prediction_band("fx", [0.0])
     with pytest.raises(ArgumentError, match=r"^x must be finite, got nan at index 1$"):
         fit.curve_stderr("torque", [0.0, np.nan])
@@ -392,22 +382,16 @@ def test_non_finite_data_is_a_data_error():
 
 
 def test_bad_arguments():
-    with pytest.raises(
-        ArgumentError, match=r"^N must be a positive finite normal load in N, got -1.0$"
-    ):
+    with pytest.raises(ArgumentError, match=r"^N must be a positive finite normal load in N, got -1.0$"):
         fit_table1(_curves(10), -1.0)
-    with pytest.raises(
-        ArgumentError, match=r"^source must be 'closed_form' or 'exact', got 'fem'$"
-    ):
+    with pytest.raises(ArgumentError, match=r"^source must be 'closed_form' or 'exact', got 'fem'$"):
         make_test_curves("fem", {})
     with pytest.raises(
         ArgumentError,
         match=r"^coefficients.k_x is missing \(no rolling map: give k_x explicitly\)$",
     ):
         make_test_curves("closed_form", {"F0": 1, "M0": 1, "a": 1, "m": 1, "R": 1, "N": 1})
-    with pytest.raises(
-        ArgumentError, match=r"^quad must be a PressureQuadrature of the static map"
-    ):
+    with pytest.raises(ArgumentError, match=r"^quad must be a PressureQuadrature of the static map"):
         make_test_curves("exact", {"F0": 1, "M0": 1, "a": 1, "m": 1, "k_x": 0, "R": 1, "N": 1})
 
 

@@ -31,8 +31,15 @@ CASES = [
 @pytest.mark.parametrize("profile,kind,suffix,location,normal,origin", CASES)
 def test_closed_forms_reproduced(analytic_mesh, profile, kind, suffix, location, normal, origin):
     path = analytic_mesh(
-        "map" + suffix, profile, radius=R, peak=PEAK, kind=kind, location=location,
-        normal=normal, origin=origin, n_rings=60,
+        "map" + suffix,
+        profile,
+        radius=R,
+        peak=PEAK,
+        kind=kind,
+        location=location,
+        normal=normal,
+        origin=origin,
+        n_rings=60,
     )
     a = analyse(path, friction=F)
     c = a.coefficients

@@ -14,11 +14,14 @@ def test_area_weights_sum_to_disc_area(rule):
     assert g.area_weights(0.2).sum() == pytest.approx(np.pi * 0.04, rel=1e-12)
 
 
-@pytest.mark.parametrize("kw,msg", [
-    ({"nr": 1}, "nr must be an integer >= 2, got 1"),
-    ({"nphi": 2}, "nphi must be an integer >= 4, got 2"),
-    ({"rule": "simpson"}, "rule must be 'gauss' or 'trapezoid', got 'simpson'"),
-])
+@pytest.mark.parametrize(
+    "kw,msg",
+    [
+        ({"nr": 1}, "nr must be an integer >= 2, got 1"),
+        ({"nphi": 2}, "nphi must be an integer >= 4, got 2"),
+        ({"rule": "simpson"}, "rule must be 'gauss' or 'trapezoid', got 'simpson'"),
+    ],
+)
 def test_grid_arguments_are_named(kw, msg):
     with pytest.raises(ArgumentError, match=msg):
         PolarGrid.make(**kw)

@@ -23,7 +23,10 @@ def smooth(x, y):
 def exact_A():
     # angular mean of smooth at radius ρ: e^{-2ρ²}(1 + 0.1ρ²)
     return np.array(
-        [quad(lambda r, k=k: np.exp(-2 * r * r) * (1 + 0.1 * r * r) * r**k, 0, 1, epsabs=1e-14)[0] for k in range(4)]
+        [
+            quad(lambda r, k=k: np.exp(-2 * r * r) * (1 + 0.1 * r * r) * r**k, 0, 1, epsabs=1e-14)[0]
+            for k in range(4)
+        ]
     )
 
 
@@ -57,7 +60,9 @@ def test_periodic_trapezoid_in_phi_is_spectral():
     # x·y² and x terms average out exactly; a cos(3φ) field needs nphi > 3 nodes only
     ref = quad(lambda r: r * r, 0, 1)[0]
     for nphi in (8, 16):
-        pm = PolarMap.from_function(lambda x, y: np.hypot(x, y) * (1 + np.cos(3 * np.arctan2(y, x))), 1.0, PolarGrid.make(8, nphi))
+        pm = PolarMap.from_function(
+            lambda x, y: np.hypot(x, y) * (1 + np.cos(3 * np.arctan2(y, x))), 1.0, PolarGrid.make(8, nphi)
+        )
         assert moments(pm).A[1] == pytest.approx(ref, rel=1e-13)
 
 
@@ -67,7 +72,9 @@ def test_fe_pipeline_is_second_order_in_mesh_size(analytic_mesh):
     N_ref = analytic.load("paraboloid", 0.1, 1e6)
     errs = []
     for n in rings:
-        a = analyse(analytic_mesh(f"p{n}.vtu", "paraboloid", radius=0.1, peak=1e6, n_rings=int(n), kind="quad"))
+        a = analyse(
+            analytic_mesh(f"p{n}.vtu", "paraboloid", radius=0.1, peak=1e6, n_rings=int(n), kind="quad")
+        )
         errs.append(abs(a.coefficients.N / N_ref - 1))
     p = observed_order(rings, np.array(errs))
     assert 1.7 < p < 2.3

@@ -102,9 +102,7 @@ def test_report_progress_lines(report):
     _, _, err, _ = report
     lines = err.strip().splitlines()
     steps = [ln for ln in lines if ln.startswith("[")]
-    assert steps and all(
-        re.fullmatch(r"\[\d+/\d+\] .+ \.\.\. done in \d+\.\d s", ln) for ln in steps
-    )
+    assert steps and all(re.fullmatch(r"\[\d+/\d+\] .+ \.\.\. done in \d+\.\d s", ln) for ln in steps)
     assert steps[-1].startswith(f"[{len(steps)}/{len(steps)}]")
 
 
@@ -171,9 +169,7 @@ def test_report_curves_csv_matches_the_fit(report):
         assert series == {"exact", "closed_form", "fit", "band_lo", "band_hi", "test"}
     # The closed form at υ = 0 is M0 exactly.
     coef = json.loads((out / "coefficients.json").read_text())
-    m0 = [float(r["value"]) for r in rows if r["figure"] == "M_C" and r["series"] == "closed_form"][
-        0
-    ]
+    m0 = [float(r["value"]) for r in rows if r["figure"] == "M_C" and r["series"] == "closed_form"][0]
     assert m0 == pytest.approx(coef["M0"], rel=1e-12)
 
 
@@ -184,9 +180,7 @@ def test_report_refuses_non_empty_folder_without_force(report, capsys):
     code = main(["report", *inputs, "--out", str(out)])
     err = capsys.readouterr().err
     assert code == 2
-    assert (
-        err == f"fepost: error: {out}: folder exists and is not empty (use --force to replace it)\n"
-    )
+    assert err == f"fepost: error: {out}: folder exists and is not empty (use --force to replace it)\n"
     assert sorted(p.name for p in out.iterdir()) == before
 
 
@@ -221,9 +215,7 @@ def test_report_figures_show_the_table1_fit(report):
 
         def series(name, fig=fig):
             return [
-                (float(r["x"]), float(r["value"]))
-                for r in rows
-                if r["figure"] == fig and r["series"] == name
+                (float(r["x"]), float(r["value"])) for r in rows if r["figure"] == fig and r["series"] == name
             ]
 
         fit, lo, hi = series("fit"), series("band_lo"), series("band_hi")
@@ -244,9 +236,7 @@ def test_report_and_table1_agree_on_analytic_maps(tmp_path):
     out, cli_json = tmp_path / "rep", tmp_path / "t1.json"
     with redirect_stderr(io.StringIO()), redirect_stdout(io.StringIO()):
         assert main(["report", str(s), str(r), "--out", str(out)]) == 0
-        assert (
-            main(["table1", "--static", str(s), "--rolling", str(r), "--json", str(cli_json)]) == 0
-        )
+        assert main(["table1", "--static", str(s), "--rolling", str(r), "--json", str(cli_json)]) == 0
     from_report = json.loads((out / "table1.json").read_text())
     from_table1 = json.loads(cli_json.read_text())
     assert from_report["settings"]["seed"] == from_table1["settings"]["seed"] == DEFAULT_SEED
@@ -272,10 +262,7 @@ def test_report_parent_is_a_file(tmp_path, small_map, capsys):
     out = tmp_path / "afile" / "rep"
     code = main(["report", small_map, "--out", str(out)])
     assert code == 2
-    assert (
-        capsys.readouterr().err
-        == f"fepost: error: {out}: parent folder {out.parent} does not exist\n"
-    )
+    assert capsys.readouterr().err == f"fepost: error: {out}: parent folder {out.parent} does not exist\n"
 
 
 def test_report_bad_mesh_leaves_nothing(tmp_path, capsys):

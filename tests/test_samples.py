@@ -23,8 +23,7 @@ def _load(case: str):
     vtu = MESHES / f"{case}.vtu"
     if not vtu.exists():
         pytest.fail(
-            f"missing sample {vtu}; regenerate with: "
-            ".venv/bin/python -m scripts.tiremodel build --case all"
+            f"missing sample {vtu}; regenerate with: .venv/bin/python -m scripts.tiremodel build --case all"
         )
     m = meshio.read(vtu)
     side = json.loads((MESHES / f"{case}.json").read_text())
@@ -163,9 +162,7 @@ def test_exodus_and_vtu_agree(case):
     np.testing.assert_allclose(e.points, v.points, rtol=0, atol=1e-9)
     np.testing.assert_array_equal(e.cells_dict["quad"], v.cells_dict["quad"])
     np.testing.assert_allclose(e.point_data["CPRESS"], v.point_data["CPRESS"], rtol=1e-9, atol=1e-6)
-    np.testing.assert_allclose(
-        e.point_data["displacement"], v.point_data["displacement"], atol=1e-12
-    )
+    np.testing.assert_allclose(e.point_data["displacement"], v.point_data["displacement"], atol=1e-12)
 
 
 def test_samples_are_small():

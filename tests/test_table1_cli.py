@@ -89,9 +89,7 @@ def test_without_rolling_map_k_x_is_assumed_and_said(meshes):
 
 
 def test_k_x_with_a_rolling_map_is_refused(analysis):
-    with pytest.raises(
-        ArgumentError, match=r"^k_x must be None when the analysis has a rolling map"
-    ):
+    with pytest.raises(ArgumentError, match=r"^k_x must be None when the analysis has a rolling map"):
         table1(analysis, k_x=0.1)
 
 
@@ -104,9 +102,7 @@ def test_exact_source_runs_and_differs(analysis, committed):
 # --- the command -------------------------------------------------------------------------
 def test_cli_writes_json_rows(meshes, tmp_path, capsys):
     out = tmp_path / "t1.json"
-    code = main(
-        ["table1", "--static", str(meshes[0]), "--rolling", str(meshes[1]), "--json", str(out)]
-    )
+    code = main(["table1", "--static", str(meshes[0]), "--rolling", str(meshes[1]), "--json", str(out)])
     assert code == 0
     printed = capsys.readouterr().out
     assert "95 % bounds" in printed and "k_x" in printed

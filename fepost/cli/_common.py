@@ -36,7 +36,9 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--rolling-axis", metavar="X,Y,Z", help="global rolling direction (default 1,0,0)")
     g.add_argument("--threshold", type=float, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
     g.add_argument("--nr", type=int, default=DEFAULT_NR, help=f"radial grid nodes (default {DEFAULT_NR})")
-    g.add_argument("--nphi", type=int, default=DEFAULT_NPHI, help=f"angular grid nodes (default {DEFAULT_NPHI})")
+    g.add_argument(
+        "--nphi", type=int, default=DEFAULT_NPHI, help=f"angular grid nodes (default {DEFAULT_NPHI})"
+    )
     g.add_argument("--rule", choices=("gauss", "trapezoid"), default="gauss", help="radial quadrature rule")
 
 
@@ -46,7 +48,9 @@ def analysis_kwargs(args: argparse.Namespace) -> dict:
         try:
             axis = tuple(float(v) for v in args.rolling_axis.split(","))
         except ValueError:
-            raise ArgumentError(f"--rolling-axis must be three numbers X,Y,Z, got {args.rolling_axis!r}") from None
+            raise ArgumentError(
+                f"--rolling-axis must be three numbers X,Y,Z, got {args.rolling_axis!r}"
+            ) from None
         if len(axis) != 3:
             raise ArgumentError(f"--rolling-axis must be three numbers X,Y,Z, got {args.rolling_axis!r}")
     disp = None if str(args.displacement).lower() == "none" else args.displacement

@@ -17,7 +17,9 @@ def add_parser(sub) -> None:
     )
     p.add_argument("static", metavar="STATIC", help="static contact map (.vtu .vtk .vtp .e .exo)")
     p.add_argument("--rolling", metavar="ROLLING", help="rolling contact map at the same deflection")
-    p.add_argument("--friction", type=float, default=0.3, metavar="F", help="friction coefficient f (default 0.3)")
+    p.add_argument(
+        "--friction", type=float, default=0.3, metavar="F", help="friction coefficient f (default 0.3)"
+    )
     p.add_argument("--json", metavar="PATH", help="write the coefficients as JSON")
     add_input_options(p)
     p.set_defaults(func=run)
@@ -32,7 +34,9 @@ def format_analysis(a: Analysis) -> str:
         ("normal load N_fe (FE faces)", f"{p.N_fe:.6g} N  (differs by {c.N / p.N_fe - 1:+.2e})"),
     ]
     if p.reaction_z is not None:
-        rows.append(("solver reaction", f"{p.reaction_z:.6g} N  (N/reaction - 1 = {c.N / p.reaction_z - 1:+.2%})"))
+        rows.append(
+            ("solver reaction", f"{p.reaction_z:.6g} N  (N/reaction - 1 = {c.N / p.reaction_z - 1:+.2%})")
+        )
     o = p.frame.origin
     rows += [
         ("patch centre (global)", f"({o[0]:.5g}, {o[1]:.5g}, {o[2]:.5g}) m"),

@@ -1,4 +1,4 @@
-"""``fepost report [STATIC [ROLLING]] --out DIR [--force] [--friction F] [--inflation-pressure P] [--seed S]``."""
+"""``fepost report [STATIC [ROLLING]] --out DIR [--force]``, plus friction, P* and seed options."""
 
 from __future__ import annotations
 
@@ -23,12 +23,8 @@ def add_parser(sub) -> None:
     p.add_argument(
         "static", metavar="STATIC", nargs="?", help="static contact map (default: the sample mesh)"
     )
-    p.add_argument(
-        "rolling", metavar="ROLLING", nargs="?", help="rolling contact map at the same deflection"
-    )
-    p.add_argument(
-        "--out", metavar="DIR", required=True, help="output folder (created; must be empty)"
-    )
+    p.add_argument("rolling", metavar="ROLLING", nargs="?", help="rolling contact map at the same deflection")
+    p.add_argument("--out", metavar="DIR", required=True, help="output folder (created; must be empty)")
     p.add_argument("--force", action="store_true", help="replace a non-empty output folder")
     p.add_argument(
         "--friction",

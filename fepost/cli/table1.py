@@ -31,17 +31,13 @@ def add_parser(sub) -> None:
             "95 % bounds | the paper's values."
         ),
     )
-    p.add_argument(
-        "--static", metavar="STATIC", help="static contact map (default: meshes/static.vtu)"
-    )
+    p.add_argument("--static", metavar="STATIC", help="static contact map (default: meshes/static.vtu)")
     p.add_argument(
         "--rolling",
         metavar="ROLLING",
         help="rolling contact map (default: meshes/rolling.vtu when --static is not given either)",
     )
-    p.add_argument(
-        "--seed", type=int, default=SEED, metavar="S", help=f"noise seed (default {SEED})"
-    )
+    p.add_argument("--seed", type=int, default=SEED, metavar="S", help=f"noise seed (default {SEED})")
     p.add_argument("--json", metavar="PATH", help="write the table as JSON")
     p.add_argument(
         "--source",
@@ -56,9 +52,7 @@ def add_parser(sub) -> None:
         metavar="F",
         help="friction coefficient f (default 0.3)",
     )
-    p.add_argument(
-        "--noise", choices=("uniform", "gaussian"), default="uniform", help="noise distribution"
-    )
+    p.add_argument("--noise", choices=("uniform", "gaussian"), default="uniform", help="noise distribution")
     p.add_argument(
         "--amplitude",
         type=float,
@@ -115,9 +109,7 @@ def run(args: argparse.Namespace) -> int:
         d = t.to_dict()
         d["inputs"] = {
             "static": str(result.static_field.source),
-            "rolling": str(result.rolling_field.source)
-            if result.rolling_field is not None
-            else None,
+            "rolling": str(result.rolling_field.source) if result.rolling_field is not None else None,
         }
         write_json_atomic(args.json, d)
     return 0

@@ -46,9 +46,7 @@ def plot_patch_plan(patch: Patch, ax=None):
             gid="pressure",
             rasterized=True,
         )
-        ax.triplot(
-            xy[:, 0], xy[:, 1], patch.triangles, color="white", lw=0.15, alpha=0.5, rasterized=True
-        )
+        ax.triplot(xy[:, 0], xy[:, 1], patch.triangles, color="white", lw=0.15, alpha=0.5, rasterized=True)
         fig.colorbar(tpc, ax=ax, label="contact pressure (kPa)", shrink=0.85)
         c = circle_points(patch.r_max * 1e3)
         ax.plot(

@@ -107,9 +107,7 @@ def _nice_range(peak: float) -> tuple[float, int]:
     return float(10 ** (k + 1)), 2
 
 
-def default_height_scale(
-    *patches: Patch, inflation_pressure: float = DEFAULT_INFLATION_PRESSURE
-) -> float:
+def default_height_scale(*patches: Patch, inflation_pressure: float = DEFAULT_INFLATION_PRESSURE) -> float:
     """mm of height per unit σ/P* so that the tallest of ``patches`` rises to
     :data:`HEIGHT_FRACTION` × its r_max."""
     p_star = _check_pressure(inflation_pressure)
@@ -191,9 +189,7 @@ def pressure_surface(
         patch.ellipse_angle,
         (patch.ellipse_centre[0] * 1e3, patch.ellipse_centre[1] * 1e3),
     )
-    plotter.add_mesh(
-        _polyline(ell), color=theme.ELLIPSE_COLOUR, line_width=5, render_lines_as_tubes=True
-    )
+    plotter.add_mesh(_polyline(ell), color=theme.ELLIPSE_COLOUR, line_width=5, render_lines_as_tubes=True)
     # Rolling direction +x: an arrow in front of the patch.
     y_arrow = -1.2 * r_mm
     arrow = pv.Arrow(
@@ -238,9 +234,7 @@ def pressure_surface(
         [f"r_max = {r_mm:.1f} mm (R)", theme.RMAX_COLOUR],
         [f"fitted ellipse, aspect {patch.aspect:.3f}", theme.ELLIPSE_COLOUR],
     ]
-    plotter.add_legend(
-        legend, bcolor="white", border=False, loc="lower left", size=(0.3, 0.08), face="line"
-    )
+    plotter.add_legend(legend, bcolor="white", border=False, loc="lower left", size=(0.3, 0.08), face="line")
     subtitle = f"height: p/P* (P* = {p_star / 1e3:.0f} kPa), colour: p (kPa)"
     plotter.add_text(
         f"{title}\n{subtitle}" if title else subtitle,

@@ -122,9 +122,7 @@ def plot_sections(data: SectionData, axes=None):
             (axes[0], "x", data.static_x, data.rolling_x),
             (axes[1], "y", data.static_y, data.rolling_y),
         ):
-            ax.plot(
-                data.s, st, color=theme.STATIC_COLOUR, lw=1.8, label="static", gid=f"static_{axis}"
-            )
+            ax.plot(data.s, st, color=theme.STATIC_COLOUR, lw=1.8, label="static", gid=f"static_{axis}")
             if ro is not None:
                 ax.plot(
                     data.s,
@@ -139,9 +137,7 @@ def plot_sections(data: SectionData, axes=None):
                 ax.axvline(sgn * data.R, color=theme.RMAX_COLOUR, lw=0.8, ls=":")
             other = "y" if axis == "x" else "x"
             ax.set_xlabel(f"{axis} (mm), along {other} = 0")
-            ax.set_title(
-                f"{axis} diameter" + (" (rolling direction)" if axis == "x" else " (lateral)")
-            )
+            ax.set_title(f"{axis} diameter" + (" (rolling direction)" if axis == "x" else " (lateral)"))
             ax.set_xlim(data.s[0], data.s[-1])
             ax.set_ylim(bottom=0.0)
         axes[0].set_ylabel(f"p / P*  (P* = {data.inflation_pressure / 1e3:.0f} kPa)")

@@ -124,9 +124,7 @@ def _errors(a, m, ups, par, tor, perp) -> CurveErrors:
 
 
 def _fit(model, start: float, data: np.ndarray, name: str) -> float:
-    res = least_squares(
-        lambda p: model(p[0]) - data, [start], bounds=(0.0, np.inf), x_scale=[start]
-    )
+    res = least_squares(lambda p: model(p[0]) - data, [start], bounds=(0.0, np.inf), x_scale=[start])
     if not res.success:
         raise FitError(f"fitting {name} to the exact curve failed: {res.message}")
     return float(res.x[0])
@@ -165,9 +163,7 @@ def approximation_error(
         if not (np.isfinite(value) and value > 0):
             raise ArgumentError(f"{name} must be positive and finite, got {value!r}")
     wz = 1.0 / R  # u = 1 m/s
-    res = friction_resultants(
-        quad, ups, np.zeros_like(ups), np.full_like(ups, wz), FrictionLaw(f=f)
-    )
+    res = friction_resultants(quad, ups, np.zeros_like(ups), np.full_like(ups, wz), FrictionLaw(f=f))
     par = -res.Fx / F0
     tor = -res.Mz / M0
     scale = abs(k_x) * M0 / (2.0 * R)

@@ -100,9 +100,7 @@ class AsymptoticCoefficients:
     direction: float
 
     def to_dict(self) -> dict:
-        return {
-            k: float(getattr(self, k)) for k in ("F0", "M0", "a", "m", "radius", "f", "direction")
-        }
+        return {k: float(getattr(self, k)) for k in ("F0", "M0", "a", "m", "radius", "f", "direction")}
 
 
 def asymptotic_coefficients(
@@ -143,9 +141,7 @@ def asymptotic_coefficients(
     second = float(s @ ((ex * x + ey * y) ** 2 * da))
     a = (N / (R * T)) ** 2
     m = (M0 * R / (f * second)) ** 2
-    return AsymptoticCoefficients(
-        f * N, M0, float(a), float(m), float(R), float(f), float(direction)
-    )
+    return AsymptoticCoefficients(f * N, M0, float(a), float(m), float(R), float(f), float(direction))
 
 
 def _inverse_r_moment(quad: PressureQuadrature, nx: float, ny: float) -> float:

@@ -86,9 +86,7 @@ def _kinematics(vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[i
         if np.any(bad):
             where = np.argwhere(bad)[0]
             at = f" at index {tuple(int(i) for i in where)}" if arr.ndim else ""
-            raise ArgumentError(
-                f"{name} must be finite ({unit}), got {float(arr[tuple(where)])!r}{at}"
-            )
+            raise ArgumentError(f"{name} must be finite ({unit}), got {float(arr[tuple(where)])!r}{at}")
         arrays[name] = arr
     shape = arrays["vx"].shape
     for name in ("vy", "wz"):
@@ -245,9 +243,7 @@ def friction_resultants(
     order = {True: 2, False: 0}.get(subtract, subtract) if isinstance(subtract, bool) else subtract
     if order not in (0, 1, 2):
         raise ArgumentError(f"subtract must be True, False, 0, 1 or 2, got {subtract!r}")
-    if threads is not None and (
-        isinstance(threads, bool) or int(threads) != threads or threads < 1
-    ):
+    if threads is not None and (isinstance(threads, bool) or int(threads) != threads or threads < 1):
         raise ArgumentError(f"threads must be a positive integer, got {threads!r}")
     vx, vy, wz, shape = _kinematics(vx, vy, wz)
     sigma_ref = law.reference_pressure(quad.mean_pressure) if law.pressure_coef else 1.0

@@ -39,9 +39,7 @@ class FrictionLaw:
     def __post_init__(self) -> None:
         for name in ("f", "pressure_coef", "speed_coef", "anisotropy"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(
-                value, (int, float, np.floating, np.integer)
-            ):
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
                 raise ArgumentError(f"{name} must be a real number, got {value!r}")
             if not np.isfinite(value):
                 raise ArgumentError(f"{name} must be finite, got {value!r}")
@@ -55,9 +53,7 @@ class FrictionLaw:
             if isinstance(ref, bool) or not isinstance(ref, (int, float, np.floating, np.integer)):
                 raise ArgumentError(f"pressure_ref must be a pressure in Pa or None, got {ref!r}")
             if not (np.isfinite(ref) and ref > 0):
-                raise ArgumentError(
-                    f"pressure_ref must be a positive finite pressure in Pa, got {ref!r}"
-                )
+                raise ArgumentError(f"pressure_ref must be a positive finite pressure in Pa, got {ref!r}")
             object.__setattr__(self, "pressure_ref", float(ref))
 
     @property

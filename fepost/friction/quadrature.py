@@ -63,9 +63,7 @@ class Ellipse:
             object.__setattr__(self, name, float(value))
         for name in ("ax", "ay"):
             if getattr(self, name) <= 0:
-                raise ArgumentError(
-                    f"domain {name} must be positive (m), got {getattr(self, name)!r}"
-                )
+                raise ArgumentError(f"domain {name} must be positive (m), got {getattr(self, name)!r}")
 
     @property
     def area(self) -> float:
@@ -109,9 +107,7 @@ class Ellipse:
         f0, f1, f2 = d2[i - 1], d2[i], d2[(i + 1) % t.size]
         den = f0 - 2 * f1 + f2
         tt = t[i] + (0.5 * h * (f0 - f2) / den if den < 0 else 0.0)
-        best = (self.cx + self.ax * np.cos(tt) - x0) ** 2 + (
-            self.cy + self.ay * np.sin(tt) - y0
-        ) ** 2
+        best = (self.cx + self.ax * np.cos(tt) - x0) ** 2 + (self.cy + self.ay * np.sin(tt) - y0) ** 2
         return float(np.sqrt(max(best, f1)))
 
 

@@ -22,16 +22,12 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(
-        prog="python -m scripts.tiremodel", description=__doc__.splitlines()[0]
-    )
+    ap = argparse.ArgumentParser(prog="python -m scripts.tiremodel", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="command", required=True)
     b = sub.add_parser("build", help="mesh, solve with CalculiX and export sample results")
     b.add_argument("--case", choices=[*dk.CASES, "all"], default="all")
     b.add_argument("--coarse", action="store_true", help="cheap mesh (tests, quick looks)")
-    b.add_argument(
-        "--out", type=Path, default=REPO / "meshes", help="output folder (default: meshes/)"
-    )
+    b.add_argument("--out", type=Path, default=REPO / "meshes", help="output folder (default: meshes/)")
     b.add_argument("--keep", type=Path, default=None, help="also copy the CalculiX work files here")
     b.add_argument("--threads", type=int, default=2)
     b.add_argument("--debug", action="store_true", help="show tracebacks")

@@ -125,9 +125,7 @@ def write_exodus(path: Path, pts, quads, point_vars: dict, title: str = "") -> N
         conn = nc.createVariable("connect1", "i4", ("num_el_in_blk1", "num_nod_per_el1"))
         conn.elem_type = "QUAD4"
         conn[:] = np.asarray(quads, dtype=np.int32) + 1
-        names(
-            nc.createVariable("name_nod_var", "S1", ("num_nod_var", "len_name")), list(point_vars)
-        )
+        names(nc.createVariable("name_nod_var", "S1", ("num_nod_var", "len_name")), list(point_vars))
         for k, vals in enumerate(point_vars.values()):
             v = nc.createVariable(f"vals_nod_var{k + 1}", "f8", ("time_step", "num_nodes"))
             v[0, :] = np.asarray(vals, dtype=float)
@@ -144,17 +142,14 @@ def write_case(res: CaseResult, out_dir: Path) -> dict:
         "case": name,
         "description": res.case.description,
         "reaction_z": float(res.road_force[2]),
-        "reaction_z_source": "CalculiX total reaction force (RF) on the fixed road nodes, "
-        "final increment",
+        "reaction_z_source": "CalculiX total reaction force (RF) on the fixed road nodes, final increment",
         "reaction_force_road": [float(v) for v in res.road_force],
         "reaction_force_rim": [float(v) for v in res.bead_force],
         "cpress_integral": n_int,
-        "cpress_integral_note": "exact integral of the bilinear CPRESS field over the "
-        "deformed faces",
+        "cpress_integral_note": "exact integral of the bilinear CPRESS field over the deformed faces",
         "inflation_pressure": dk.PRESSURE,
         "deflection": res.case.deflection,
-        "deflection_definition": "vertical rim travel after the inflated crown first "
-        "touches the road",
+        "deflection_definition": "vertical rim travel after the inflated crown first touches the road",
         "rim_travel_z": res.rim_travel,
         "inflated_clearance": res.inflated_clearance,
         "friction": dk.FRICTION,

@@ -18,9 +18,7 @@ import numpy as np
 class FrdResults:
     node_ids: np.ndarray  # CalculiX node numbers, sorted
     coords: np.ndarray  # (n, 3) undeformed coordinates
-    steps: list[tuple[int, float]] = field(
-        default_factory=list
-    )  # (step, time) of stored increments
+    steps: list[tuple[int, float]] = field(default_factory=list)  # (step, time) of stored increments
     # last stored increment of each step: {step: {block name: (components, (n, k) array)}}
     last: dict[int, dict[str, tuple[list[str], np.ndarray]]] = field(default_factory=dict)
 
@@ -96,9 +94,7 @@ def _step_of_counter(path) -> dict[int, int]:
     return out
 
 
-_TOTAL = re.compile(
-    r"total force \(fx,fy,fz\) for set (\S+) and time\s+(\S+)\s*\n\s*(\S+)\s+(\S+)\s+(\S+)"
-)
+_TOTAL = re.compile(r"total force \(fx,fy,fz\) for set (\S+) and time\s+(\S+)\s*\n\s*(\S+)\s+(\S+)\s+(\S+)")
 
 
 def read_dat_totals(path) -> list[tuple[str, float, np.ndarray]]:
@@ -107,7 +103,5 @@ def read_dat_totals(path) -> list[tuple[str, float, np.ndarray]]:
         text = fh.read()
     out = []
     for m in _TOTAL.finditer(text):
-        out.append(
-            (m.group(1), float(m.group(2)), np.array([float(m.group(i)) for i in (3, 4, 5)]))
-        )
+        out.append((m.group(1), float(m.group(2)), np.array([float(m.group(i)) for i in (3, 4, 5)])))
     return out

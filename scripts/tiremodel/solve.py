@@ -24,9 +24,7 @@ class ModelError(RuntimeError):
 def find_ccx() -> str:
     exe = shutil.which("ccx")
     if exe is None:
-        raise ModelError(
-            "CalculiX solver 'ccx' not found on PATH (Debian: apt-get install calculix-ccx)"
-        )
+        raise ModelError("CalculiX solver 'ccx' not found on PATH (Debian: apt-get install calculix-ccx)")
     return exe
 
 

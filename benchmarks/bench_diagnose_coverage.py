@@ -1,0 +1,165 @@
+"""Monte-Carlo coverage of the 95 % intervals of ``fepost diagnose``, per cause and parameter.
+
+For each cause the synthetic data of the detection tests (tests/test_diagnose_detect.py)
+are made once at the test's design seed with :func:`fepost.diagnose.synthetic.synthesize`
+(kinematics, loads, rolls and the clean exact resultants of the fine generator grid),
+then the noise is redrawn ``--seeds`` times with
+:func:`fepost.diagnose.synthetic.renoised` (same noise model and SD). Each replicate
+is fitted with the TRUE cause's model only (no selection, so the figure is the
+intervals' own coverage) and each parameter's 95 % interval is checked against the
+truth. Printed per parameter: coverage with its Monte-Carlo standard error
+√(p(1−p)/K), and the mean and SD of z = (estimate − truth)/stderr (nominal 0 and 1:
+a mean ≠ 0 is a bias, e.g. a model error of the fit grid; an SD > 1 intervals too
+narrow).
+
+Sets (as in the tests): ``A`` tire-like map R = 0.12 m, loads 0.7/1.0/1.3, 400
+points, noise 1.5 %; ``B`` paraboloid R = 0.09 m with a rolling map (k_x = 0.1),
+roll −1/0/+1, 300 points, noise 2 %.
+
+Run: ``.venv/bin/python benchmarks/bench_diagnose_coverage.py [--sets A B] [--seeds 200]
+[--nr 24 --nphi 48] [--causes ...] [--jobs 2]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import multiprocessing as mp
+import time
+
+import numpy as np
+
+from fepost.analytic import pressure_function
+from fepost.diagnose.causes import Predictor, build_candidates
+from fepost.diagnose.fitting import fit
+from fepost.diagnose.simulation import FIT_NPHI, FIT_NR, simulation_from_maps
+from fepost.diagnose.synthetic import renoised, synthesize
+from fepost.polar import PolarGrid, PolarMap
+
+SET_A = [
+    ("friction_level", {"f": 0.27}),
+    ("pressure_dependent_friction", {"c_p": 0.25}),
+    ("speed_dependent_friction", {"c_v": 0.08}),
+    ("elliptic_patch", {"s": 0.88}),
+    ("anisotropic_friction", {"alpha": 1.12}),
+    ("pressure_shift", {"dx": -0.003, "dy": 0.0025}),
+    ("sensor_offset", {"offset_Fx": -120.0, "offset_Fy": 90.0, "offset_Mz": -6.0}),
+]
+SET_B = [
+    ("friction_level", {"f": 0.34}),
+    ("pressure_dependent_friction", {"c_p": -0.35}),
+    ("speed_dependent_friction", {"c_v": -0.15}),
+    ("elliptic_patch", {"s": 1.1}),
+    ("anisotropic_friction", {"alpha": 0.9}),
+    ("pressure_shift", {"dx": 0.0025, "dy": 0.0035}),
+    ("sensor_offset", {"offset_Fx": 80.0, "offset_Fy": 60.0, "offset_Mz": -4.0}),
+]
+
+
+def _map(profile, radius, peak, k_x=0.0):
+    fn = pressure_function(profile, radius, peak=peak, k_x=k_x)
+    return PolarMap.from_function(fn, radius, PolarGrid.make(), source=profile)
+
+
+def set_up(name: str):
+    """(cases, base seed, synthesize kwargs, static, rolling) of test set ``name``."""
+    if name == "A":
+        pmap = _map("tire", 0.12, 2.5e5)
+        return SET_A, 100, {"n": 400, "noise": 0.015, "loads": (0.7, 1.0, 1.3)}, pmap, None
+    if name == "B":
+        static, rolling = _map("paraboloid", 0.09, 4e5), _map("paraboloid", 0.09, 4e5, k_x=0.1)
+        return SET_B, 200, {"n": 300, "noise": 0.02}, static, rolling
+    raise SystemExit(f"unknown set {name!r}")
+
+
+# Fork-shared state of one (set, cause) study: the workers inherit it.
+_STATE: dict = {}
+
+
+def _one(seed: int):
+    if _STATE["vary"]:
+        # a new test design (kinematics, rolls, loads) and noise per replicate
+        syn = synthesize(*_STATE["args"], seed=seed, **_STATE["kwargs"])
+        pred = Predictor(_STATE["sim"], syn.data)
+        cand = build_candidates(pred)[_STATE["effect"]]
+    else:
+        syn = renoised(_STATE["syn"], seed)
+        pred, cand = _STATE["pred"], _STATE["cand"]
+    ft = fit(cand, syn.data.forces / pred.scale)
+    truth = np.array([_STATE["truth"][n] for n in ft.names])
+    covered = (ft.ci95[:, 0] <= truth) & (truth <= ft.ci95[:, 1])
+    z = (ft.values - truth) / ft.stderr
+    return covered, z
+
+
+def study(set_name, effect, params, seed, kwargs, static, rolling, sim, seeds, jobs, vary=False):
+    syn = synthesize(static, effect, params, rolling=rolling, seed=seed, **kwargs)
+    pred = Predictor(sim, syn.data)
+    cand = build_candidates(pred)[effect]
+    truth = {**syn.truth}
+    if effect != "friction_level":
+        truth["f"] = syn.friction
+    _STATE.update(
+        syn=syn, pred=pred, cand=cand, truth=truth, vary=vary, sim=sim, effect=effect,
+        args=(static, effect, params), kwargs={"rolling": rolling, **kwargs},
+    )  # fmt: skip
+    noise_seeds = [50_000 + k for k in range(seeds)]
+    if jobs > 1:
+        with mp.get_context("fork").Pool(jobs) as pool:
+            out = pool.map(_one, noise_seeds, chunksize=max(1, seeds // (4 * jobs)))
+    else:
+        out = [_one(s) for s in noise_seeds]
+    cov = np.array([o[0] for o in out], float)
+    z = np.array([o[1] for o in out])
+    names = tuple(p.name for p in cand.parameters)
+    rows = []
+    for j, name in enumerate(names):
+        p = cov[:, j].mean()
+        se = np.sqrt(p * (1 - p) / seeds)
+        rows.append((set_name, effect, name, p, se, z[:, j].mean(), z[:, j].std(ddof=1)))
+    return rows
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sets", nargs="+", default=["A", "B"])
+    parser.add_argument("--seeds", type=int, default=200)
+    parser.add_argument("--nr", type=int, default=FIT_NR)
+    parser.add_argument("--nphi", type=int, default=FIT_NPHI)
+    parser.add_argument("--causes", nargs="*", default=None)
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument(
+        "--vary-design",
+        action="store_true",
+        help="draw new kinematics/rolls/loads per replicate too (slow: new exact integrals)",
+    )
+    args = parser.parse_args(argv)
+    t0 = time.perf_counter()
+    print(
+        f"coverage of the 95 % intervals, true cause fitted, {args.seeds} noise draws per cause, "
+        f"fit grid {args.nr} x {args.nphi}"
+        + (", new design per replicate" if args.vary_design else ", design of the test seed")
+    )
+    print(f"{'set':<3} {'cause':<28} {'param':<10} {'coverage':>9} {'MC se':>6} {'mean z':>7} {'SD z':>6}")
+    low = []
+    for set_name in args.sets:
+        cases, base, kwargs, static, rolling = set_up(set_name)
+        sim = simulation_from_maps(static, rolling, friction=0.3, nr=args.nr, nphi=args.nphi)
+        for i, (effect, params) in enumerate(cases):
+            if args.causes and effect not in args.causes:
+                continue
+            rows = study(
+                set_name, effect, params, base + i, kwargs, static, rolling, sim,
+                args.seeds, args.jobs, args.vary_design,
+            )  # fmt: skip
+            for s, e, n, p, se, mz, sz in rows:
+                se0 = np.sqrt(0.95 * 0.05 / args.seeds)  # the MC se at nominal coverage
+                flag = "" if abs(p - 0.95) <= 2 * se0 else "  <--"
+                if flag:
+                    low.append(f"{s}:{e}:{n}")
+                print(f"{s:<3} {e:<28} {n:<10} {p:9.1%} {se:6.1%} {mz:+7.2f} {sz:6.2f}{flag}", flush=True)
+    print(f"\noutside 95 % ± 2 MC se (nominal): {low or 'none'}")
+    print(f"elapsed {time.perf_counter() - t0:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
