@@ -88,7 +88,6 @@ class PolarMap:
     ``sigma`` has shape (nr, nphi) in Pa, ``radius`` is R in m, ``centre`` the
     (x, y) of the grid centre in the patch frame (m; (0, 0) = static centre of
     pressure). ``valid`` marks nodes that fell on the FE surface (others are 0).
-    ``edge`` (nphi,), optional, holds σ on the rim ρ = 1 for :meth:`interpolate`.
     """
 
     grid: PolarGrid
@@ -97,7 +96,6 @@ class PolarMap:
     centre: tuple[float, float] = (0.0, 0.0)
     valid: np.ndarray | None = field(default=None)
     source: str = ""
-    edge: np.ndarray | None = field(default=None)
 
     def __post_init__(self) -> None:
         sig = frozen(self.sigma)
@@ -110,19 +108,13 @@ class PolarMap:
         object.__setattr__(self, "centre", (float(self.centre[0]), float(self.centre[1])))
         if self.valid is not None:
             object.__setattr__(self, "valid", frozen(self.valid, dtype=bool))
-        if self.edge is not None:
-            edge = frozen(self.edge)
-            if edge.shape != (self.grid.shape[1],):
-                raise ArgumentError(f"edge must have shape ({self.grid.shape[1]},), got {edge.shape}")
-            object.__setattr__(self, "edge", edge)
 
     @classmethod
     def from_function(cls, func, radius: float, grid: PolarGrid | None = None, source: str = "") -> PolarMap:
         """Sample ``func(x, y) -> sigma`` (Pa, x and y in m about the centre) on ``grid``."""
         grid = grid or PolarGrid.make()
         x, y = grid.xy(radius)
-        edge = np.asarray(func(radius * np.cos(grid.phi), radius * np.sin(grid.phi)), float)
-        return cls(grid=grid, radius=radius, sigma=np.asarray(func(x, y), float), source=source, edge=edge)
+        return cls(grid=grid, radius=radius, sigma=np.asarray(func(x, y), float), source=source)
 
     def xy(self) -> tuple[np.ndarray, np.ndarray]:
         """Node coordinates (m) relative to ``centre``, each (nr, nphi)."""
@@ -143,30 +135,23 @@ class PolarMap:
     def interpolate(self, x, y) -> np.ndarray:
         """σ at arbitrary points (m, about ``centre``), bilinear in (ρ, φ); 0 outside R.
 
-        Inside the first radial node the value tends linearly to the angular mean
-        of the first ring at ρ = 0; beyond the last node it tends linearly to
-        ``edge`` at ρ = 1 when the map has one, else it is held constant.
+        Radial values outside the first/last node are held constant up to ρ = 1.
         """
         x = np.asarray(x, float)
         y = np.asarray(y, float)
-        g = self.grid
-        rho_n, s = g.rho, self.sigma
-        if rho_n[0] > 0.0:
-            rho_n = np.r_[0.0, rho_n]
-            s = np.vstack([np.full(s.shape[1], s[0].mean()), s])
-        if rho_n[-1] < 1.0 and self.edge is not None:
-            rho_n = np.r_[rho_n, 1.0]
-            s = np.vstack([s, self.edge])
         rho = np.hypot(x, y) / self.radius
         phi = np.mod(np.arctan2(y, x), 2.0 * np.pi)
+        g = self.grid
         nphi = g.phi.size
-        t = phi / (2.0 * np.pi / nphi)
+        dphi = 2.0 * np.pi / nphi
+        t = phi / dphi
         j0 = np.floor(t).astype(int) % nphi
         j1 = (j0 + 1) % nphi
         tj = t - np.floor(t)
-        i1 = np.clip(np.searchsorted(rho_n, rho), 1, rho_n.size - 1)
+        i1 = np.clip(np.searchsorted(g.rho, rho), 1, g.rho.size - 1)
         i0 = i1 - 1
-        ti = np.clip((rho - rho_n[i0]) / (rho_n[i1] - rho_n[i0]), 0.0, 1.0)
+        ti = np.clip((rho - g.rho[i0]) / (g.rho[i1] - g.rho[i0]), 0.0, 1.0)
+        s = self.sigma
         val = (1 - ti) * ((1 - tj) * s[i0, j0] + tj * s[i0, j1]) + ti * (
             (1 - tj) * s[i1, j0] + tj * s[i1, j1]
         )

@@ -46,19 +46,12 @@ def resample(
     if radius is None:
         radius = float(np.max(np.hypot(patch.xy[:, 0] - cx, patch.xy[:, 1] - cy)))
     x, y = grid.xy(radius)
-    # the grid nodes, then the rim ρ = 1 (for interpolation between nodes and rim)
-    px = np.r_[x.ravel(), radius * np.cos(grid.phi)] + cx
-    py = np.r_[y.ravel(), radius * np.sin(grid.phi)] + cy
-    probe = pv.PolyData(np.column_stack([px, py, np.zeros(px.size)]))
+    probe = pv.PolyData(np.column_stack([x.ravel() + cx, y.ravel() + cy, np.zeros(x.size)]))
     mesh = _surface(patch)
     out = probe.sample(mesh, tolerance=1e-9 * radius, snap_to_closest_point=False)
-    values = np.asarray(out.point_data["p"], float)
-    ok = np.asarray(out.point_data["vtkValidPointMask"], bool)
-    values = np.where(ok, values, 0.0)
-    n = x.size
-    sigma = values[:n].reshape(grid.shape)
-    valid = ok[:n].reshape(grid.shape)
-    edge = values[n:]
+    sigma = np.asarray(out.point_data["p"], float).reshape(grid.shape)
+    valid = np.asarray(out.point_data["vtkValidPointMask"], bool).reshape(grid.shape)
+    sigma = np.where(valid, sigma, 0.0)
     inner = np.hypot(x, y) < 0.5 * min(patch.ellipse_axes)
     if np.any(~valid & inner):
         warnings.warn(
@@ -67,6 +60,4 @@ def resample(
             PatchWarning,
             stacklevel=2,
         )
-    return PolarMap(
-        grid=grid, radius=radius, sigma=sigma, centre=(cx, cy), valid=valid, source=patch.source, edge=edge
-    )
+    return PolarMap(grid=grid, radius=radius, sigma=sigma, centre=(cx, cy), valid=valid, source=patch.source)

@@ -39,24 +39,18 @@ def test_map_arrays_are_read_only():
     pm = PolarMap.from_function(analytic.pressure_function("hertz", 1.0), 1.0, PolarGrid.make(8, 16))
     with pytest.raises(ValueError):
         pm.sigma[0, 0] = 1.0
-    with pytest.raises(ValueError):
-        pm.edge[0] = 1.0
 
 
-def test_interpolation_reaches_the_rim_value():
-    """Between the last Gauss node and ρ = 1 the value tends to the rim (0 for Hertz)."""
+def test_interpolation_inside_the_grid():
+    """Bilinear in (ρ, φ): O(h²) on a smooth region; zero outside the disc."""
     f = analytic.pressure_function("hertz", 0.1, peak=1e6)
     pm = PolarMap.from_function(f, 0.1, PolarGrid.make(24, 48))
-    phi = np.linspace(0, 2 * np.pi, 7)
-    # √(1 − ρ²) at a rounded ρ = 1 is ~1e-8 of the peak
-    assert np.allclose(pm.interpolate(0.1 * np.cos(phi), 0.1 * np.sin(phi)), 0.0, atol=1e-7 * 1e6)
-    # and it is a good interpolant inside: bilinear error O(h²) on a smooth region
-    r = np.linspace(0.0, 0.08, 9)
+    r = np.linspace(0.01, 0.08, 8)
     assert np.allclose(pm.interpolate(r, 0 * r), f(r, 0 * r), rtol=5e-3)
     assert pm.interpolate(0.2, 0.0) == 0.0
 
 
-def test_interpolation_without_rim_holds_the_last_ring():
+def test_interpolation_holds_the_last_ring_up_to_the_rim():
     g = PolarGrid.make(6, 8)
     pm = PolarMap(g, 1.0, np.ones((6, 8)))
     assert pm.interpolate(0.9999, 0.0) == pytest.approx(1.0)

@@ -49,10 +49,9 @@ def regrid(pmap: PolarMap, grid: PolarGrid, *, mirror: bool = False) -> PolarMap
     x, y = grid.xy(pmap.radius)
     sign = -1.0 if mirror else 1.0
     sigma = pmap.interpolate(sign * x, y)
-    rim = pmap.interpolate(sign * pmap.radius * np.cos(grid.phi), pmap.radius * np.sin(grid.phi))
     cx, cy = pmap.centre
     return PolarMap(
-        grid=grid, radius=pmap.radius, sigma=sigma, centre=(sign * cx, cy), source=pmap.source, edge=rim
+        grid=grid, radius=pmap.radius, sigma=sigma, centre=(sign * cx, cy), source=pmap.source
     )
 
 
