@@ -59,16 +59,3 @@ class ContactField:
     @property
     def n_faces(self) -> int:
         return int(self.triangles.shape[0])
-
-    def node_values(self) -> np.ndarray:
-        """Pressure per node (cell data averaged onto nodes by face area)."""
-        if self.location == "point":
-            return self.values
-        p = self.points[self.triangles]
-        area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-        num = np.zeros(self.n_points)
-        den = np.zeros(self.n_points)
-        for k in range(3):
-            np.add.at(num, self.triangles[:, k], area * self.values)
-            np.add.at(den, self.triangles[:, k], area)
-        return np.divide(num, den, out=np.zeros_like(num), where=den > 0)
