@@ -135,7 +135,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     t0 = time.perf_counter()
     print(
-        f"coverage of the 95 % intervals, true cause fitted, {args.seeds} noise draws per cause, "
+        f"coverage of the 95 % intervals, true cause fitted, {args.seeds} replicates per cause, "
         f"fit grid {args.nr} x {args.nphi}"
         + (", new design per replicate" if args.vary_design else ", design of the test seed")
     )

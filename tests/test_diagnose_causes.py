@@ -27,9 +27,7 @@ TOL = 1e-9
 
 
 def _map(k_x=0.0, profile="paraboloid"):
-    return PolarMap.from_function(
-        pressure_function(profile, R, peak=2.0e5, k_x=k_x), R, PolarGrid.make()
-    )
+    return PolarMap.from_function(pressure_function(profile, R, peak=2.0e5, k_x=k_x), R, PolarGrid.make())
 
 
 CASES = [
@@ -48,9 +46,7 @@ CASES = [
 ]
 
 
-@pytest.mark.parametrize(
-    ("effect", "params", "values"), CASES, ids=[f"{c[0]}{c[2]}" for c in CASES]
-)
+@pytest.mark.parametrize(("effect", "params", "values"), CASES, ids=[f"{c[0]}{c[2]}" for c in CASES])
 @pytest.mark.parametrize("loads", [None, (0.8, 1.0, 1.25)], ids=["one-load", "loads"])
 def test_candidate_equals_direct_effect(effect, params, values, loads):
     static, rolling = _map(), _map(k_x=0.15)
@@ -110,9 +106,7 @@ def test_test_matrix_has_the_required_structure():
     assert np.any((v == 0) & (u > 0)), "pure spin"
     assert np.any((u == 0) & (v > 0)), "pure sliding"
     assert np.any(kin.wz > 0) and np.any(kin.wz < 0), "both spin signs"
-    assert np.unique(np.round(np.degrees(np.arctan2(kin.vy, kin.vx)[v > 0]))).size >= 8, (
-        "directions"
-    )
+    assert np.unique(np.round(np.degrees(np.arctan2(kin.vy, kin.vx)[v > 0]))).size >= 8, "directions"
     both = (u > 0) & (v > 0)
     ratios = np.round(v[both] / u[both], 6)
     speeds_at_half = np.unique(np.round(u[both][ratios == 0.5], 6))

@@ -61,9 +61,7 @@ def test_existing_folder_needs_force(setup, capsys):
     args = ["diagnose", "--simulation", str(static), "--measured", str(csv), "--out", str(out)]
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
-    assert (
-        err == f"fepost: error: {out}: folder exists and is not empty (use --force to replace it)"
-    )
+    assert err == f"fepost: error: {out}: folder exists and is not empty (use --force to replace it)"
     assert (out / "keep.txt").read_text() == "mine"
     assert main([*args, "--force"]) == 0
     assert not (out / "keep.txt").exists() and (out / "diagnosis.json").is_file()
@@ -85,9 +83,7 @@ def test_bad_csv_is_a_one_line_error_and_writes_nothing(setup, capsys, text, mes
     static, _, tmp = setup
     bad = tmp / "bad.csv"
     bad.write_text(text)
-    rc = main(
-        ["diagnose", "--simulation", str(static), "--measured", str(bad), "--out", str(tmp / "o")]
-    )
+    rc = main(["diagnose", "--simulation", str(static), "--measured", str(bad), "--out", str(tmp / "o")])
     assert rc == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith(f"fepost: error: {bad}: ")

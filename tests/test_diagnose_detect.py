@@ -13,12 +13,22 @@ The tests below use **other maps and other values** (never tuned on):
 * set B: a paraboloid, R = 0.09 m, peak 4e5 Pa, with a rolling map (k_x = 0.1)
   and rows at roll = −1/0/+1, one load, 300 points, noise 2 % of range;
 * set C: the CalculiX sample map ``meshes/static.vtu`` (skipped until it exists).
-Seeds are fixed per case (set base + index), chosen before the first run. Each
-case must name the cause with no rival, land within ~4 standard errors, gain in
-held-out RMSE and leave noise-like residuals; the 95 % intervals must hold the
-truth at the nominal rate (see MAX_MISSES). Set B misses 3 of 11 on its seeds
-(f of friction_level, α, offset_Fy; each |z| ≈ 2.2–2.5); over 40 seeds each the
-z-scores of those parameters have SD 0.8–1.1.
+Seeds are fixed per case (set base + index), chosen before the first run and
+never changed. Each case must name the cause with no rival, gain in held-out
+RMSE, leave noise-like residuals, and every parameter's truth must lie inside
+its reported 95 % interval.
+
+Known misses (:data:`KNOWN_MISSES`). The intervals are calibrated: over 200
+noise draws at each case's own test design, fitting the true cause, every
+parameter's coverage lies within 2 Monte-Carlo SE of 95 % and z = (estimate −
+truth)/SE has mean within ±0.2 and SD 0.9–1.1, with the same figures on a fit grid
+equal to the generator's (``benchmarks/bench_diagnose_coverage.py``). At the
+committed seeds three set-B parameters nevertheless fall just outside their
+intervals (|z| = 2.2–2.5): the 1-in-20 misses a 95 % interval must have (with
+22 parameters, P(at least one miss) = 1 − 0.95²² ≈ 68 %). They are listed
+exactly, not tolerated: a case must miss precisely its listed parameters (any
+other miss, or a listed one that starts covering, fails) and is then reported
+as xfail.
 """
 
 from __future__ import annotations
@@ -62,31 +72,32 @@ def _map(profile, radius, peak, k_x=0.0):
     return PolarMap.from_function(fn, radius, PolarGrid.make(), source=profile)
 
 
-#: A 95 % interval misses the truth one time in twenty. Each set checks 11
-#: parameters; under nominal coverage the misses are Binomial(11, 0.05), and
-#: P(misses >= 4) = 0.2 %. So a set may miss at most 3; more means the intervals
-#: are too narrow or biased. (Per-seed coverage rates: benchmarks/bench_diagnose.py.)
-MAX_MISSES = 3
+#: Parameters whose truth lies outside the 95 % interval at the committed seed
+#: (see the module docstring; z = (estimate − truth)/SE at that seed, and the
+#: coverage of the parameter's interval over 200 noise draws at that test design).
+KNOWN_MISSES = {
+    ("B", "friction_level"): {"f": "z = -2.18; coverage 96.0 +- 1.4 %"},
+    ("B", "anisotropic_friction"): {"alpha": "z = -2.18; coverage 96.5 +- 1.3 %"},
+    ("B", "sensor_offset"): {"offset_Fy": "z = +2.50; coverage 95.5 +- 1.5 %"},
+}
 
 
-def _check(diag, syn, effect) -> tuple[list[str], list[str]]:
-    """(problems, interval misses) of one diagnosis of data with ``effect`` hidden."""
-    problems, misses = [], []
+def _check(diag, syn, effect) -> tuple[list[str], dict[str, str]]:
+    """(problems, interval misses by parameter) of one diagnosis of data with ``effect`` hidden."""
+    problems, misses = [], {}
     if diag.cause != effect:
-        return [f"{effect}: named {diag.cause}"], []
+        return [f"{effect}: named {diag.cause}"], {}
     if diag.indistinguishable:
         problems.append(f"{effect}: indistinguishable {diag.indistinguishable}")
+    if set(diag.parameters) != set(syn.truth):
+        problems.append(f"{effect}: parameters {sorted(diag.parameters)} != {sorted(syn.truth)}")
+        return problems, {}
     for name, truth in syn.truth.items():
         if effect != "friction_level" and name == "f":
             truth = syn.friction
         est = diag.parameters[name]
-        half = 0.5 * (est.ci95[1] - est.ci95[0])
         if not est.covers(truth):
-            misses.append(f"{effect}: {name} = {truth} outside {est.ci95}")
-        if abs(est.value - truth) > 2.0 * half:  # beyond ~4 standard errors: a gross error
-            problems.append(
-                f"{effect}: {name} = {est.value} far from {truth} (95 % half-width {half:.3g})"
-            )
+            misses[name] = f"{effect}: {name} = {truth} outside {est.ci95} (estimate {est.value})"
     g = diag.gain
     if not (g["rmse_after"] < g["rmse_before"] and g["delta_bic"] < -10.0):
         problems.append(f"{effect}: no gain {g}")
@@ -96,36 +107,33 @@ def _check(diag, syn, effect) -> tuple[list[str], list[str]]:
     return problems, misses
 
 
-def _run_set(cases, make, base_seed):
-    problems, misses = [], []
-    for i, (effect, params) in enumerate(cases):
-        p, m = make(effect, params, base_seed + i)
-        problems += p
-        misses += m
+def _assert_case(set_name, effect, problems, misses):
     assert not problems, problems
-    assert len(misses) <= MAX_MISSES, misses
+    known = KNOWN_MISSES.get((set_name, effect), {})
+    assert set(misses) == set(known), (
+        f"interval misses {sorted(misses.values())}; known at this seed: {sorted(known)}"
+    )
+    if known:
+        pytest.xfail(f"known 1-in-20 interval miss at this seed: {known}")
 
 
-def test_set_a_tire_map_with_loads():
+@pytest.mark.parametrize(("i", "effect", "params"), [(i, *c) for i, c in enumerate(SET_A)])
+def test_set_a_tire_map_with_loads(i, effect, params):
     pmap = _map("tire", 0.12, 2.5e5)
-
-    def make(effect, params, seed):
-        syn = synthesize(pmap, effect, params, n=400, seed=seed, noise=0.015, loads=(0.7, 1.0, 1.3))
-        return _check(diagnose(pmap, syn.data, friction=0.3, seed=seed), syn, effect)
-
-    _run_set(SET_A, make, 100)
+    seed = 100 + i
+    syn = synthesize(pmap, effect, params, n=400, seed=seed, noise=0.015, loads=(0.7, 1.0, 1.3))
+    problems, misses = _check(diagnose(pmap, syn.data, friction=0.3, seed=seed), syn, effect)
+    _assert_case("A", effect, problems, misses)
 
 
-def test_set_b_paraboloid_with_rolling_map():
+@pytest.mark.parametrize(("i", "effect", "params"), [(i, *c) for i, c in enumerate(SET_B)])
+def test_set_b_paraboloid_with_rolling_map(i, effect, params):
     static, rolling = _map("paraboloid", 0.09, 4e5), _map("paraboloid", 0.09, 4e5, k_x=0.1)
-
-    def make(effect, params, seed):
-        syn = synthesize(static, effect, params, rolling=rolling, n=300, seed=seed, noise=0.02)
-        return _check(
-            diagnose(static, syn.data, rolling=rolling, friction=0.3, seed=seed), syn, effect
-        )
-
-    _run_set(SET_B, make, 200)
+    seed = 200 + i
+    syn = synthesize(static, effect, params, rolling=rolling, n=300, seed=seed, noise=0.02)
+    diag = diagnose(static, syn.data, rolling=rolling, friction=0.3, seed=seed)
+    problems, misses = _check(diag, syn, effect)
+    _assert_case("B", effect, problems, misses)
 
 
 @pytest.mark.parametrize("seed", [301, 302])
@@ -186,4 +194,4 @@ def test_set_c_calculix_map(effect, params):
     else:
         problems, misses = _check(d, syn, effect)
         assert not problems, problems
-        assert len(misses) <= 1, misses
+        assert not misses, sorted(misses.values())

@@ -55,10 +55,7 @@ def test_arrays_are_read_only():
 def test_missing_columns_are_named():
     with pytest.raises(DataError) as exc:
         parse_csv("vx,vy,Fx,Fy\n1,2,3,4\n", "m.csv")
-    assert (
-        str(exc.value)
-        == "m.csv: missing column(s) wz, Mz in the header (found 'vx', 'vy', 'Fx', 'Fy')"
-    )
+    assert str(exc.value) == "m.csv: missing column(s) wz, Mz in the header (found 'vx', 'vy', 'Fx', 'Fy')"
 
 
 def test_non_numeric_cell_names_line_and_column():
@@ -69,9 +66,7 @@ def test_non_numeric_cell_names_line_and_column():
 
 
 def test_empty_and_non_finite_cells():
-    with pytest.raises(
-        DataError, match=r"^m.csv: line 2, column Fy: not a number: 'an empty cell'$"
-    ):
+    with pytest.raises(DataError, match=r"^m.csv: line 2, column Fy: not a number: 'an empty cell'$"):
         parse_csv("vx,vy,wz,Fx,Fy,Mz\n0.1,0,0,-900,,0\n", "m.csv")
     with pytest.raises(DataError, match=r"^m.csv: line 2, column Mz: not a finite number: 'nan'$"):
         parse_csv("vx,vy,wz,Fx,Fy,Mz\n0.1,0,0,-900,1,nan\n", "m.csv")
@@ -82,9 +77,7 @@ def test_short_row_and_bad_roll_and_bad_load():
         parse_csv("vx,vy,wz,Fx,Fy,Mz\n1,2,3,4\n")
     with pytest.raises(DataError, match=r"^line 2, column roll: must be -1, 0 or 1, got 2$"):
         parse_csv("vx,vy,wz,Fx,Fy,Mz,roll\n1,0,0,-1,0,0,2\n")
-    with pytest.raises(
-        DataError, match=r"^line 2, column N: load must be positive \(N\), got -5.0$"
-    ):
+    with pytest.raises(DataError, match=r"^line 2, column N: load must be positive \(N\), got -5.0$"):
         parse_csv("vx,vy,wz,Fx,Fy,Mz,N\n1,0,0,-1,0,0,-5\n")
 
 
@@ -123,9 +116,7 @@ def test_plausible_data_pass():
 
 def test_too_few_rows():
     with pytest.raises(DataError) as exc:
-        check_plausible(
-            _data(n=MIN_ROWS - 1), friction=0.3, load=3000.0, radius=0.1, has_rolling=False
-        )
+        check_plausible(_data(n=MIN_ROWS - 1), friction=0.3, load=3000.0, radius=0.1, has_rolling=False)
     assert str(exc.value) == (
         f"m.csv: {MIN_ROWS - 1} test points are too few: the candidate models and the 5-fold check "
         f"need at least {MIN_ROWS}"
@@ -137,38 +128,28 @@ def test_all_zero_channel():
         DataError,
         match=r"^m.csv: column Mz is zero in every row: a dead channel cannot be diagnosed$",
     ):
-        check_plausible(
-            _data(Mz=np.zeros(40)), friction=0.3, load=3000.0, radius=0.1, has_rolling=False
-        )
+        check_plausible(_data(Mz=np.zeros(40)), friction=0.3, load=3000.0, radius=0.1, has_rolling=False)
 
 
 def test_roll_without_rolling_map_is_an_error():
     roll = np.zeros(40, int)
     roll[:3] = 1
-    with pytest.raises(
-        DataError, match=r"column roll: 3 rows have roll = ±1 but no rolling map was given"
-    ):
+    with pytest.raises(DataError, match=r"column roll: 3 rows have roll = ±1 but no rolling map was given"):
         check_plausible(_data(roll=roll), friction=0.3, load=3000.0, radius=0.1, has_rolling=False)
     check_plausible(_data(roll=roll), friction=0.3, load=3000.0, radius=0.1, has_rolling=True)
 
 
 def test_forces_far_above_fN_name_the_column():
     # kN-sized numbers in N columns: |F| = 1000 x 900 N = 1000 x f N
-    with pytest.raises(
-        DataError, match=r"^m.csv: line \d+, column Fx: \|Fx\| is .* x f·N .*wrong units\?$"
-    ):
-        check_plausible(
-            _data(scale=1000.0), friction=0.3, load=3000.0, radius=0.1, has_rolling=False
-        )
+    with pytest.raises(DataError, match=r"^m.csv: line \d+, column Fx: \|Fx\| is .* x f·N .*wrong units\?$"):
+        check_plausible(_data(scale=1000.0), friction=0.3, load=3000.0, radius=0.1, has_rolling=False)
     big_mz = _data(Mz=np.full(40, 5000.0))
     with pytest.raises(DataError, match=r"column Mz: \|Mz\| is .* x f·N·R"):
         check_plausible(big_mz, friction=0.3, load=3000.0, radius=0.1, has_rolling=False)
 
 
 def test_forces_far_below_fN_warn():
-    with pytest.warns(
-        UnitsWarning, match=r"columns Fx, Fy: the largest sliding force is 0.001 x f·N"
-    ):
+    with pytest.warns(UnitsWarning, match=r"columns Fx, Fy: the largest sliding force is 0.001 x f·N"):
         check_plausible(_data(scale=1e-3), friction=0.3, load=3000.0, radius=0.1, has_rolling=False)
 
 

@@ -34,9 +34,7 @@ C = Parameter("c", "1", 0.0, -5.0, 5.0, 0.1, 0.0)
 def toy_candidates(second=None) -> dict[str, Candidate]:
     cands = {
         "none": Candidate("none", (), lambda p: BASE, (), "toy"),
-        "friction_level": Candidate(
-            "friction_level", (F,), lambda p: p[0] * BASE, ("none",), "toy"
-        ),
+        "friction_level": Candidate("friction_level", (F,), lambda p: p[0] * BASE, ("none",), "toy"),
         "ext": Candidate(
             "ext",
             (F, C),
@@ -134,9 +132,7 @@ def test_friction_level_alone():
 
 
 def test_indistinguishable_siblings_are_listed():
-    twin = PATTERN + 1e-4 * np.column_stack(
-        [X, X, X]
-    )  # the data cannot tell the two patterns apart
+    twin = PATTERN + 1e-4 * np.column_stack([X, X, X])  # the data cannot tell the two patterns apart
     cands = toy_candidates(second=twin)
     scores = choose(data(7, c=0.08), cands)
     assert scores[0].name in ("ext", "ext2")

@@ -148,9 +148,7 @@ class Predictor:
         for r, idx in self.groups.items():
             top = max(
                 top,
-                float(np.max(self.lam[idx]))
-                * float(np.max(self.sim.quads[r].sigma))
-                / self.sigma_ref,
+                float(np.max(self.lam[idx])) * float(np.max(self.sim.quads[r].sigma)) / self.sigma_ref,
             )
         return top
 
@@ -214,9 +212,7 @@ def _geometric(
             hp, hm = gp[j] - g0[j], g0[j] - gm[j]
             bp, bm = basis(tuple(gp)), basis(tuple(gm))
             # second-order divided differences on the (possibly uneven) stencil
-            grad[j] = (
-                (bp - bm) / (hp + hm) if hp and hm else ((bp - b0) / hp if hp else (b0 - bm) / hm)
-            )
+            grad[j] = (bp - bm) / (hp + hm) if hp and hm else ((bp - b0) / hp if hp else (b0 - bm) / hm)
             if hp and hm:
                 hess[j, j] = 2.0 * (hp * bm + hm * bp - (hp + hm) * b0) / (hp * hm * (hp + hm))
             plus.append((gp, hp))
@@ -254,21 +250,15 @@ def build_candidates(pred: Predictor) -> dict[str, Candidate]:
     m_a = base[:, 2] - m_b
     scale = pred.scale
 
-    f_par = Parameter(
-        "f", "1", f0, 0.01 * f0, 10.0 * f0, f0, None, "friction coefficient (along x)"
-    )
+    f_par = Parameter("f", "1", f0, 0.01 * f0, 10.0 * f0, f0, None, "friction coefficient (along x)")
 
     ratio = pred.max_pressure_ratio()
     cp_low = -1.0 / (ratio - 1.0) if ratio > 1.0 else -10.0
     cv_low = -1.0 / pred.max_slip_speed() if pred.max_slip_speed() > 0 else -10.0
 
     coulomb = FrictionLaw(f=1.0)
-    stretch = _GeometryCache(
-        lambda g: pred.resultants(coulomb, transform=lambda q: q.stretched(g[0]))
-    )
-    shift = _GeometryCache(
-        lambda g: pred.resultants(coulomb, transform=lambda q: q.shifted(g[0], g[1]))
-    )
+    stretch = _GeometryCache(lambda g: pred.resultants(coulomb, transform=lambda q: q.stretched(g[0])))
+    shift = _GeometryCache(lambda g: pred.resultants(coulomb, transform=lambda q: q.shifted(g[0], g[1])))
 
     def aniso(p):
         f, a = p
@@ -303,9 +293,7 @@ def build_candidates(pred: Predictor) -> dict[str, Candidate]:
             "speed_dependent_friction",
             (
                 f_par,
-                Parameter(
-                    "c_v", "s/m", 0.0, 0.999 * cv_low, 10.0, 0.05, 0.0, "μ = f (1 + c_v |w|)"
-                ),
+                Parameter("c_v", "s/m", 0.0, 0.999 * cv_low, 10.0, 0.05, 0.0, "μ = f (1 + c_v |w|)"),
             ),
             lambda p: p[0] * (base + p[1] * speed),
             ("none", "friction_level"),
@@ -315,9 +303,7 @@ def build_candidates(pred: Predictor) -> dict[str, Candidate]:
             "elliptic_patch",
             (
                 f_par,
-                Parameter(
-                    "s", "1", 1.0, 0.5, 2.0, 0.05, 1.0, "stretch x → s·x, y → y/s (aspect s²)"
-                ),
+                Parameter("s", "1", 1.0, 0.5, 2.0, 0.05, 1.0, "stretch x → s·x, y → y/s (aspect s²)"),
             ),
             stretch,
             ("none", "friction_level"),

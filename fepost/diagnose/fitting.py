@@ -100,9 +100,7 @@ class Fit:
         return {
             "parameters": {
                 n: {"value": float(v), "ci95": [float(lo), float(hi)], "stderr": float(s)}
-                for n, v, (lo, hi), s in zip(
-                    self.names, self.values, self.ci95, self.stderr, strict=True
-                )
+                for n, v, (lo, hi), s in zip(self.names, self.values, self.ci95, self.stderr, strict=True)
             },
             "sigma": [float(s) for s in self.sigma],
             "log_likelihood": self.log_likelihood,
@@ -151,13 +149,9 @@ def fit(
     """
     if cand.expand is None:
         return _fit_direct(cand, Y, rows, start=start, sigma=sigma, intervals=intervals)
-    values = (
-        np.array([p.start for p in cand.parameters]) if start is None else np.asarray(start, float)
-    )
+    values = np.array([p.start for p in cand.parameters]) if start is None else np.asarray(start, float)
     lin = cand.expand(values)
-    current = _fit_direct(
-        lin, Y, rows, start=values, sigma=sigma, intervals=False, evaluate_only=True
-    )
+    current = _fit_direct(lin, Y, rows, start=values, sigma=sigma, intervals=False, evaluate_only=True)
     for _ in range(GN_MAX):
         trial = _fit_direct(lin, Y, rows, start=values, sigma=current.sigma, intervals=True)
         step = trial.values - values
@@ -225,9 +219,7 @@ def _fit_direct(
     scale = np.array([p.scale for p in cand.parameters])
     lower = np.array([p.lower for p in cand.parameters]) / scale
     upper = np.array([p.upper for p in cand.parameters]) / scale
-    u = (
-        np.array([p.start for p in cand.parameters]) if start is None else np.asarray(start, float)
-    ) / scale
+    u = (np.array([p.start for p in cand.parameters]) if start is None else np.asarray(start, float)) / scale
     width = np.where(np.isfinite(upper - lower), upper - lower, 0.0)
     u = np.clip(u, lower + 1e-9 * width, upper - 1e-9 * width)
 
@@ -288,6 +280,4 @@ def _fit_direct(
         for nm, uu, lo, hi, tt in zip(names, u, lower, upper, tol, strict=True)
         if uu - lo < tt or hi - uu < tt
     )
-    return Fit(
-        cand.name, names, values, ci, stderr, sig, rss, n, log_likelihood(rss, n), at_bound, cand
-    )
+    return Fit(cand.name, names, values, ci, stderr, sig, rss, n, log_likelihood(rss, n), at_bound, cand)

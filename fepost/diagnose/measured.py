@@ -86,9 +86,7 @@ class MeasuredData:
         if roll.size != n:
             raise DataError(f"roll must have {n} entries like vx, got {roll.size}")
         if not np.all(np.isin(roll, (-1, 0, 1))):
-            raise DataError(
-                f"roll must be -1, 0 or +1, got {sorted(set(roll.tolist()) - {-1, 0, 1})}"
-            )
+            raise DataError(f"roll must be -1, 0 or +1, got {sorted(set(roll.tolist()) - {-1, 0, 1})}")
         object.__setattr__(self, "roll", frozen(roll, dtype=int))
         lines = np.arange(1, n + 1) if self.lines is None else np.ravel(self.lines)
         object.__setattr__(self, "lines", frozen(lines, dtype=int))
@@ -115,10 +113,7 @@ class MeasuredData:
         return np.full(len(self), float(default)) if self.N is None else np.array(self.N)
 
     def to_dict(self) -> dict:
-        d = {
-            name: getattr(self, name).tolist()
-            for name in ("vx", "vy", "wz", "Fx", "Fy", "Mz", "roll")
-        }
+        d = {name: getattr(self, name).tolist() for name in ("vx", "vy", "wz", "Fx", "Fy", "Mz", "roll")}
         d["N"] = None if self.N is None else self.N.tolist()
         d["source"] = self.source
         return d
@@ -177,9 +172,7 @@ def parse_csv(text: str, source: str = "") -> MeasuredData:
         bad = ~np.isin(raw, (-1.0, 0.0, 1.0))
         if np.any(bad):
             i = int(np.flatnonzero(bad)[0])
-            raise DataError(
-                f"{src}line {lines[i]}, column roll: must be -1, 0 or 1, got {raw[i]:g}"
-            )
+            raise DataError(f"{src}line {lines[i]}, column roll: must be -1, 0 or 1, got {raw[i]:g}")
         roll = raw.astype(int)
     return MeasuredData(
         vx=values["vx"], vy=values["vy"], wz=values["wz"],
@@ -196,9 +189,7 @@ def read_measured(path) -> MeasuredData:
     except FileNotFoundError:
         raise DataError(f"{path}: no such file") from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise DataError(
-            f"{path}: cannot read the measured data ({exc.__class__.__name__})"
-        ) from None
+        raise DataError(f"{path}: cannot read the measured data ({exc.__class__.__name__})") from None
     return parse_csv(text, source=str(path))
 
 
@@ -214,8 +205,7 @@ def write_csv(data: MeasuredData, path, comment: str = "") -> None:
     for i in range(len(data)):
         out.write(
             ",".join(
-                f"{a[i]:.10g}" if c != "roll" else str(int(a[i]))
-                for c, a in zip(cols, arrays, strict=True)
+                f"{a[i]:.10g}" if c != "roll" else str(int(a[i])) for c, a in zip(cols, arrays, strict=True)
             )
             + "\n"
         )
@@ -243,9 +233,7 @@ def check_plausible(
         )
     for c in CHANNELS:
         if np.all(getattr(data, c) == 0.0):
-            raise DataError(
-                f"{src}column {c} is zero in every row: a dead channel cannot be diagnosed"
-            )
+            raise DataError(f"{src}column {c} is zero in every row: a dead channel cannot be diagnosed")
     rolling_rows = int(np.count_nonzero(data.roll != 0))
     if rolling_rows and not has_rolling:
         raise DataError(

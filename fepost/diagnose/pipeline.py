@@ -94,9 +94,7 @@ def diagnose(
     Raises :class:`~fepost.errors.DataError` on unusable data.
     """
     t0 = time.perf_counter()
-    sim = load_simulation(
-        simulation, rolling, friction=friction, nr=nr, nphi=nphi, **(analyse_kwargs or {})
-    )
+    sim = load_simulation(simulation, rolling, friction=friction, nr=nr, nphi=nphi, **(analyse_kwargs or {}))
     data = measured if isinstance(measured, MeasuredData) else read_measured(measured)
     check_plausible(
         data,
@@ -140,9 +138,7 @@ def diagnose(
         "heldout": f"{n_folds}-fold cross-validation (folds shuffled with seed {seed})",
         "delta": "score(cause) - score(none); negative favours the cause",
     }
-    variables = kinematic_variables(
-        data.vx, data.vy, data.wz, sim.radius, data.loads(sim.load), data.roll
-    )
+    variables = kinematic_variables(data.vx, data.vy, data.wz, sim.radius, data.loads(sim.load), data.roll)
     residuals = {
         "before": residual_structure((meas - before) / scale, variables),
         "after": residual_structure((meas - heldout) / scale, variables),

@@ -70,9 +70,7 @@ def folds(n: int, k: int = FOLDS, seed: int = 0) -> list[np.ndarray]:
     return [np.sort(part) for part in np.array_split(order, k)]
 
 
-def crossvalidate(
-    cand: Candidate, Y: np.ndarray, parts: list[np.ndarray], full: Fit
-) -> CrossValidation:
+def crossvalidate(cand: Candidate, Y: np.ndarray, parts: list[np.ndarray], full: Fit) -> CrossValidation:
     """Fit ``cand`` without each part (warm-started at ``full``) and predict the part.
 
     A geometric candidate is refitted in its second-order expansion about the
@@ -223,13 +221,9 @@ def design_notes(vx, vy, wz, radius: float, loads=None) -> list[str]:
             "only through the pressure map's shape (test at several loads to separate them)"
         )
     if not np.any((u > 0) & (v == 0)):
-        notes.append(
-            "no pure-spin points: the spin torque level M0 is seen only through combined points"
-        )
+        notes.append("no pure-spin points: the spin torque level M0 is seen only through combined points")
     if not np.any((u == 0) & (v > 0)):
-        notes.append(
-            "no pure-sliding points: friction_level and anisotropic_friction are weakly separated"
-        )
+        notes.append("no pure-sliding points: friction_level and anisotropic_friction are weakly separated")
     dirs = np.unique(key_dir[v > 0])
     if dirs.size < 3:
         notes.append(
@@ -237,7 +231,5 @@ def design_notes(vx, vy, wz, radius: float, loads=None) -> list[str]:
             "are poorly separated"
         )
     if not (np.any(wz > 0) and np.any(wz < 0)):
-        notes.append(
-            "one spin sign only: sensor offsets in Mz and Fy are confounded with asymmetric effects"
-        )
+        notes.append("one spin sign only: sensor offsets in Mz and Fy are confounded with asymmetric effects")
     return notes

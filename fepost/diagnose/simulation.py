@@ -50,9 +50,7 @@ def regrid(pmap: PolarMap, grid: PolarGrid, *, mirror: bool = False) -> PolarMap
     sign = -1.0 if mirror else 1.0
     sigma = pmap.interpolate(sign * x, y)
     cx, cy = pmap.centre
-    return PolarMap(
-        grid=grid, radius=pmap.radius, sigma=sigma, centre=(sign * cx, cy), source=pmap.source
-    )
+    return PolarMap(grid=grid, radius=pmap.radius, sigma=sigma, centre=(sign * cx, cy), source=pmap.source)
 
 
 @dataclass(frozen=True)
