@@ -104,7 +104,9 @@ def _data(n=40, scale=1.0, **over):
     ang = rng.uniform(0, 2 * np.pi, n)
     fields = {
         "vx": np.cos(ang), "vy": np.sin(ang), "wz": rng.choice([-5.0, 0.0, 5.0], n),
-        "Fx": -900 * np.cos(ang) * scale, "Fy": -900 * np.sin(ang) * scale, "Mz": rng.normal(0, 20, n) * scale,
+        "Fx": -900 * np.cos(ang) * scale,
+        "Fy": -900 * np.sin(ang) * scale,
+        "Mz": rng.normal(0, 20, n) * scale,
     }  # fmt: skip
     fields.update(over)
     return MeasuredData(**fields, source="m.csv")

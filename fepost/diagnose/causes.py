@@ -173,7 +173,8 @@ class _GeometryCache:
         return value
 
 
-#: Central-difference step of the geometric derivatives (first, second and mixed), in units of each parameter's
+#: Central-difference step of the geometric derivatives (first, second and mixed),
+#: in units of each parameter's
 #: scale (0.2 × 0.05 = 1 % stretch; 0.2 × 0.05R = 0.01R shift). Deliberately not
 #: tiny: the exact resultants jump by ~1e-4 f·N when an instantaneous centre of
 #: rotation crosses the patch boundary (the interpolated pressure is not zero

@@ -229,7 +229,8 @@ def check_plausible(
     n = len(data)
     if n < MIN_ROWS:
         raise DataError(
-            f"{src}{n} test points are too few: the candidate models and the 5-fold check need at least {MIN_ROWS}"
+            f"{src}{n} test points are too few: the candidate models and the 5-fold check "
+            f"need at least {MIN_ROWS}"
         )
     for c in CHANNELS:
         if np.all(getattr(data, c) == 0.0):

@@ -130,7 +130,8 @@ class Diagnosis:
             parts = []
             for ch, st in self.residuals[key].items():
                 parts.append(
-                    f"{ch} {st['verdict']} (rmse {st['rmse']:.3g}, worst: {st['strongest']}, p={st['p_adjusted']:.2g})"
+                    f"{ch} {st['verdict']} (rmse {st['rmse']:.3g}, worst: {st['strongest']}, "
+                    f"p={st['p_adjusted']:.2g})"
                 )
             lines.append(f"residuals of the {title}: " + "; ".join(parts))
         cf = self.closed_form
@@ -142,7 +143,8 @@ class Diagnosis:
         for s in self.candidates:
             mark = "*" if s.admissible else " "
             lines.append(
-                f" {mark} {s.name:<29} BIC {s.fit.bic:11.1f}  dBIC {s.delta_bic:9.1f}  cv-rmse {s.cv.rmse:.4g}"
+                f" {mark} {s.name:<29} BIC {s.fit.bic:11.1f}  dBIC {s.delta_bic:9.1f}  "
+                f"cv-rmse {s.cv.rmse:.4g}"
             )
         return "\n".join(lines) + "\n"
 

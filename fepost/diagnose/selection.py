@@ -213,7 +213,8 @@ def design_notes(vx, vy, wz, radius: float, loads=None) -> list[str]:
     if not spread:
         notes.append(
             "no test points share a speed ratio and direction at absolute speeds 1.5x apart: "
-            "speed_dependent_friction cannot be told from shape effects (pressure_dependent_friction, elliptic_patch)"
+            "speed_dependent_friction cannot be told from shape effects "
+            "(pressure_dependent_friction, elliptic_patch)"
         )
     if loads is None or np.unique(np.round(np.asarray(loads, float), 6)).size < 2:
         notes.append(
