@@ -9,12 +9,14 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .coefficients import Coefficients, coefficients_from_moments
+from .errors import PatchWarning
 from .field import ContactField
 from .moments import Moments, moments
 from .patch import DEFAULT_THRESHOLD, Patch, build_patch
@@ -70,6 +72,21 @@ class Analysis:
         return d
 
 
+#: Largest accepted |N/N_fe − 1| before a warning: the polar grid must carry the FE load.
+RESAMPLE_TOL = 0.01
+
+
+def _check_resampling(patch: Patch, mom: Moments) -> None:
+    err = mom.N / patch.N_fe - 1.0
+    if abs(err) > RESAMPLE_TOL:
+        warnings.warn(
+            f"{patch.source}: the polar grid carries {err:+.1%} of the FE load (N = {mom.N:.6g} N, "
+            f"N_fe = {patch.N_fe:.6g} N); refine it (--nr/--nphi) or check the mesh for holes",
+            PatchWarning,
+            stacklevel=3,
+        )
+
+
 def _as_field(src, field, step, displacement) -> ContactField:
     if isinstance(src, ContactField):
         return src
@@ -99,6 +116,7 @@ def analyse(
     sp = build_patch(sf, threshold=threshold, rolling_axis=rolling_axis)
     sm = resample(sp, grid, radius=sp.r_max)
     smo = moments(sm)
+    _check_resampling(sp, smo)
     rf = rp = rm = rmo = None
     if rolling is not None:
         rf = _as_field(rolling, field, step, displacement)
@@ -106,5 +124,6 @@ def analyse(
         r_roll = float(np.max(np.hypot(rp.xy[:, 0], rp.xy[:, 1])))
         rm = resample(rp, grid, radius=max(sp.r_max, r_roll))
         rmo = moments(rm)
+        _check_resampling(rp, rmo)
     coef = coefficients_from_moments(smo, rmo, friction=friction)
     return Analysis(sf, sp, sm, smo, coef, rf, rp, rm, rmo)

@@ -58,6 +58,7 @@ class FaceSums:
     Sxx: float  # ∬ x² dA
     Syy: float
     Sxy: float
+    max_edge: float  # longest face edge, m
     area: np.ndarray
     load: np.ndarray
 
@@ -109,8 +110,13 @@ def face_sums(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str
     def work(sl: slice) -> np.ndarray:
         t = tri[sl]
         x, y = X[t], Y[t]
-        a = 0.5 * np.abs(
-            (x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (y[:, 1] - y[:, 0]) * (x[:, 2] - x[:, 0])
+        dx1, dy1 = x[:, 1] - x[:, 0], y[:, 1] - y[:, 0]
+        dx2, dy2 = x[:, 2] - x[:, 0], y[:, 2] - y[:, 0]
+        a = 0.5 * np.abs(dx1 * dy2 - dy1 * dx2)
+        e2 = max(
+            float(np.max(dx1 * dx1 + dy1 * dy1)),
+            float(np.max(dx2 * dx2 + dy2 * dy2)),
+            float(np.max((dx2 - dx1) ** 2 + (dy2 - dy1) ** 2)),
         )
         sx, sy = _rowsum(x), _rowsum(y)
         if location == "point":
@@ -138,11 +144,15 @@ def face_sums(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str
                 w @ (_rowsum(x * x) + sx * sx),
                 w @ (_rowsum(y * y) + sy * sy),
                 w @ (_rowsum(x * y) + sx * sy),
+                e2,
             ]
         )
 
-    tot = np.sum(_map(work, m), axis=0)
-    return FaceSums(*(float(v) for v in tot), area=area, load=load)
+    parts = np.array(_map(work, m))
+    tot = parts[:, :-1].sum(axis=0)
+    return FaceSums(
+        *(float(v) for v in tot), max_edge=float(np.sqrt(parts[:, -1].max())), area=area, load=load
+    )
 
 
 def load_outside(

@@ -32,13 +32,11 @@ Repaired with a warning: NaN away from the patch and small negative values
 from __future__ import annotations
 
 import warnings
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
+from scipy import ndimage
 
 from ._arrays import frozen
 from .errors import ArgumentError, PatchError, PatchWarning, PressureError, PressureWarning
@@ -51,6 +49,8 @@ RMAX_TOL = 1.15
 PLANARITY_TOL = 0.02
 NEGATIVE_TOL = 0.01
 FRAGMENT_SHARE = 0.01
+GAP_FRACTION = 0.05
+RASTER_MAX = 2048
 
 
 @dataclass(frozen=True)
@@ -108,6 +108,7 @@ class Patch:
     circular: bool
     reaction_z: float | None = None
     dropped_fragments: int = 0
+    max_edge: float = float("nan")  # longest edge of a loaded face (m): the mesh size
     notes: tuple[str, ...] = field(default=())
 
     def __post_init__(self) -> None:
@@ -218,21 +219,28 @@ def _loaded_faces(fld: ContactField, v: np.ndarray, thr: float) -> np.ndarray:
     return v > thr
 
 
-def _components(tri: np.ndarray, n_points: int) -> tuple[int, np.ndarray]:
-    """Connected components of faces sharing a node; returns (count, label per face)."""
-    # two edges per triangle connect its three nodes
-    idx = np.int32 if n_points < 2**31 - 1 else np.int64
-    rows = np.concatenate([tri[:, 0], tri[:, 1]]).astype(idx)
-    cols = np.concatenate([tri[:, 1], tri[:, 2]]).astype(idx)
-    graph = coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n_points, n_points))
-    n, node_labels = connected_components(graph, directed=False)
-    face_labels = node_labels[tri[:, 0]]
-    present = np.zeros(n, bool)
-    present[face_labels] = True
-    if present.all():
-        return n, face_labels
-    compact = np.cumsum(present) - 1
-    return int(present.sum()), compact[face_labels]
+def _components(xy: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
+    """Separate loaded regions: (count, label per face).
+
+    Regions closer than a gap of about :data:`GAP_FRACTION` × √area (tread
+    grooves, sparse contact at the edge) belong to one patch; regions farther
+    apart (dual wheels) are separate. The nodes are binned on a raster of cell
+    h = max(GAP_FRACTION·√area, longest loaded edge), so faces that share a node
+    always fall in touching cells; one dilation closes gaps narrower than ~h.
+    """
+    h = max(GAP_FRACTION * np.sqrt(sums.A), sums.max_edge)
+    lo = xy.min(axis=0)
+    n = np.floor((xy.max(axis=0) - lo) / h).astype(int) + 3
+    if n.max() > RASTER_MAX:  # a very sparse region: coarsen the raster
+        h *= n.max() / RASTER_MAX
+        n = np.floor((xy.max(axis=0) - lo) / h).astype(int) + 3
+    ij = np.floor((xy - lo) / h).astype(int) + 1
+    occupied = np.zeros(tuple(n), bool)
+    occupied[ij[:, 0], ij[:, 1]] = True
+    occupied = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), bool))
+    labels, count = ndimage.label(occupied, structure=np.ones((3, 3), bool))
+    face = labels[ij[tri[:, 0], 0], ij[tri[:, 0], 1]] - 1
+    return int(count), face
 
 
 def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -335,11 +343,8 @@ def build_patch(
         tri = fld.triangles[loaded]
         fvals = v[loaded] if fld.location == "cell" else v
 
-    # connectivity (scipy) runs beside the geometry pass (numpy, GIL released)
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        job = pool.submit(_components, tri, fld.n_points)
-        geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
-        ncomp, labels = job.result()
+    geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
+    ncomp, labels = _components(geo.local[:, :2], geo.triangles, geo.sums)
     dropped = 0
     if ncomp > 1:
         share = np.bincount(labels, weights=geo.sums.load, minlength=ncomp) / geo.sums.N
@@ -431,5 +436,6 @@ def build_patch(
         circular=circular,
         reaction_z=fld.reaction_z,
         dropped_fragments=dropped,
+        max_edge=sums.max_edge,
         notes=tuple(notes),
     )

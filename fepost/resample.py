@@ -2,20 +2,17 @@
 
 The FE field is interpolated with its own elements: linear on each triangle
 for nodal data, constant per face for face data (VTK's probe filter through
-pyvista's ``sample``). Grid nodes that fall outside every face get zero
-pressure; the valid-point mask is checked and kept on the map, and a
-:class:`~fepost.errors.PatchWarning` is issued when invalid nodes lie inside
-the loaded region (a hole in the mesh).
+pyvista's ``sample``). Grid nodes that fall on no loaded face (outside the
+patch, in a groove, in a hole of the mesh) get zero pressure; the valid-point
+mask is kept on the map. Whether the resampled map still carries the FE load
+is checked by :func:`fepost.analysis.analyse` (N against N_fe).
 """
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pyvista as pv
 
-from .errors import PatchWarning
 from .patch import Patch
 from .polar import PolarGrid, PolarMap
 
@@ -52,12 +49,4 @@ def resample(
     sigma = np.asarray(out.point_data["p"], float).reshape(grid.shape)
     valid = np.asarray(out.point_data["vtkValidPointMask"], bool).reshape(grid.shape)
     sigma = np.where(valid, sigma, 0.0)
-    inner = np.hypot(x, y) < 0.5 * min(patch.ellipse_axes)
-    if np.any(~valid & inner):
-        warnings.warn(
-            f"{patch.source}: {int(np.sum(~valid & inner))} polar grid nodes inside the patch "
-            "fall on no FE face (a hole in the mesh?); they count as zero pressure",
-            PatchWarning,
-            stacklevel=2,
-        )
     return PolarMap(grid=grid, radius=radius, sigma=sigma, centre=(cx, cy), valid=valid, source=patch.source)
