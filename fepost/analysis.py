@@ -58,7 +58,7 @@ class Analysis:
             "field": self.static_field.field,
             "step": self.static_field.step,
         }
-        if self.rolling_patch is not None:
+        if self.rolling_patch is not None and self.rolling_field is not None and self.rolling_map is not None:
             rf = self.rolling_field
             d["rolling"] = {
                 "source": rf.source,

@@ -150,9 +150,9 @@ def face_sums(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str
 
     parts = np.array(_map(work, m))
     tot = parts[:, :-1].sum(axis=0)
-    return FaceSums(
-        *(float(v) for v in tot), max_edge=float(np.sqrt(parts[:, -1].max())), area=area, load=load
-    )
+    N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy = (float(v) for v in tot)
+    max_edge = float(np.sqrt(parts[:, -1].max()))
+    return FaceSums(N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy, max_edge, area, load)
 
 
 def load_outside(

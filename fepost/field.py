@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -44,7 +44,7 @@ class ContactField:
     step: int | None = None
     time: float | None = None
     reaction_z: float | None = None
-    arrays: tuple[str, ...] = field(default=())
+    arrays: tuple[str, ...] = ()
     sidecar: dict | None = None
 
     def __post_init__(self) -> None:

@@ -32,7 +32,7 @@ Repaired with a warning: NaN away from the patch and small negative values
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -109,7 +109,7 @@ class Patch:
     reaction_z: float | None = None
     dropped_fragments: int = 0
     max_edge: float = float("nan")  # longest edge of a loaded face (m): the mesh size
-    notes: tuple[str, ...] = field(default=())
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("xy", "height", "values"):

@@ -105,7 +105,9 @@ def write_map(
     p2, cells = disc_mesh(n_rings, kind, seed)
     s = np.sqrt(aspect)
     p2 = radius * p2 * np.array([s, 1.0 / s]) + np.asarray(shift, float)
-    sigma = pressure_function(profile, radius, peak, k_x=k_x, centre=tuple(shift), aspect=aspect)
+    sigma = pressure_function(
+        profile, radius, peak, k_x=k_x, centre=(float(shift[0]), float(shift[1])), aspect=aspect
+    )
     rot = rotation(normal, x_axis)
     pts = np.column_stack([p2, np.zeros(len(p2))]) @ rot + np.asarray(origin, float)
     if location == "point":

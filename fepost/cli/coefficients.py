@@ -55,7 +55,7 @@ def format_analysis(a: Analysis) -> str:
         ("b = m/4", f"{c.b:.6g}"),
         ("b1 = M0/2", f"{c.b1:.6g} N m"),
     ]
-    if c.k_x is not None:
+    if c.k_x is not None and a.rolling_field is not None:
         rows += [
             ("rolling map", f"{a.rolling_field.source}"),
             ("x_c (rolling CoP shift)", f"{c.x_c:.6g} m"),
