@@ -22,22 +22,13 @@ from fepost.analytic import pressure_function
 from fepost.diagnose import diagnose
 from fepost.diagnose.causes import Predictor, build_candidates
 from fepost.diagnose.simulation import simulation_from_maps
-from fepost.diagnose.synthetic import rig_programme, synthesize
+from fepost.diagnose.synthetic import VALIDATION_SET_A, rig_programme, synthesize
 from fepost.friction.exact import friction_resultants
 from fepost.friction.law import FrictionLaw
 from fepost.friction.quadrature import PressureQuadrature, edge_grid
 from fepost.polar import PolarGrid, PolarMap
 
-CASES = [
-    ("none", {}),
-    ("friction_level", {"f": 0.27}),
-    ("pressure_dependent_friction", {"c_p": 0.25}),
-    ("speed_dependent_friction", {"c_v": 0.08}),
-    ("elliptic_patch", {"s": 0.88}),
-    ("anisotropic_friction", {"alpha": 1.12}),
-    ("pressure_shift", {"dx": -0.003, "dy": 0.0025}),
-    ("sensor_offset", {"offset_Fx": -120.0, "offset_Fy": 90.0, "offset_Mz": -6.0}),
-]
+CASES = (("none", {}), *VALIDATION_SET_A)
 
 
 def grid_accuracy() -> None:

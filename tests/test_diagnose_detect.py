@@ -38,38 +38,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fepost.analytic import pressure_function
 from fepost.diagnose import diagnose
-from fepost.diagnose.synthetic import synthesize
-from fepost.polar import PolarGrid, PolarMap
+from fepost.diagnose.synthetic import VALIDATION_SET_A, VALIDATION_SET_B, analytic_map, synthesize
 
 pytestmark = pytest.mark.slow
 
 MESHES = Path(__file__).resolve().parents[1] / "meshes"
 
-SET_A = [
-    ("friction_level", {"f": 0.27}),
-    ("pressure_dependent_friction", {"c_p": 0.25}),
-    ("speed_dependent_friction", {"c_v": 0.08}),
-    ("elliptic_patch", {"s": 0.88}),
-    ("anisotropic_friction", {"alpha": 1.12}),
-    ("pressure_shift", {"dx": -0.003, "dy": 0.0025}),
-    ("sensor_offset", {"offset_Fx": -120.0, "offset_Fy": 90.0, "offset_Mz": -6.0}),
-]
-SET_B = [
-    ("friction_level", {"f": 0.34}),
-    ("pressure_dependent_friction", {"c_p": -0.35}),
-    ("speed_dependent_friction", {"c_v": -0.15}),
-    ("elliptic_patch", {"s": 1.1}),
-    ("anisotropic_friction", {"alpha": 0.9}),
-    ("pressure_shift", {"dx": 0.0025, "dy": 0.0035}),
-    ("sensor_offset", {"offset_Fx": 80.0, "offset_Fy": 60.0, "offset_Mz": -4.0}),
-]
-
-
-def _map(profile, radius, peak, k_x=0.0):
-    fn = pressure_function(profile, radius, peak=peak, k_x=k_x)
-    return PolarMap.from_function(fn, radius, PolarGrid.make(), source=profile)
+SET_A = VALIDATION_SET_A
+SET_B = VALIDATION_SET_B
+_map = analytic_map
 
 
 #: Parameters whose truth lies outside the 95 % interval at the committed seed

@@ -24,11 +24,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .._arrays import frozen
+from ..analytic import pressure_function
 from ..errors import ArgumentError
 from ..friction.exact import friction_resultants
 from ..friction.law import FrictionLaw
 from ..friction.quadrature import PressureQuadrature, edge_grid
-from ..polar import PolarMap
+from ..polar import PolarGrid, PolarMap
 from .causes import CAUSES
 from .measured import MeasuredData
 from .simulation import regrid
@@ -265,3 +266,33 @@ def synthesize(
     truth = {"f": f, **{k: float(v) for k, v in params.items() if k != "f"}}
     meta = {"N": N_sim, "R": R, "n": int(kin.vx.size), "seed": seed, "noise": noise}
     return SyntheticData(data, effect, truth, clean, sd, friction, meta)
+
+
+#: Validation cases (hidden effect, true parameters) shared by the detection
+#: tests and the coverage benchmark. Set A runs on a tire-like map at three
+#: loads, set B on a paraboloid with a rolling map; neither map nor these values
+#: were used to tune the selection rule.
+VALIDATION_SET_A: tuple[tuple[str, dict], ...] = (
+    ("friction_level", {"f": 0.27}),
+    ("pressure_dependent_friction", {"c_p": 0.25}),
+    ("speed_dependent_friction", {"c_v": 0.08}),
+    ("elliptic_patch", {"s": 0.88}),
+    ("anisotropic_friction", {"alpha": 1.12}),
+    ("pressure_shift", {"dx": -0.003, "dy": 0.0025}),
+    ("sensor_offset", {"offset_Fx": -120.0, "offset_Fy": 90.0, "offset_Mz": -6.0}),
+)
+VALIDATION_SET_B: tuple[tuple[str, dict], ...] = (
+    ("friction_level", {"f": 0.34}),
+    ("pressure_dependent_friction", {"c_p": -0.35}),
+    ("speed_dependent_friction", {"c_v": -0.15}),
+    ("elliptic_patch", {"s": 1.1}),
+    ("anisotropic_friction", {"alpha": 0.9}),
+    ("pressure_shift", {"dx": 0.0025, "dy": 0.0035}),
+    ("sensor_offset", {"offset_Fx": 80.0, "offset_Fy": 60.0, "offset_Mz": -4.0}),
+)
+
+
+def analytic_map(profile: str, radius: float, peak: float, k_x: float = 0.0) -> PolarMap:
+    """An analytic pressure map (``fepost.analytic`` profile) on the default polar grid."""
+    fn = pressure_function(profile, radius, peak=peak, k_x=k_x)
+    return PolarMap.from_function(fn, radius, PolarGrid.make(), source=profile)
