@@ -38,7 +38,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy import ndimage
 
-from ._arrays import frozen
+from ._arrays import frozen, sealed
 from .errors import ArgumentError, PatchError, PatchWarning, PressureError, PressureWarning
 from .facesums import FaceSums, face_sums, load_outside, triangle_areas
 from .field import ContactField
@@ -160,7 +160,8 @@ class Patch:
 
 
 def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
-    v = np.array(fld.values, float)
+    """The pressure values checked and, where allowed, repaired (a new array only then)."""
+    v = fld.values
     finite = np.isfinite(v)
     if not finite.any():
         raise PressureError(f"{fld.source}: pressure array {fld.field!r} holds no finite values")
@@ -177,7 +178,6 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
             loaded_nodes[fld.triangles[face_loaded].ravel()] = True
             inside = bad & loaded_nodes
         else:
-            inside = bad  # neighbourhood of cells is not cheap; any NaN face is refused below
             tri_nodes_loaded = np.zeros(fld.n_points, bool)
             tri_nodes_loaded[fld.triangles[finite & (np.where(finite, v, 0) > 0)].ravel()] = True
             inside = bad & np.any(tri_nodes_loaded[fld.triangles], axis=1)
@@ -192,7 +192,7 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
             PressureWarning,
             stacklevel=3,
         )
-        v[bad] = 0.0
+        v = np.where(finite, v, 0.0)
     vmin = float(v.min())
     if vmin < -NEGATIVE_TOL * peak:
         n = int(np.sum(v < -NEGATIVE_TOL * peak))
@@ -209,7 +209,7 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
             stacklevel=3,
         )
         v = np.clip(v, 0.0, None)
-    return v, peak
+    return (v if v is fld.values else sealed(v)), peak
 
 
 def _loaded_faces(fld: ContactField, v: np.ndarray, thr: float) -> np.ndarray:
@@ -372,11 +372,11 @@ def build_patch(
     xy = local[:, :2]
     N = sums.N
     cop = sums.centre_of_pressure
-    height = local[:, 2]
+    height = sealed(np.ascontiguousarray(local[:, 2]))
     if frame is None:
         origin = base.to_global(cop[None, :])[0]  # on the plane: local z = 0
         fr = Frame(origin=origin, axes=base.axes)
-        xy = xy - cop
+        xy = sealed(xy - cop)
         cop_rel = (0.0, 0.0)
         cen = sums.centroid - cop
     else:
