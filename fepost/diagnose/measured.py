@@ -98,7 +98,8 @@ class MeasuredData:
 
     def _where(self, i: int) -> str:
         src = f"{self.source}: " if self.source else ""
-        return f"{src}line {int(self.lines[i])}"
+        line = i + 1 if self.lines is None else int(self.lines[i])
+        return f"{src}line {line}"
 
     def __len__(self) -> int:
         return int(self.vx.size)
@@ -174,10 +175,11 @@ def parse_csv(text: str, source: str = "") -> MeasuredData:
             i = int(np.flatnonzero(bad)[0])
             raise DataError(f"{src}line {lines[i]}, column roll: must be -1, 0 or 1, got {raw[i]:g}")
         roll = raw.astype(int)
+    arr = {k: np.asarray(v, float) for k, v in values.items()}
     return MeasuredData(
-        vx=values["vx"], vy=values["vy"], wz=values["wz"],
-        Fx=values["Fx"], Fy=values["Fy"], Mz=values["Mz"],
-        N=values.get("N"), roll=roll, lines=lines, source=source,
+        vx=arr["vx"], vy=arr["vy"], wz=arr["wz"],
+        Fx=arr["Fx"], Fy=arr["Fy"], Mz=arr["Mz"],
+        N=arr.get("N"), roll=roll, lines=np.asarray(lines, int), source=source,
     )  # fmt: skip
 
 
@@ -246,8 +248,9 @@ def check_plausible(
         ratio = np.abs(getattr(data, c)) / scale
         i = int(np.argmax(ratio))
         if ratio[i] > UNITS_ERROR_RATIO:
+            line = i + 1 if data.lines is None else int(data.lines[i])
             raise DataError(
-                f"{src}line {int(data.lines[i])}, column {c}: |{c}| is {ratio[i]:.3g} x {unit} "
+                f"{src}line {line}, column {c}: |{c}| is {ratio[i]:.3g} x {unit} "
                 f"(f = {friction:g}, N = {loads[i]:.6g} N, R = {radius:.4g} m): wrong units?"
             )
     sliding = np.hypot(data.vx, data.vy) > 0

@@ -73,7 +73,7 @@ def residual_structure(res: np.ndarray, variables: dict[str, np.ndarray]) -> dic
             parts = [p for p in parts if p.size >= 2]
             if len(parts) >= 2:
                 tests[name] = float(stats.f_oneway(*parts).pvalue)
-        worst = min(tests, key=tests.get)
+        worst = min(tests, key=tests.__getitem__)
         p_adj = min(1.0, tests[worst] * len(tests))
         out[ch] = {
             "rmse": float(np.sqrt(np.mean(r**2))),

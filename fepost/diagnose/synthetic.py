@@ -44,7 +44,7 @@ DIRECTIONS = 8
 GEN_NR, GEN_NPHI = 48, 96
 
 #: Parameters of each hidden effect, with the no-effect values.
-EFFECT_PARAMETERS = {
+EFFECT_PARAMETERS: dict[str, dict[str, float | None]] = {
     "none": {},
     "friction_level": {"f": None},
     "pressure_dependent_friction": {"c_p": 0.0},

@@ -67,7 +67,7 @@ class CurveData:
                 raise ArgumentError(f"{self.name}: {name} has {v.size} values, x has {n}")
         if (self.test_x is None) != (self.test_y is None):
             raise ArgumentError(f"{self.name}: give both test_x and test_y or neither")
-        if self.test_x is not None and self.test_x.size != self.test_y.size:
+        if self.test_x is not None and self.test_y is not None and self.test_x.size != self.test_y.size:
             raise ArgumentError(
                 f"{self.name}: test_x has {self.test_x.size} values, test_y {self.test_y.size}"
             )
@@ -172,7 +172,7 @@ def curve_table(curves: Iterable[CurveData]) -> tuple[list[str], list[list]]:
                     [c.name, c.x_name, series, float(x), float(v), c.unit]
                     for x, v in zip(c.x, y, strict=True)
                 ]
-        if c.test_x is not None:
+        if c.test_x is not None and c.test_y is not None:
             rows += [
                 [c.name, c.x_name, "test", float(x), float(v), c.unit]
                 for x, v in zip(c.test_x, c.test_y, strict=True)

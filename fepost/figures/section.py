@@ -66,7 +66,7 @@ class SectionData:
             "static_x": self.static_x.tolist(),
             "static_y": self.static_y.tolist(),
         }
-        if self.rolling_x is not None:
+        if self.rolling_x is not None and self.rolling_y is not None:
             d.update({"rolling_x": self.rolling_x.tolist(), "rolling_y": self.rolling_y.tolist()})
         d.update({"inflation_pressure": self.inflation_pressure, "R_mm": self.R})
         return d

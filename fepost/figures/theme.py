@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import Any
 
 #: Window size of the 3-D renders, pixels (width, height).
 WINDOW_SIZE = (1200, 900)
@@ -30,7 +31,7 @@ TEST_COLOUR = "#555555"
 MPL_FIGSIZE = (7.0, 4.6)
 MPL_DPI = 130
 
-_MPL_RC = {
+_MPL_RC: dict[str, Any] = {
     "figure.figsize": MPL_FIGSIZE,
     "figure.dpi": 100,
     "savefig.dpi": MPL_DPI,
@@ -81,5 +82,5 @@ def mpl_style() -> Iterator[None]:
     """matplotlib rc settings of fepost figures (Agg backend assumed)."""
     import matplotlib as mpl
 
-    with mpl.rc_context(_MPL_RC):
+    with mpl.rc_context(_MPL_RC):  # type: ignore[arg-type]  # matplotlib types keys as Literal
         yield
