@@ -99,10 +99,14 @@ def _read_vtk(path: Path, step: int | None) -> tuple[pv.DataSet, int | None, flo
             data = pv.read(str(path))
         except Exception as exc:  # VTK/pyvista raise a zoo of types for corrupt input
             raise InputFileError(f"{path}: cannot read {path.suffix} file ({_first_line(exc)})") from None
+    if isinstance(data, pv.MultiBlock):
+        data = _combine(data)
     if err.messages and (data is None or data.n_points == 0):
         raise InputFileError(
             f"{path}: corrupt or truncated {path.suffix} file ({_first_line(err.messages[0])})"
         )
+    if data is None:
+        raise InputFileError(f"{path}: the file holds no mesh (0 nodes or 0 cells)")
     return data, None, None
 
 

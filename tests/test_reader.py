@@ -139,3 +139,16 @@ def test_results_are_immutable_and_inputs_untouched(tmp_path):
             arr[0] = 0
     with pytest.raises(AttributeError):
         a.coefficients.M0 = 1.0
+
+
+def test_multiblock_vtm_is_merged(tmp_path):
+    """A .vtm with the patch split over two blocks reads as one surface."""
+    from fepost.synthetic import write_map
+
+    whole = pv.read(write_map(tmp_path / "w.vtu", "hertz", radius=R, peak=PEAK, n_rings=30))
+    centres = whole.cell_centers().points
+    left = whole.extract_cells(np.flatnonzero(centres[:, 0] < 0))
+    right = whole.extract_cells(np.flatnonzero(centres[:, 0] >= 0))
+    pv.MultiBlock([left, right]).save(tmp_path / "split.vtm")
+    a = analyse(tmp_path / "split.vtm")
+    assert a.coefficients.N == pytest.approx(analyse(tmp_path / "w.vtu").coefficients.N, rel=1e-9)
