@@ -234,13 +234,17 @@ def _components(xy: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, n
     if n.max() > RASTER_MAX:  # a very sparse region: coarsen the raster
         h *= n.max() / RASTER_MAX
         n = np.floor((xy.max(axis=0) - lo) / h).astype(int) + 3
-    ij = np.floor((xy - lo) / h).astype(int) + 1
+    # coordinates are >= lo, so truncation is the floor
+    i = ((xy[:, 0] - lo[0]) * (1.0 / h)).astype(np.int32) + 1
+    j = ((xy[:, 1] - lo[1]) * (1.0 / h)).astype(np.int32) + 1
     occupied = np.zeros(tuple(n), bool)
-    occupied[ij[:, 0], ij[:, 1]] = True
+    occupied[i, j] = True
     occupied = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), bool))
     labels, count = ndimage.label(occupied, structure=np.ones((3, 3), bool))
-    face = labels[ij[tri[:, 0], 0], ij[tri[:, 0], 1]] - 1
-    return int(count), face
+    if count == 1:
+        return 1, np.zeros(len(tri), np.int64)
+    first = tri[:, 0]
+    return int(count), labels[i[first], j[first]] - 1
 
 
 def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
