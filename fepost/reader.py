@@ -181,9 +181,7 @@ def _array_catalogue(data: pv.DataSet) -> dict[str, str]:
     for n in data.point_data.keys():
         names[n] = "point"
     for n in data.cell_data.keys():
-        names.setdefault(n, "cell")
-        if names[n] != "cell" and n in data.cell_data:
-            names[n] = "point"  # same name in both: prefer nodal
+        names.setdefault(n, "cell")  # same name in both: the nodal array wins
     return names
 
 
