@@ -402,9 +402,10 @@ def build_patch(
         rms = float(np.sqrt(np.average(height[wmask] ** 2, weights=nvals[wmask])))
     else:
         rms = float(np.sqrt(np.mean(height**2)))
-    if frame is None and rms > PLANARITY_TOL * r_equiv:
+    if rms > PLANARITY_TOL * r_equiv:
+        plane = "its best-fit plane" if frame is None else "the given frame's plane (the static patch's)"
         raise PatchError(
-            f"{fld.source}: the contact patch is not planar (RMS distance from its best-fit plane "
+            f"{fld.source}: the contact patch is not planar (RMS distance from {plane} "
             f"{rms:.3g} m = {rms / r_equiv:.1%} of its radius, limit {PLANARITY_TOL:.0%}); "
             "are the coordinates undeformed? try --displacement NAME"
         )

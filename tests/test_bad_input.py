@@ -186,3 +186,15 @@ def test_sentinels_are_masked_with_warning(capsys, tmp_path):
 def test_debug_shows_traceback(tmp_path):
     with pytest.raises(Exception, match="no such file"):
         main(["--debug", "coefficients", str(tmp_path / "nope.vtu")])
+
+
+def test_rolling_map_off_the_static_plane(capsys, tmp_path):
+    static = disc(tmp_path / "s.vtu")
+    rolling = disc(tmp_path / "r.vtu", z_fn=lambda q: 0.05 + 0 * q[:, 0])  # 5 cm above the road
+    out = tmp_path / "out.json"
+    code = main(["coefficients", str(static), "--rolling", str(rolling), "--json", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and not out.exists()
+    assert re.search(
+        r"r\.vtu: the contact patch is not planar \(RMS distance from the given frame's plane", err[-1]
+    )
