@@ -65,6 +65,7 @@ from .friction.closed_form import f_parallel_ratio, f_perpendicular_ratio, torqu
 from .friction.exact import friction_resultants
 from .friction.law import FrictionLaw
 from .friction.quadrature import PressureQuadrature
+from .lsq import jacobian_svd, leverage
 
 #: Fitted parameters, in this order.
 PARAMETERS = ("F0", "M0", "a", "m", "k_x")
@@ -688,24 +689,13 @@ def _solve(prob: _Problem, theta0, w, max_nfev, fixed: int | None = None, value:
     return res
 
 
-def _leverage(J: np.ndarray) -> np.ndarray:
-    """Diagonal of the hat matrix J (JᵀJ)⁺ Jᵀ (rank-revealing, from the thin SVD)."""
-    U, s, _ = np.linalg.svd(J, full_matrices=False)
-    keep = s > np.finfo(float).eps * max(J.shape) * (s[0] if s.size else 0.0)
-    return np.sum(U[:, keep] ** 2, axis=1)
-
-
 def _covariance(prob: _Problem, J: np.ndarray, s2: float) -> tuple[np.ndarray, str | None]:
     """θ covariance s²(JᵀJ)⁻¹ as in curve_fit, or (NaN, reason) when indeterminate."""
-    _, s, VT = np.linalg.svd(J, full_matrices=False)
-    p = J.shape[1]
-    threshold = np.finfo(float).eps * max(J.shape) * s[0] if s.size else np.inf
-    if not np.all(np.isfinite(s)) or s.size < p or s[-1] <= threshold or s[0] / s[-1] > COND_MAX:
-        worst = int(np.argmax(np.abs(VT[-1]))) if np.all(np.isfinite(VT)) else 0
-        cond = s[0] / s[-1] if s.size and s[-1] > 0 else np.inf
-        return np.full((p, p), np.nan), f"(condition number {cond:.3g}): {PARAMETERS[worst]}"
-    cov = (VT.T / s**2) @ VT * s2
-    return cov, None
+    svd = jacobian_svd(J, COND_MAX)
+    if not svd.identifiable:
+        p = J.shape[1]
+        return np.full((p, p), np.nan), f"(condition number {svd.condition:.3g}): {PARAMETERS[svd.weakest]}"
+    return svd.inverse * s2, None
 
 
 def _profile(prob, theta, w, j, chi2_min, delta, wald, max_nfev) -> tuple[float, float]:
@@ -801,7 +791,7 @@ def fit_table1(
         w = np.concatenate([np.full(int(c), 1.0 / sg) for c, sg in zip(counts, sigma, strict=True)])
         res = _solve(prob, theta, w, max_nfev)
         theta, nfev = res.x, nfev + res.nfev
-        h = _leverage(res.jac)
+        h = leverage(res.jac)
         r = prob.model(theta) - y
         share = np.array([h[s].sum() for s in slices])
         dof_c = np.maximum(counts - share, 0.5)

@@ -96,11 +96,10 @@ def _read_vtk(path: Path, step: int | None) -> tuple[pv.DataSet, int | None, flo
         raise InputFileError(f"{path}: --step applies to Exodus time series, not to {path.suffix} files")
     with _VtkErrors() as err:
         try:
-            data = pv.read(str(path))
+            raw = pv.read(str(path))
         except Exception as exc:  # VTK/pyvista raise a zoo of types for corrupt input
             raise InputFileError(f"{path}: cannot read {path.suffix} file ({_first_line(exc)})") from None
-    if isinstance(data, pv.MultiBlock):
-        data = _combine(data)
+    data = _combine(raw) if isinstance(raw, pv.MultiBlock) else raw
     if err.messages and (data is None or data.n_points == 0):
         raise InputFileError(
             f"{path}: corrupt or truncated {path.suffix} file ({_first_line(err.messages[0])})"

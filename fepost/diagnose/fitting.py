@@ -30,6 +30,7 @@ from scipy import optimize, stats
 
 from .._arrays import frozen
 from ..errors import FitError, FitWarning
+from ..lsq import jacobian_svd
 from .causes import Candidate
 
 #: IRLS stops when every σ_c changes by less than this (relative) ...
@@ -118,12 +119,9 @@ def log_likelihood(rss: np.ndarray, n: int) -> float:
 
 
 def _covariance(jac: np.ndarray, n_obs: int, k: int) -> tuple[np.ndarray, bool]:
-    _, s, vt = np.linalg.svd(jac, full_matrices=False)
-    threshold = np.finfo(float).eps * max(jac.shape) * (s[0] if s.size else 0.0)
-    ok = bool(s.size) and bool(np.all(s > threshold))
-    s_inv = np.where(s > threshold, 1.0 / np.where(s > threshold, s, 1.0), 0.0)
-    cov = (vt.T * s_inv**2) @ vt
-    return cov * n_obs / max(n_obs - k, 1), ok
+    """(JᵀJ)⁻¹ of the whitened Jacobian, scaled by n/(n − k) for the fitted variances."""
+    svd = jacobian_svd(jac)
+    return svd.inverse * n_obs / max(n_obs - k, 1), svd.identifiable
 
 
 def fit(
