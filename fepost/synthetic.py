@@ -151,11 +151,14 @@ def write_exodus(
     point_data: list[dict],
     cell_data: list[dict] | None = None,
     times: list[float] | None = None,
+    title: str = "fepost verification map",
 ) -> Path:
     """Write a one-block Exodus II file with one time step per entry of ``point_data``.
 
     ``points`` (n, 3) m; ``cells`` (m, 3) triangles or (m, 4) quads (0-based);
-    ``point_data``/``cell_data``: per step, {name: values}.
+    ``point_data``/``cell_data``: per step, {name: values}. A 3-vector is stored
+    as the scalars ``<name>X``, ``<name>Y``, ``<name>Z`` (the Exodus convention,
+    which VTK's reader joins back into one vector).
     """
     import pyexodus
 
@@ -171,7 +174,7 @@ def write_exodus(
     e = pyexodus.exodus(
         str(path),
         mode="w",
-        title="fepost verification map",
+        title=title,
         numDims=3,
         numNodes=len(points),
         numElems=len(cells),
@@ -187,7 +190,7 @@ def write_exodus(
         cnames = list(cell_data[0])
         vec = {k: v for k, v in point_data[0].items() if np.ndim(v) == 2}
         scalar_n = [k for k in nnames if k not in vec]
-        flat_n = scalar_n + [f"{k}_{c}" for k in vec for c in "XYZ"[: np.shape(vec[k])[1]]]
+        flat_n = scalar_n + [f"{k}{c}" for k in vec for c in "XYZ"[: np.shape(vec[k])[1]]]
         if flat_n:
             e.set_node_variable_number(len(flat_n))
             for i, k in enumerate(flat_n):
@@ -203,7 +206,7 @@ def write_exodus(
             for k in vec:
                 arr = np.asarray(point_data[step][k], float)
                 for c, comp in enumerate("XYZ"[: arr.shape[1]]):
-                    e.put_node_variable_values(f"{k}_{comp}", step + 1, arr[:, c])
+                    e.put_node_variable_values(f"{k}{comp}", step + 1, arr[:, c])
             for k in cnames:
                 e.put_element_variable_values(1, k, step + 1, np.asarray(cell_data[step][k], float))
     finally:

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from fepost.synthetic import write_exodus
+
 from . import deck as dk
 from .solve import CaseResult
 
@@ -56,79 +58,15 @@ def write_surface(out_dir: Path, name: str, pts, quads, cp, disp) -> None:
     cells = [("quad", quads.astype(np.int64))]
     mesh = meshio.Mesh(pts, cells, point_data={"CPRESS": cp, "displacement": disp})
     meshio.write(out_dir / f"{name}.vtu", mesh, binary=True, compression="zlib")
-    # Exodus II: vectors as <name>X/Y/Z scalars (the Exodus convention; meshio
-    # and VTK's reader join them back into one 3-vector "displacement")
+    # Exodus II through fepost's writer (pyexodus): the displacement vector is stored as
+    # displacementX/Y/Z, which VTK's Exodus reader joins back into one 3-vector
     write_exodus(
         out_dir / f"{name}.e",
         pts,
         quads,
-        {
-            "CPRESS": cp,
-            "displacementX": disp[:, 0],
-            "displacementY": disp[:, 1],
-            "displacementZ": disp[:, 2],
-        },
+        [{"CPRESS": cp, "displacement": disp}],
         title=f"fepost tire sample {name}",
     )
-
-
-def write_exodus(path: Path, pts, quads, point_vars: dict, title: str = "") -> None:
-    """Minimal standard Exodus II (netCDF classic 64-bit offset) with one QUAD4 block.
-
-    meshio's Exodus writer stores nodal variables with non-standard dimensions
-    that VTK's Exodus reader misreads, so the file is written here following
-    the Exodus II layout (coordx/y/z, connect1, vals_nod_var<k>(time_step, num_nodes)).
-    """
-    import netCDF4
-
-    path = Path(path)
-    if path.exists():
-        path.unlink()
-    n, e = len(pts), len(quads)
-    with netCDF4.Dataset(path, "w", format="NETCDF3_64BIT_OFFSET") as nc:
-        nc.title = title
-        nc.api_version = np.float32(5.1)
-        nc.version = np.float32(5.1)
-        nc.floating_point_word_size = np.int32(8)
-        nc.file_size = np.int32(1)
-        nc.maximum_name_length = np.int32(32)
-        nc.createDimension("len_string", 33)
-        nc.createDimension("len_line", 81)
-        nc.createDimension("four", 4)
-        nc.createDimension("len_name", 33)
-        nc.createDimension("time_step", None)
-        nc.createDimension("num_dim", 3)
-        nc.createDimension("num_nodes", n)
-        nc.createDimension("num_elem", e)
-        nc.createDimension("num_el_blk", 1)
-        nc.createDimension("num_el_in_blk1", e)
-        nc.createDimension("num_nod_per_el1", 4)
-        nc.createDimension("num_nod_var", len(point_vars))
-        tw = nc.createVariable("time_whole", "f8", ("time_step",))
-        tw[0] = 0.0
-
-        def names(var, items):
-            arr = np.zeros((len(items), 33), dtype="S1")
-            for i, it in enumerate(items):
-                b = it.encode()[:32]
-                arr[i, : len(b)] = np.frombuffer(b, dtype="S1")
-            var[:] = arr
-
-        names(nc.createVariable("coor_names", "S1", ("num_dim", "len_name")), ["X", "Y", "Z"])
-        for k, ax in enumerate("xyz"):
-            nc.createVariable(f"coord{ax}", "f8", ("num_nodes",))[:] = np.asarray(pts)[:, k]
-        nc.createVariable("eb_status", "i4", ("num_el_blk",))[:] = [1]
-        prop = nc.createVariable("eb_prop1", "i4", ("num_el_blk",))
-        prop.setncattr("name", "ID")
-        prop[:] = [1]
-        names(nc.createVariable("eb_names", "S1", ("num_el_blk", "len_name")), ["outer_surface"])
-        conn = nc.createVariable("connect1", "i4", ("num_el_in_blk1", "num_nod_per_el1"))
-        conn.elem_type = "QUAD4"
-        conn[:] = np.asarray(quads, dtype=np.int32) + 1
-        names(nc.createVariable("name_nod_var", "S1", ("num_nod_var", "len_name")), list(point_vars))
-        for k, vals in enumerate(point_vars.values()):
-            v = nc.createVariable(f"vals_nod_var{k + 1}", "f8", ("time_step", "num_nodes"))
-            v[0, :] = np.asarray(vals, dtype=float)
 
 
 def write_case(res: CaseResult, out_dir: Path) -> dict:
