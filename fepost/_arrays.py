@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
+
+#: Read-only views whose writable bases no one else holds, by id (see :func:`adopted`).
+_ADOPTED: weakref.WeakValueDictionary = weakref.WeakValueDictionary()
 
 
 def _immutable(a) -> bool:
@@ -10,6 +15,8 @@ def _immutable(a) -> bool:
     while a is not None:
         if not isinstance(a, np.ndarray) or a.flags.writeable:
             return False
+        if _ADOPTED.get(id(a)) is a:
+            return True
         a = a.base
     return True
 
@@ -35,3 +42,16 @@ def sealed(a: np.ndarray) -> np.ndarray:
     """
     a.setflags(write=False)
     return a
+
+
+def adopted(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` that :func:`frozen` shares instead of copying.
+
+    For arrays whose memory belongs to an object that the library itself has
+    just created and drops (a VTK data set a reader built from a file):
+    nothing else can reach that memory, so the view is as good as immutable.
+    """
+    v = a.view(np.ndarray)
+    v.setflags(write=False)
+    _ADOPTED[id(v)] = v
+    return v

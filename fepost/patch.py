@@ -40,7 +40,7 @@ from scipy import ndimage
 
 from ._arrays import frozen, sealed
 from .errors import ArgumentError, PatchError, PatchWarning, PressureError, PressureWarning
-from .facesums import FaceSums, face_sums, load_outside, triangle_areas
+from .facesums import FaceSums, face_loads, face_sums, load_outside, triangle_areas
 from .field import ContactField
 
 DEFAULT_THRESHOLD = 1e-6
@@ -219,7 +219,7 @@ def _loaded_faces(fld: ContactField, v: np.ndarray, thr: float) -> np.ndarray:
     return v > thr
 
 
-def _components(xy: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
+def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
     """Separate loaded regions: (count, label per face).
 
     Regions closer than a gap of about :data:`GAP_FRACTION` × √area (tread
@@ -229,14 +229,15 @@ def _components(xy: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, n
     always fall in touching cells; one dilation closes gaps narrower than ~h.
     """
     h = max(GAP_FRACTION * np.sqrt(sums.A), sums.max_edge)
-    lo = xy.min(axis=0)
-    n = np.floor((xy.max(axis=0) - lo) / h).astype(int) + 3
+    lo = np.array([x.min(), y.min()])
+    ext = np.array([x.max(), y.max()]) - lo
+    n = np.floor(ext / h).astype(int) + 3
     if n.max() > RASTER_MAX:  # a very sparse region: coarsen the raster
         h *= n.max() / RASTER_MAX
-        n = np.floor((xy.max(axis=0) - lo) / h).astype(int) + 3
+        n = np.floor(ext / h).astype(int) + 3
     # coordinates are >= lo, so truncation is the floor
-    i = ((xy[:, 0] - lo[0]) * (1.0 / h)).astype(np.int32) + 1
-    j = ((xy[:, 1] - lo[1]) * (1.0 / h)).astype(np.int32) + 1
+    i = ((x - lo[0]) * (1.0 / h)).astype(np.int32) + 1
+    j = ((y - lo[1]) * (1.0 / h)).astype(np.int32) + 1
     occupied = np.zeros(tuple(n), bool)
     occupied[i, j] = True
     occupied = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), bool))
@@ -248,15 +249,29 @@ def _components(xy: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, n
 
 
 def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Weighted least-squares plane through ``points`` (n, 3): (centroid, unit normal).
+
+    The second moments are accumulated column by column (one (n,) temporary)
+    about a node of the patch, so large global offsets cost no precision.
+    """
     w = weights / weights.sum()
-    c = w @ points
-    d = points - c
-    _, vecs = np.linalg.eigh(d.T @ (d * w[:, None]))
+    ref = points[int(np.argmax(weights))]
+    c = w @ points - ref
+    m = np.empty((3, 3))
+    buf = np.empty(len(points))
+    cols = [points[:, k] for k in range(3)]
+    for a in range(3):
+        np.subtract(cols[a], ref[a], out=buf)
+        buf *= w
+        for b in range(a, 3):
+            m[a, b] = m[b, a] = buf @ cols[b] - ref[b] * buf.sum()
+    cov = m - np.outer(c, c)
+    _, vecs = np.linalg.eigh(cov)
     n = vecs[:, 0]
     k = int(np.argmax(np.abs(n)))
     if n[k] < 0:
         n = -n
-    return c, n
+    return c + ref, n
 
 
 def _axes(normal: np.ndarray, rolling_axis) -> np.ndarray:
@@ -282,7 +297,8 @@ class _Geometry(NamedTuple):
     triangles: np.ndarray
     values: np.ndarray
     base: Frame
-    local: np.ndarray
+    xy: np.ndarray  # (n, 2) in-plane coordinates in the base frame (m)
+    z: np.ndarray  # distance from the base plane (m)
     sums: FaceSums
 
 
@@ -300,21 +316,26 @@ def _geometry(fld, tri, fvals, v, thr, frame, rolling_axis) -> _Geometry:
         nvals = v[used] if fld.location == "point" else fvals
     if frame is None:
         if fld.location == "point":
-            wmask = nvals > thr
-            cpts, w = pts[wmask], nvals[wmask]
+            w = np.where(nvals > thr, nvals, 0.0)
+            n_loaded = int(np.count_nonzero(w))
         else:
-            cpts, w = pts, np.ones(len(pts))
-        if len(cpts) < 3:
+            w = np.ones(len(pts))
+            n_loaded = len(pts)
+        if n_loaded < 3:
             raise PatchError(f"{fld.source}: the contact patch has fewer than 3 loaded nodes")
-        c, normal = _plane(cpts, w)
+        c, normal = _plane(pts, w)
         base = Frame(origin=c, axes=_axes(normal, rolling_axis))
     else:
         base = frame
-    local = base.to_local(pts)
-    sums = face_sums(local[:, :2], tri_local, nvals, fld.location)
+    # patch coordinates: (pts − o)·e_k = pts·e_k − o·e_k
+    xy = pts @ base.axes[:2].T
+    xy -= base.origin @ base.axes[:2].T
+    z = pts @ base.axes[2]
+    z -= base.origin @ base.axes[2]
+    sums = face_sums(xy[:, 0], xy[:, 1], tri_local, nvals, fld.location)
     if not sums.N > 0:
         raise PatchError(f"{fld.source}: the contact patch carries no load")
-    return _Geometry(pts, tri_local, nvals, base, local, sums)
+    return _Geometry(pts, tri_local, nvals, base, xy, z, sums)
 
 
 def build_patch(
@@ -348,10 +369,11 @@ def build_patch(
         fvals = v[loaded] if fld.location == "cell" else v
 
     geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
-    ncomp, labels = _components(geo.local[:, :2], geo.triangles, geo.sums)
+    ncomp, labels = _components(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)
     dropped = 0
     if ncomp > 1:
-        share = np.bincount(labels, weights=geo.sums.load, minlength=ncomp) / geo.sums.N
+        loads = face_loads(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.values, fld.location)
+        share = np.bincount(labels, weights=loads, minlength=ncomp) / geo.sums.N
         big = np.flatnonzero(share > FRAGMENT_SHARE)
         if big.size > 1:
             parts = ", ".join(f"{s:.0%}" for s in sorted(share[big], reverse=True))
@@ -372,21 +394,22 @@ def build_patch(
         if fld.location == "cell":
             fvals = fvals[keep]
         geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
-    pts, tri_local, nvals, base, local, sums = geo
-    xy = local[:, :2]
+    pts, tri_local, nvals, base, xy, height, sums = geo
     N = sums.N
     cop = sums.centre_of_pressure
-    height = sealed(np.ascontiguousarray(local[:, 2]))
     if frame is None:
         origin = base.to_global(cop[None, :])[0]  # on the plane: local z = 0
         fr = Frame(origin=origin, axes=base.axes)
-        xy = sealed(xy - cop)
+        xy -= cop  # the geometry's own array: shifted in place
         cop_rel = (0.0, 0.0)
         cen = sums.centroid - cop
     else:
         fr = frame
         cop_rel = (float(cop[0]), float(cop[1]))
         cen = sums.centroid
+    xy = sealed(xy)
+    height = sealed(height)
+    x, y = xy[:, 0], xy[:, 1]
     area = sums.A
     evals, evecs = np.linalg.eigh(sums.covariance())
     evals = np.clip(evals, 0.0, None)
@@ -395,13 +418,13 @@ def build_patch(
     angle = float(np.arctan2(major[1], major[0]))
     angle = (angle + np.pi / 2) % np.pi - np.pi / 2
     aspect = float(semi[0] / semi[1]) if semi[1] > 0 else np.inf
-    r_max = float(np.sqrt(np.max(xy[:, 0] ** 2 + xy[:, 1] ** 2)))
+    r_max = float(np.sqrt(np.max(x * x + y * y)))
     r_equiv = float(np.sqrt(area / np.pi))
     if fld.location == "point":
-        wmask = nvals > thr
-        rms = float(np.sqrt(np.average(height[wmask] ** 2, weights=nvals[wmask])))
+        w = np.where(nvals > thr, nvals, 0.0)
+        rms = float(np.sqrt((w @ (height * height)) / w.sum()))
     else:
-        rms = float(np.sqrt(np.mean(height**2)))
+        rms = float(np.sqrt((height @ height) / len(height)))
     if rms > PLANARITY_TOL * r_equiv:
         plane = "its best-fit plane" if frame is None else "the given frame's plane (the static patch's)"
         raise PatchError(
@@ -409,7 +432,7 @@ def build_patch(
             f"{rms:.3g} m = {rms / r_equiv:.1%} of its radius, limit {PLANARITY_TOL:.0%}); "
             "are the coordinates undeformed? try --displacement NAME"
         )
-    outside = load_outside(xy, tri_local, nvals, fld.location, r_equiv, sums)
+    outside = load_outside(x, y, tri_local, nvals, fld.location, r_equiv, sums)
     circular = bool(aspect <= 1.0 + ASPECT_TOL and r_max / r_equiv <= RMAX_TOL)
     notes = []
     if not circular:

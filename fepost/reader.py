@@ -41,6 +41,7 @@ import numpy as np
 import pyvista as pv
 from pyvista.core.utilities.observers import VtkErrorCatcher
 
+from ._arrays import adopted
 from .errors import FieldError, InputFileError, SentinelWarning
 from .field import ContactField
 
@@ -362,11 +363,12 @@ def read_contact(
     if side is not None and side.get("reaction_z") is not None:
         reaction = float(side["reaction_z"])
     label = name if comp is None else f"{name}:{comp}"
+    # the arrays live in VTK objects made here and dropped on return: shared, not copied
     return ContactField(
         source=str(path),
-        points=points,
-        triangles=tri,
-        values=vals,
+        points=adopted(points),
+        triangles=adopted(tri),
+        values=adopted(vals),
         location=location,  # type: ignore[arg-type]
         field=label,
         step=chosen,

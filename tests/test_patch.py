@@ -64,3 +64,29 @@ def test_too_coarse_a_grid_is_reported(analytic_mesh):
 
     with pytest.warns(PatchWarning, match=r"h\.vtu: the polar grid carries -\d+\.\d% of the FE load"):
         analyse(path, grid=PolarGrid.make(4, 4, "trapezoid"))
+
+
+@pytest.mark.parametrize("location", ["point", "cell"])
+def test_load_outside_the_equivalent_circle_of_an_ellipse(analytic_mesh, location):
+    """Uniform pressure on an ellipse of aspect 1.3: the share outside the circle of equal
+    area is the ellipse's area outside that circle over its whole area (an independent
+    1-D integral over the polar angle)."""
+    from scipy.integrate import quad
+
+    aspect = 1.3
+    p = analyse(
+        analytic_mesh("u.vtu", "uniform", radius=R, aspect=aspect, n_rings=60, location=location)
+    ).static_patch
+    a, b = R * np.sqrt(aspect), R / np.sqrt(aspect)
+    r = p.r_equiv
+
+    def inside(phi):
+        rho = a * b / np.hypot(b * np.cos(phi), a * np.sin(phi))
+        return 0.5 * min(rho, r) ** 2
+
+    kink = np.arccos(np.sqrt((r**-2 - a**-2) / (b**-2 - a**-2)))  # where the ellipse crosses the circle
+    area_in = 4 * quad(inside, 0, np.pi / 2, points=[kink], epsabs=0, epsrel=1e-12)[0]
+    expected = 1.0 - area_in / (np.pi * a * b)
+    assert 0.03 < expected < 0.2
+    assert p.load_outside == pytest.approx(expected, rel=2e-3)
+    assert p.r_equiv == pytest.approx(R, rel=2e-3)
