@@ -5,8 +5,9 @@
   measurement, with the identity line.
 * :func:`plot_residuals` — residuals in % of the channel scale (f₀N, f₀NR)
   against sliding speed, speed ratio, sliding direction, spin sign and (when
-  they vary) load and roll: structure shows as a trend or a step, noise as a
-  flat band.
+  they vary) load and roll, with the group means the ANOVA test compares
+  (± their 95 % interval) and its p-value per panel: structure shows as a
+  trend or a step of the means, noise as a flat band around zero.
 * :func:`plot_candidates` — ΔBIC of every candidate against the simulation.
 
 Each function takes an optional figure or axes and returns it; none calls show().
@@ -18,6 +19,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .measured import CHANNELS
+from .residuals import binned_means
 from .result import Diagnosis
 
 UNITS = {"Fx": "N", "Fy": "N", "Mz": "N·m"}
@@ -78,15 +80,32 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
     ra = 100 * (meas - diag.predictions["after_heldout"]) / diag.scales
     rng = np.random.default_rng(0)
     for j, name in enumerate(cols):
-        x = np.array(diag.variables[name], float)
-        if np.unique(x[np.isfinite(x)]).size <= 3:  # categorical: jitter
-            x = x + rng.uniform(-0.15, 0.15, x.size)
+        x0 = np.array(diag.variables[name], float)
+        x = x0
+        if np.unique(x0[np.isfinite(x0)]).size <= 3:  # categorical: jitter the points only
+            x = x0 + rng.uniform(-0.15, 0.15, x0.size)
         for c in range(3):
             ax = axes[c, j]
             ax.axhline(0.0, color="k", lw=0.6)
-            ax.scatter(x, rb[:, c], s=6, c=BEFORE, label="simulation")
+            ax.scatter(x, rb[:, c], s=6, c=BEFORE, alpha=0.6, label="simulation")
             if diag.cause != "none":
-                ax.scatter(x, ra[:, c], s=6, c=AFTER, alpha=0.7, label=diag.cause)
+                ax.scatter(x, ra[:, c], s=6, c=AFTER, alpha=0.5, label=diag.cause)
+            groups = binned_means(rb[:, c], name, x0)
+            if groups is not None:
+                bars = ax.errorbar(
+                    *groups[:2],
+                    yerr=groups[2],
+                    fmt="o-",
+                    color="k",
+                    ms=3,
+                    lw=1.0,
+                    capsize=2,
+                    label="simulation: group mean ± 95 %",
+                )
+                bars.lines[0].set_gid("group-means")
+            p = diag.residuals["before"][CHANNELS[c]]["p_values"].get(name)
+            if p is not None:
+                ax.text(0.02, 0.97, f"ANOVA p = {p:.2g}", transform=ax.transAxes, fontsize=7, va="top")
             if c == 2:
                 ax.set_xlabel(name)
             if j == 0:

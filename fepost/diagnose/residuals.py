@@ -59,6 +59,36 @@ def _groups(name: str, x: np.ndarray) -> np.ndarray | None:
     return np.where(ok, lab, -1).astype(int)
 
 
+def binned_means(r: np.ndarray, name: str, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Residual mean per group of the ANOVA test and its 95 % t-interval half-width.
+
+    Returns (x-position, mean of ``r``, half-width), one entry per group with at
+    least two points, in increasing x, or None when ``x`` does not vary. The
+    x-position is the mean of x in the group, or for the sliding direction the
+    centre of its 45° sector (the ±180° sector sits at 180°). These are the
+    group means the F-test compares, drawn over the scatter.
+    """
+    x = np.asarray(x, float)
+    lab = _groups(name, x)
+    if lab is None:
+        return None
+    xs, ms, hw = [], [], []
+    for g in np.unique(lab[lab >= 0]):
+        sel = lab == g
+        n = int(sel.sum())
+        if n < 2:
+            continue
+        rg = r[sel]
+        if name.startswith("sliding direction"):
+            xs.append(float(45.0 * g if 45.0 * g <= 180.0 else 45.0 * g - 360.0))
+        else:
+            xs.append(float(np.mean(x[sel])))
+        ms.append(float(np.mean(rg)))
+        hw.append(float(stats.t.ppf(0.975, n - 1) * np.std(rg, ddof=1) / np.sqrt(n)))
+    order = np.argsort(xs)
+    return np.array(xs)[order], np.array(ms)[order], np.array(hw)[order]
+
+
 def residual_structure(res: np.ndarray, variables: dict[str, np.ndarray]) -> dict:
     """Per-channel RMSE, mean test and ANOVA p-values, and the verdict (see the module docstring)."""
     out = {}
