@@ -74,6 +74,16 @@ def test_figure_elliptic_patch(tmp_path, verify_image_cache):
     pl.show()
 
 
+def test_figure1_calculix_sample(verify_image_cache):
+    """Figure 1 from real solver output (the committed CalculiX static case)."""
+    from pathlib import Path
+
+    mesh = Path(__file__).resolve().parents[1] / "meshes" / "static.vtu"
+    a = analyse(mesh)
+    pl = pressure_surface(a.static_patch, title="Figure 1: CalculiX static sample")
+    pl.show()
+
+
 def test_patch_mesh_carries_the_fe_values_exactly(maps):
     p = maps.static_patch
     mesh = patch_mesh(p, inflation_pressure=2e5, height_scale=10.0)
