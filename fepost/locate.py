@@ -32,7 +32,7 @@ from .errors import ArgumentError
 #: Largest raster side (cells); the raster holds the query points' bounding box.
 RASTER_MAX = 2048
 #: Raster cell size in typical mesh edges: a cell holds a few triangles.
-CELL_EDGES = 2.0
+CELL_EDGES = 1.0
 #: Triangles per chunk of the candidate pass.
 CHUNK = 1 << 16
 #: Query points per block of the exact test (bounds the pair arrays).
