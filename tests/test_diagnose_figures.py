@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from fepost.diagnose import diagnose
-from fepost.diagnose.figures import plot_residuals
+from fepost.diagnose.figures import along_sliding, plot_residuals
 from fepost.diagnose.measured import CHANNELS
 from fepost.diagnose.residuals import binned_means
 from fepost.diagnose.synthetic import analytic_map, synthesize
@@ -38,9 +38,11 @@ def test_residual_figure_draws_the_tested_group_means(diag):
     rb = 100 * (meas - diag.predictions["before"]) / diag.scales
     drawn = [ln for ax in fig.axes for ln in ax.get_lines() if ln.get_gid() == "group-means"]
     expected = []
-    for c in range(len(CHANNELS)):
+    rows = [rb[:, c] for c in range(len(CHANNELS))] + [along_sliding(diag.data, rb)]
+    for r in rows:
+        ok = np.isfinite(r)
         for name, x in diag.variables.items():
-            g = binned_means(rb[:, c], name, np.asarray(x, float))
+            g = binned_means(r[ok], name, np.asarray(x, float)[ok])
             if g is not None:
                 expected.append(g)
     assert len(drawn) == len(expected) > 0
@@ -57,3 +59,16 @@ def test_direction_groups_sit_at_their_sector_centres():
     xs, ms, _ = binned_means(r, "sliding direction (deg)", deg)
     np.testing.assert_allclose(xs, [0.0, 45.0, 90.0, 180.0])  # sectors of 45°, ±180° wraps to 180
     np.testing.assert_allclose(ms, [1.0, 6.0, 1.0, 2.0])
+
+
+def test_along_sliding_residual_is_positive_for_too_little_friction(diag):
+    """Measured forces 20 % below the simulation's: the residual along v is +0.2 |F_sim|."""
+    pred = diag.predictions["before"]
+    res = 0.8 * pred - pred
+    along = along_sliding(diag.data, res)
+    v = np.hypot(diag.data.vx, diag.data.vy)
+    sliding = v > 0
+    opposing = -(pred[:, 0] * diag.data.vx + pred[:, 1] * diag.data.vy)[sliding] / v[sliding]
+    assert np.all(opposing > 0)  # friction opposes sliding
+    np.testing.assert_allclose(along[sliding], 0.2 * opposing, rtol=1e-12)
+    assert np.all(np.isnan(along[~sliding]))

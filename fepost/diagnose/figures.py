@@ -7,7 +7,11 @@
   against sliding speed, speed ratio, sliding direction, spin sign and (when
   they vary) load and roll, with the group means the ANOVA test compares
   (± their 95 % interval) and its p-value per panel: structure shows as a
-  trend or a step of the means, noise as a flat band around zero.
+  trend or a step of the means, noise as a flat band around zero. A fourth
+  row shows the force residual along the sliding direction (positive: less
+  friction than simulated), where a change of friction level with speed,
+  load or pressure shows as a trend of the means even when the signed Fx, Fy
+  residuals only fan out.
 * :func:`plot_candidates` — ΔBIC of every candidate against the simulation.
 
 Each function takes an optional figure or axes and returns it; none calls show().
@@ -69,28 +73,46 @@ def _columns(diag: Diagnosis) -> list[str]:
     return cols
 
 
+def along_sliding(data, res: np.ndarray) -> np.ndarray:
+    """Force residual (rows of Fx, Fy in ``res``) along the sliding direction v/|v|; nan at |v| = 0."""
+    v = np.hypot(data.vx, data.vy)
+    along = res[:, 0] * data.vx + res[:, 1] * data.vy
+    return np.divide(along, v, out=np.full(v.shape, np.nan), where=v > 0)
+
+
 def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
     """Residuals (% of scale) against the kinematic variables; returns the figure."""
     cols = _columns(diag)
     if fig is None:
-        fig = Figure(figsize=(3.0 * len(cols) + 1, 8), layout="constrained")
-    axes = np.atleast_2d(fig.subplots(3, len(cols), sharey="row", squeeze=False))
+        fig = Figure(figsize=(3.0 * len(cols) + 1, 10.5), layout="constrained")
+    axes = np.atleast_2d(fig.subplots(4, len(cols), sharey="row", squeeze=False))
     meas = diag.data.forces
     rb = 100 * (meas - diag.predictions["before"]) / diag.scales
     ra = 100 * (meas - diag.predictions["after_heldout"]) / diag.scales
+    rows = [
+        (rb[:, c], ra[:, c], f"{CHANNELS[c]} residual (% of f0N{'R' if c == 2 else ''})") for c in range(3)
+    ]
+    rows.append(
+        (
+            along_sliding(diag.data, rb),
+            along_sliding(diag.data, ra),
+            "along sliding (% of f0N)\n+ = less friction than simulated",
+        )
+    )
     rng = np.random.default_rng(0)
     for j, name in enumerate(cols):
         x0 = np.array(diag.variables[name], float)
         x = x0
         if np.unique(x0[np.isfinite(x0)]).size <= 3:  # categorical: jitter the points only
             x = x0 + rng.uniform(-0.15, 0.15, x0.size)
-        for c in range(3):
+        for c, (before, after, label) in enumerate(rows):
             ax = axes[c, j]
             ax.axhline(0.0, color="k", lw=0.6)
-            ax.scatter(x, rb[:, c], s=6, c=BEFORE, alpha=0.6, label="simulation")
+            ax.scatter(x, before, s=6, c=BEFORE, alpha=0.6, label="simulation")
             if diag.cause != "none":
-                ax.scatter(x, ra[:, c], s=6, c=AFTER, alpha=0.5, label=diag.cause)
-            groups = binned_means(rb[:, c], name, x0)
+                ax.scatter(x, after, s=6, c=AFTER, alpha=0.5, label=diag.cause)
+            ok = np.isfinite(before)
+            groups = binned_means(before[ok], name, x0[ok])
             if groups is not None:
                 bars = ax.errorbar(
                     *groups[:2],
@@ -103,15 +125,16 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
                     label="simulation: group mean ± 95 %",
                 )
                 bars.lines[0].set_gid("group-means")
-            p = diag.residuals["before"][CHANNELS[c]]["p_values"].get(name)
-            if p is not None:
-                ax.text(0.02, 0.97, f"ANOVA p = {p:.2g}", transform=ax.transAxes, fontsize=7, va="top")
-            if c == 2:
+            if c < 3:
+                p = diag.residuals["before"][CHANNELS[c]]["p_values"].get(name)
+                if p is not None:
+                    ax.text(0.02, 0.97, f"ANOVA p = {p:.2g}", transform=ax.transAxes, fontsize=7, va="top")
+            if c == len(rows) - 1:
                 ax.set_xlabel(name)
             if j == 0:
-                ax.set_ylabel(f"{CHANNELS[c]} residual (% of f0N{'R' if c == 2 else ''})")
-            st = diag.residuals["before"][CHANNELS[c]]
-            if j == 0:
+                ax.set_ylabel(label)
+            if j == 0 and c < 3:
+                st = diag.residuals["before"][CHANNELS[c]]
                 ax.set_title(
                     f"{CHANNELS[c]}: {st['verdict']} (p={st['p_adjusted']:.2g})",
                     fontsize=8,
