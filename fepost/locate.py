@@ -35,6 +35,8 @@ RASTER_MAX = 2048
 CELL_EDGES = 1.0
 #: Triangles per chunk of the candidate pass.
 CHUNK = 1 << 16
+#: Cells per batch when the candidates' boxes are expanded (bounds their arrays).
+EXPAND_MAX = 1 << 22
 #: Query points per block of the exact test (bounds the pair arrays).
 QUERY_BLOCK = 1 << 15
 #: A point counts as inside a triangle when every barycentric coordinate is ≥ −TOL.
@@ -107,17 +109,33 @@ def _candidates(X, Y, tri, origin, h, shape, sat) -> tuple[np.ndarray, np.ndarra
 
 
 def _register(cand: np.ndarray, boxes: np.ndarray, occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The (cell key, candidate) pairs of the candidates' boxes in cells holding a query, sorted by key."""
+    """The (cell key, candidate) pairs of the candidates' boxes in cells holding a query, sorted by key.
+
+    Boxes are expanded to their cells in batches of at most :data:`EXPAND_MAX`
+    cells, so a few very large faces cannot exhaust memory.
+    """
     ny = occupied.shape[1]
+    occ = occupied.ravel()
     ni = boxes[:, 1] - boxes[:, 0]
     nj = boxes[:, 3] - boxes[:, 2]
-    n = (ni * nj).astype(np.int64)
-    owner = np.repeat(np.arange(len(cand)), n)
-    k = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)  # rank inside each box
-    nj_o = nj[owner]
-    key = (boxes[owner, 0] + k // nj_o).astype(np.int64) * ny + (boxes[owner, 2] + k % nj_o)
-    keep = np.flatnonzero(occupied.ravel()[key])
-    key, owner = key[keep], owner[keep]
+    n = ni.astype(np.int64) * nj
+    ends = np.cumsum(n)
+    keys, owners = [], []
+    lo = 0
+    while lo < len(cand):
+        # the next batch: as many boxes as fit in EXPAND_MAX cells (at least one)
+        hi = max(lo + 1, int(np.searchsorted(ends, (ends[lo - 1] if lo else 0) + EXPAND_MAX, side="right")))
+        nb = n[lo:hi]
+        owner = np.repeat(np.arange(lo, hi), nb)
+        k = np.arange(nb.sum()) - np.repeat(np.cumsum(nb) - nb, nb)  # rank inside each box
+        nj_o = nj[owner]
+        key = (boxes[owner, 0] + k // nj_o).astype(np.int64) * ny + (boxes[owner, 2] + k % nj_o)
+        keep = np.flatnonzero(occ[key])
+        keys.append(key[keep])
+        owners.append(owner[keep])
+        lo = hi
+    key = np.concatenate(keys)
+    owner = np.concatenate(owners)
     order = np.argsort(key, kind="stable")
     return key[order], cand[owner[order]]
 

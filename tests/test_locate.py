@@ -131,3 +131,21 @@ def test_resample_methods_agree_on_solver_output(case, rule):
     np.testing.assert_allclose(a.sigma, b.sigma, rtol=0, atol=1e-9 * peak)
     with pytest.raises(ArgumentError, match="method"):
         resample(patch, grid, method="nearest")
+
+
+def test_huge_faces_are_expanded_in_bounded_batches(monkeypatch):
+    """A fine mesh plus faces spanning the whole raster: same answer with tiny batches."""
+    xy, tri = disc_mesh(40, "tri", seed=12, graded=False)
+    big = np.array([[-10.0, -10.0], [10.0, -10.0], [0.0, 10.0]])  # one face holding every query point
+    xy2 = np.vstack([xy, big])
+    n = len(xy)
+    tri2 = np.vstack([tri, [[n, n + 1, n + 2]]])
+    f = 1.0 + xy2[:, 0] - 2.0 * xy2[:, 1]
+    pts = _random_points(3000, 13, reach=2.0)
+    ref, ref_ok = locate.interpolate(xy2, tri2, f, "point", pts)
+    monkeypatch.setattr(locate, "EXPAND_MAX", 64)
+    v, ok = locate.interpolate(xy2, tri2, f, "point", pts)
+    np.testing.assert_array_equal(ok, ref_ok)
+    np.testing.assert_allclose(v, ref, atol=1e-12)
+    assert ok.all()  # every point lies in the big face at least
+    np.testing.assert_allclose(v, 1.0 + pts[:, 0] - 2.0 * pts[:, 1], atol=1e-12)
