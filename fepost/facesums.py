@@ -144,9 +144,9 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
     return FaceSums(N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy, max_edge)
 
 
-def face_loads(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str):
+def face_loads(xy: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str) -> np.ndarray:
     """Exact load (N) of each face, an (m,) array."""
-    a = triangle_areas(np.column_stack([x, y]), tri)
+    a = triangle_areas(xy, tri)
     if location == "point":
         return a * _rows(np.asarray(values, float)[tri.T]) / 3.0
     return a * values
@@ -160,19 +160,20 @@ def load_outside(
     location: str,
     radius: float,
     sums: FaceSums,
+    r2: np.ndarray | None = None,
 ) -> float:
     """Share of the load outside the circle of ``radius`` about the origin of (``x``, ``y``).
 
     Faces wholly inside count nothing; the faces that reach past the circle
     (usually few) are integrated with a 7-point rule of degree 5, exact for the
-    faces wholly outside.
+    faces wholly outside. ``r2``: x² + y² per node, when the caller has it already.
     """
     total = sums.N
     if total <= 0:
         return 0.0
     X = np.asarray(x, dtype=float)
     Y = np.asarray(y, dtype=float)
-    R2 = X * X + Y * Y
+    R2 = X * X + Y * Y if r2 is None else r2
     rad2 = radius * radius
 
     def work(sl: slice) -> float:

@@ -299,6 +299,7 @@ class _Geometry(NamedTuple):
     base: Frame
     xy: np.ndarray  # (n, 2) in-plane coordinates in the base frame (m)
     z: np.ndarray  # distance from the base plane (m)
+    weights: np.ndarray  # per node: the pressure where loaded, else 0 (face data: 1)
     sums: FaceSums
 
 
@@ -314,14 +315,9 @@ def _geometry(fld, tri, fvals, v, thr, frame, rolling_axis) -> _Geometry:
         tri_local = remap[tri]
         pts = fld.points[used]
         nvals = v[used] if fld.location == "point" else fvals
+    w = np.where(nvals > thr, nvals, 0.0) if fld.location == "point" else np.ones(len(pts))
     if frame is None:
-        if fld.location == "point":
-            w = np.where(nvals > thr, nvals, 0.0)
-            n_loaded = int(np.count_nonzero(w))
-        else:
-            w = np.ones(len(pts))
-            n_loaded = len(pts)
-        if n_loaded < 3:
+        if np.count_nonzero(w) < 3:
             raise PatchError(f"{fld.source}: the contact patch has fewer than 3 loaded nodes")
         c, normal = _plane(pts, w)
         base = Frame(origin=c, axes=_axes(normal, rolling_axis))
@@ -335,7 +331,7 @@ def _geometry(fld, tri, fvals, v, thr, frame, rolling_axis) -> _Geometry:
     sums = face_sums(xy[:, 0], xy[:, 1], tri_local, nvals, fld.location)
     if not sums.N > 0:
         raise PatchError(f"{fld.source}: the contact patch carries no load")
-    return _Geometry(pts, tri_local, nvals, base, xy, z, sums)
+    return _Geometry(pts, tri_local, nvals, base, xy, z, w, sums)
 
 
 def build_patch(
@@ -372,7 +368,7 @@ def build_patch(
     ncomp, labels = _components(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)
     dropped = 0
     if ncomp > 1:
-        loads = face_loads(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.values, fld.location)
+        loads = face_loads(geo.xy, geo.triangles, geo.values, fld.location)
         share = np.bincount(labels, weights=loads, minlength=ncomp) / geo.sums.N
         big = np.flatnonzero(share > FRAGMENT_SHARE)
         if big.size > 1:
@@ -394,7 +390,7 @@ def build_patch(
         if fld.location == "cell":
             fvals = fvals[keep]
         geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
-    pts, tri_local, nvals, base, xy, height, sums = geo
+    pts, tri_local, nvals, base, xy, height, weights, sums = geo
     N = sums.N
     cop = sums.centre_of_pressure
     if frame is None:
@@ -418,13 +414,10 @@ def build_patch(
     angle = float(np.arctan2(major[1], major[0]))
     angle = (angle + np.pi / 2) % np.pi - np.pi / 2
     aspect = float(semi[0] / semi[1]) if semi[1] > 0 else np.inf
-    r_max = float(np.sqrt(np.max(x * x + y * y)))
+    r2 = x * x + y * y
+    r_max = float(np.sqrt(np.max(r2)))
     r_equiv = float(np.sqrt(area / np.pi))
-    if fld.location == "point":
-        w = np.where(nvals > thr, nvals, 0.0)
-        rms = float(np.sqrt((w @ (height * height)) / w.sum()))
-    else:
-        rms = float(np.sqrt((height @ height) / len(height)))
+    rms = float(np.sqrt((weights @ (height * height)) / weights.sum()))
     if rms > PLANARITY_TOL * r_equiv:
         plane = "its best-fit plane" if frame is None else "the given frame's plane (the static patch's)"
         raise PatchError(
@@ -432,7 +425,7 @@ def build_patch(
             f"{rms:.3g} m = {rms / r_equiv:.1%} of its radius, limit {PLANARITY_TOL:.0%}); "
             "are the coordinates undeformed? try --displacement NAME"
         )
-    outside = load_outside(x, y, tri_local, nvals, fld.location, r_equiv, sums)
+    outside = load_outside(x, y, tri_local, nvals, fld.location, r_equiv, sums, r2=r2)
     circular = bool(aspect <= 1.0 + ASPECT_TOL and r_max / r_equiv <= RMAX_TOL)
     notes = []
     if not circular:

@@ -22,6 +22,11 @@ def sample_mesh(name: str) -> Path:
     return p
 
 
+def add_friction_option(p: argparse.ArgumentParser, what: str = "friction coefficient f") -> None:
+    """``--friction F`` (default 0.3), shared by every command that needs f."""
+    p.add_argument("--friction", type=float, default=0.3, metavar="F", help=f"{what} (default 0.3)")
+
+
 def add_input_options(p: argparse.ArgumentParser) -> None:
     """Reading, patch and grid options common to commands that read FE exports."""
     g = p.add_argument_group("reading and resampling")

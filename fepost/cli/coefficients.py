@@ -6,7 +6,7 @@ import argparse
 
 from ..analysis import Analysis, analyse
 from ..output import write_json_atomic
-from ._common import add_input_options, analysis_kwargs
+from ._common import add_friction_option, add_input_options, analysis_kwargs
 
 
 def add_parser(sub) -> None:
@@ -17,9 +17,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument("static", metavar="STATIC", help="static contact map (.vtu .vtk .vtp .e .exo)")
     p.add_argument("--rolling", metavar="ROLLING", help="rolling contact map at the same deflection")
-    p.add_argument(
-        "--friction", type=float, default=0.3, metavar="F", help="friction coefficient f (default 0.3)"
-    )
+    add_friction_option(p)
     p.add_argument("--json", metavar="PATH", help="write the coefficients as JSON")
     add_input_options(p)
     p.set_defaults(func=run)

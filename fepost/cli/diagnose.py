@@ -15,7 +15,7 @@ from ..diagnose import diagnose
 from ..diagnose.selection import FOLDS
 from ..diagnose.writer import write_diagnosis
 from ..errors import ArgumentError, OutputError
-from ._common import add_input_options, analysis_kwargs
+from ._common import add_friction_option, add_input_options, analysis_kwargs
 
 
 def add_parser(sub) -> None:
@@ -42,13 +42,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--measured", required=True, metavar="CSV", help="measured friction data (INTERFACE.md CSV)"
     )
-    p.add_argument(
-        "--friction",
-        type=float,
-        default=0.3,
-        metavar="F",
-        help="nominal friction coefficient (default 0.3)",
-    )
+    add_friction_option(p, "nominal friction coefficient")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--force", action="store_true", help="replace a non-empty output folder")
     p.add_argument(

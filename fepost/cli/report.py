@@ -7,7 +7,7 @@ import sys
 
 from ..report import build_report
 from ..table1 import DEFAULT_SEED
-from ._common import add_input_options, analysis_kwargs, sample_mesh
+from ._common import add_friction_option, add_input_options, analysis_kwargs, sample_mesh
 
 
 def add_parser(sub) -> None:
@@ -26,13 +26,7 @@ def add_parser(sub) -> None:
     p.add_argument("rolling", metavar="ROLLING", nargs="?", help="rolling contact map at the same deflection")
     p.add_argument("--out", metavar="DIR", required=True, help="output folder (created; must be empty)")
     p.add_argument("--force", action="store_true", help="replace a non-empty output folder")
-    p.add_argument(
-        "--friction",
-        type=float,
-        default=0.3,
-        metavar="F",
-        help="friction coefficient f (default 0.3)",
-    )
+    add_friction_option(p)
     p.add_argument(
         "--inflation-pressure",
         type=float,

@@ -15,7 +15,7 @@ from ..analysis import analyse
 from ..identify import DEFAULT_AMPLITUDE, DEFAULT_N_POINTS, DEFAULT_SPAN
 from ..output import write_json_atomic
 from ..table1 import DEFAULT_SEED, format_table, table1
-from ._common import add_input_options, analysis_kwargs, sample_mesh
+from ._common import add_friction_option, add_input_options, analysis_kwargs, sample_mesh
 
 #: The committed seed of ``fepost table1`` (same as :data:`fepost.table1.DEFAULT_SEED`).
 SEED = DEFAULT_SEED
@@ -45,13 +45,7 @@ def add_parser(sub) -> None:
         default="closed_form",
         help="test curves from the paper's closed forms (default) or the exact friction integrals",
     )
-    p.add_argument(
-        "--friction",
-        type=float,
-        default=0.3,
-        metavar="F",
-        help="friction coefficient f (default 0.3)",
-    )
+    add_friction_option(p)
     p.add_argument("--noise", choices=("uniform", "gaussian"), default="uniform", help="noise distribution")
     p.add_argument(
         "--amplitude",
