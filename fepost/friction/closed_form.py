@@ -112,8 +112,10 @@ def asymptotic_coefficients(
     u = |ω| R; σ-weighted integrals about the patch origin, n̂ = v̂ rotated by +90°:
 
     - u ≫ v: the ICR sits at p0 = J v/ω, close to the origin, and to first order
-      F∥ = f v/|ω| · T, T = ∬ σ (n̂·ê_r)²/r dA. Matching F0 v/(√a u) gives
-      √a = N / (R T).
+      F = −(f/|ω|) S v with S = ∬ σ ê_r ê_rᵀ/r dA, so F∥ = f v/|ω| · T with
+      T = v̂ᵀS v̂ = ∬ σ (v̂·ê_r)²/r dA. Matching F0 v/(√a u) gives √a = N / (R T).
+      (A patch long along x slides along x with little drag near pure spin: the
+      weight is (v̂·ê_r)², along the sliding direction.)
     - v ≫ u: ŵ = v̂ + (ω/v)(v̂·p) n̂ + O(ω²), so M_z = −f(ω/v) ∬ σ (v̂·p)² dA
       (plus −fN x_c × v̂, zero when the origin is the centre of pressure).
       Matching M0 u/(√m v) gives √m = M0 R / (f ∬ σ (v̂·p)² dA).
@@ -132,12 +134,11 @@ def asymptotic_coefficients(
     if not np.isfinite(direction):
         raise ArgumentError(f"direction must be a finite angle in rad, got {direction!r}")
     ex, ey = np.cos(direction), np.sin(direction)
-    nx, ny = -ey, ex
     x, y, s, da = quad.x, quad.y, quad.sigma, quad.dA
     r = np.hypot(x, y)
     N = float(s @ da)
     M0 = f * float(s @ (r * da))
-    T = _inverse_r_moment(quad, nx, ny)
+    T = _inverse_r_moment(quad, ex, ey)
     second = float(s @ ((ex * x + ey * y) ** 2 * da))
     a = (N / (R * T)) ** 2
     m = (M0 * R / (f * second)) ** 2
@@ -145,7 +146,7 @@ def asymptotic_coefficients(
 
 
 def _inverse_r_moment(quad: PressureQuadrature, nx: float, ny: float) -> float:
-    """T = ∬ σ (n̂·ê_r)²/r dA about the origin (Pa·m).
+    """T = ∬ σ (n̂·ê_r)²/r dA about the origin (N/m), n̂ = (nx, ny).
 
     The integrand is singular like 1/r at the origin; when the origin lies in the
     domain, σ(0) + ∇σ(0)·p is subtracted and integrated exactly along rays
@@ -171,3 +172,26 @@ def _inverse_r_moment(quad: PressureQuadrature, nx: float, ny: float) -> float:
     pr2 = (nx * c + ny * sn) ** 2
     exact = (2.0 * np.pi / n) * np.sum(pr2 * (s0 * rho + (gx * c + gy * sn) * rho**2 / 2.0))
     return float(rem @ (proj2 * inv * da)) + float(exact)
+
+
+def paper_coefficients(tensors, f: float, k_x: float = 0.0) -> dict[str, float]:
+    """F0, M0, a, m of the paper's definitions for a map's pressure integrals.
+
+    ``tensors``: :class:`~fepost.friction.tensors.MapTensors` (R = ``tensors.radius``).
+    With A⁰ = tr S/(2πR), A¹ = N/(2πR²), A² = ∬σ r dA/(2πR³), A³ = tr Q/(2πR⁴)
+    (the angular means of the same integrals), √a = 2A¹/A⁰ and √m = 2A²/A³:
+    a = (2N/(R tr S))², m = (2R ∬σ r dA/tr Q)². ``k_x`` is passed through.
+    """
+    R = tensors.radius
+    a = (2.0 * tensors.N / (R * float(np.trace(tensors.inverse)))) ** 2
+    m = (2.0 * R * tensors.polar / float(np.trace(tensors.second))) ** 2
+    return {"F0": f * tensors.N, "M0": f * tensors.polar, "a": a, "m": m, "k_x": float(k_x), "radius": R}
+
+
+def paper_model(F0: float, M0: float, a: float, m: float, k_x: float, radius: float):
+    """The closed forms as a callable (vx, vy, wz) → (Fx, Fy, Mz), like the generalised model."""
+
+    def predict(vx, vy, wz):
+        return components(vx, vy, wz, F0=F0, M0=M0, a=a, m=m, k_x=k_x, radius=radius)
+
+    return predict

@@ -36,6 +36,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .._arrays import frozen
 from ..errors import ArgumentError
@@ -259,12 +260,21 @@ def friction_resultants(
         sx[sl], sy[sl] = _chunk(nodes, law, vx[sl], vy[sl], wz[sl])
 
     workers = threads or os.cpu_count() or 1
-    if workers > 1 and len(starts) > 1:
-        with ThreadPoolExecutor(max_workers=min(workers, len(starts))) as pool:
-            list(pool.map(work, starts))
-    else:
-        for start in starts:
-            work(start)
+    # Parallel over chunks, one BLAS thread each: a multi-threaded BLAS under our
+    # own thread pool oversubscribes the cores (5x slower on a busy 2-core machine).
+    with threadpool_limits(limits=1, user_api="blas"):
+        if workers > 1 and len(starts) > 1:
+            with ThreadPoolExecutor(max_workers=min(workers, len(starts))) as pool:
+                list(pool.map(work, starts))
+        else:
+            for start in starts:
+                work(start)
+        return _finish(quad, law, sigma_ref, order, vx, vy, wz, sx, sy, shape)
+
+
+def _finish(quad, law, sigma_ref, order, vx, vy, wz, sx, sy, shape) -> Resultants:
+    """Resultants from the node sums, with the ICR subtraction where it applies."""
+    k = vx.size
 
     alpha = law.anisotropy
     fx = -sx[:, 0]
