@@ -16,14 +16,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from model_maps import RADIUS, asymmetric, ellipse_quad, reference_tensors, tire_like
 
 from fepost.errors import ArgumentError, DataError
-from fepost.friction.build import build_model
+from fepost.friction.build import AUTO_TARGET, DEFAULT_ORDER, build_model
 from fepost.friction.closed_form import paper_coefficients, paper_model
 from fepost.friction.exact import friction_resultants
 from fepost.friction.law import FrictionLaw
 from fepost.friction.model import GeneralisedModel
+from fepost.friction.reference_maps import RADIUS, asymmetric, ellipse_quad, reference_tensors, tire_like
 from fepost.friction.sphere import error_map
 from fepost.friction.tensors import effective_quadrature, map_tensors
 
@@ -42,7 +42,7 @@ def models():
     out = {}
     for profile, aspect in MAPS:
         quad = ellipse_quad(profile, aspect)
-        out[profile, aspect] = (quad, build_model(quad, LAW, check=False))
+        out[profile, aspect] = (quad, build_model(quad, LAW, order=DEFAULT_ORDER, check=False))
     return out
 
 
@@ -97,6 +97,10 @@ def test_pressure_dependent_law_is_folded_into_the_pressure():
 def test_speed_dependent_law_is_refused():
     with pytest.raises(ArgumentError, match="speed_coef"):
         build_model(ellipse_quad(), FrictionLaw(f=F, speed_coef=0.1))
+    with pytest.raises(ArgumentError, match="order must be"):
+        build_model(ellipse_quad(), LAW, order="best")
+    with pytest.raises(ArgumentError, match="too coarse"):
+        build_model(ellipse_quad(), LAW, order=(4, 8), grid=(8, 8))
 
 
 # -- exact limits -----------------------------------------------------------------------
@@ -164,7 +168,7 @@ def test_asymmetric_limits_rolling_shift():
     M_z = −f N x_c × v̂ with x_c = k ⟨x²⟩/R."""
     k = 0.13
     quad = ellipse_quad("hertz", 1.0, k_x=k)
-    model = build_model(quad, LAW, check=False)
+    model = build_model(quad, LAW, order=DEFAULT_ORDER, check=False)
     ref = reference_tensors("hertz", 1.0)
     R, N, M0 = RADIUS, ref["N"], F * ref["polar"]
     for sgn in (1.0, -1.0):
@@ -270,16 +274,27 @@ GOAL_MAPS = {
 @pytest.mark.parametrize("name", list(GOAL_MAPS))
 def test_accuracy_goal_over_the_sphere(name):
     quad = GOAL_MAPS[name]()
-    model = build_model(quad, LAW, check=False)
+    model = build_model(quad, LAW, order=DEFAULT_ORDER, check=False)
     em = error_map(quad, {"model": model}, law=LAW, F0=model.F0, M0=model.M0, R=model.R, n_beta=13, n_t=41)
     worst = em.worst("model")
     assert worst["force"] <= GOAL, worst
     assert worst["torque"] <= GOAL, worst
 
 
+def test_auto_order_climbs_where_the_patch_is_long():
+    short = build_model(ellipse_quad("hertz", 1.5), LAW)
+    assert short.order == DEFAULT_ORDER
+    long = build_model(ellipse_quad("uniform", 3.0), LAW)
+    assert long.order > DEFAULT_ORDER
+    assert max(long.accuracy["model_force"], long.accuracy["model_torque"]) <= AUTO_TARGET
+    quad = ellipse_quad("uniform", 3.0)
+    em = error_map(quad, {"m": long}, law=LAW, F0=long.F0, M0=long.M0, R=long.R, n_beta=7, n_t=41)
+    assert em.worst("m")["torque"] <= GOAL
+
+
 def test_build_measures_its_own_accuracy():
     quad = tire_like(2.0)
-    model = build_model(quad, LAW)
+    model = build_model(quad, LAW, order=DEFAULT_ORDER)
     acc = model.accuracy
     assert acc["model_force"] <= GOAL and acc["model_torque"] <= GOAL
     assert acc["base_force"] > acc["model_force"] and acc["base_torque"] > acc["model_torque"]

@@ -43,7 +43,13 @@ DEFAULT_ORDER = (4, 8)
 #: Default fit grid (θ nodes, t nodes): 768 kinematic points, 2304 equations.
 FIT_GRID = (32, 24)
 #: Validation grid (θ nodes, t nodes).
-CHECK_GRID = (32, 25)
+CHECK_GRID = (32, 33)
+#: ``order="auto"`` tries these (order, fit grid) in turn ...
+AUTO_LADDER = (((4, 8), (32, 24)), ((6, 10), (40, 28)), ((8, 12), (48, 32)))
+#: ... and stops at the first whose largest error on the check grid (F/F0 or M/M0)
+#: is at most this. The check grid sees ~2/3 of the sphere's worst error
+#: (benchmarks/bench_model.py), so 0.015 here keeps the sphere under the 3 % goal.
+AUTO_TARGET = 0.015
 
 
 def base_coefficients(tensors: MapTensors, f: float) -> dict:
@@ -91,8 +97,8 @@ def build_model(
     law: FrictionLaw | None = None,
     *,
     radius: float | None = None,
-    order=DEFAULT_ORDER,
-    grid=FIT_GRID,
+    order="auto",
+    grid=None,
     check: bool = True,
 ) -> GeneralisedModel:
     """The generalised model of the map ``quad`` under ``law`` (default Coulomb, f = 0.3).
@@ -100,10 +106,23 @@ def build_model(
     ``radius``: R (m) of u = ω_z R (default ``quad.radius``; any R gives the same
     predictions, only the dimensionless coefficients change). ``order``: (K, L)
     of the correction ((2K + 1)·L numbers; the base alone is
-    :meth:`GeneralisedModel.without_correction`).
-    ``grid``: (θ nodes, t nodes) of the fit. ``check``: measure the accuracy on a
-    staggered grid (module docstring). A speed-dependent law is refused.
+    :meth:`GeneralisedModel.without_correction`), or ``"auto"`` (default): the
+    first of :data:`AUTO_LADDER` whose check-grid error is within
+    :data:`AUTO_TARGET` (72 numbers up to aspect ~2.5, more beyond).
+    ``grid``: (θ nodes, t nodes) of the fit (default: :data:`FIT_GRID`, or the
+    ladder's). ``check``: measure the accuracy on a staggered grid (module
+    docstring; always done with ``"auto"``). A speed-dependent law is refused.
     """
+    if isinstance(order, str):
+        if order != "auto":
+            raise ArgumentError(f"order must be (K, L) or 'auto', got {order!r}")
+        for rung, rung_grid in AUTO_LADDER[:-1]:
+            model = build_model(quad, law, radius=radius, order=rung, grid=grid or rung_grid, check=True)
+            if max(model.accuracy["model_force"], model.accuracy["model_torque"]) <= AUTO_TARGET:
+                return model
+        rung, rung_grid = AUTO_LADDER[-1]
+        return build_model(quad, law, radius=radius, order=rung, grid=grid or rung_grid, check=True)
+    grid = FIT_GRID if grid is None else grid
     law = FrictionLaw() if law is None else law
     eq = effective_quadrature(quad, law)  # validates quad and law
     K, L = _check_order(order)
@@ -207,7 +226,9 @@ def measure_accuracy(model: GeneralisedModel, quad: PressureQuadrature, law: Fri
     vx, vy = c * vx - s * vy, s * vx + c * vy
     wz = u / model.R
     exact = friction_resultants(quad, vx, vy, wz, law)
-    out: dict[str, object] = {"grid": f"{n_theta} directions x {n_t} t-nodes (Chebyshev, ends included), staggered"}
+    out: dict[str, object] = {
+        "grid": f"{n_theta} directions x {n_t} t-nodes (Chebyshev, ends included), staggered"
+    }
     for name, m in (("model", model), ("base", model.without_correction())):
         fx, fy, mz = m(vx, vy, wz)
         out[f"{name}_force"] = float(np.max(np.hypot(fx - exact.Fx, fy - exact.Fy)) / model.F0)

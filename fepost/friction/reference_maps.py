@@ -1,4 +1,8 @@
-"""Pressure maps for the generalised-model tests, with their pressure integrals in closed form.
+"""Reference pressure maps for the friction models, with their pressure integrals in closed form.
+
+Used by the tests and ``benchmarks/bench_model.py`` to check the generalised model
+on patches of known shape (ellipses of any aspect, a tire-like rounded rectangle,
+an asymmetric rolling-like map).
 
 An elliptic map σ = σ0 p(s), s = r/ρ_b(φ), on the ellipse with semi-axes (A, B)
 (ρ_b(φ) = 1/√(cos²φ/A² + sin²φ/B²)) has
@@ -15,10 +19,11 @@ from __future__ import annotations
 import numpy as np
 from scipy import integrate
 
-from fepost.analytic import pressure_function
-from fepost.friction.quadrature import PressureQuadrature, edge_grid
-from fepost.polar import PolarMap
+from ..analytic import pressure_function
+from ..polar import PolarMap
+from .quadrature import PressureQuadrature, edge_grid
 
+#: Radius (m) of the equal-area disc of every reference map, and its peak pressure (Pa).
 RADIUS = 0.1
 PEAK = 2.0e5
 MK = {
