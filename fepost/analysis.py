@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +44,13 @@ class Analysis:
     def grid(self) -> PolarGrid:
         return self.static_map.grid
 
+    @cached_property
+    def model_summary(self):
+        """The generalised friction model of these maps (:mod:`fepost.friction.summary`)."""
+        from .friction.summary import summarise
+
+        return summarise(self)
+
     def to_dict(self) -> dict:
         """The coefficients JSON of INTERFACE.md (SI units), with provenance."""
         d = self.coefficients.to_dict()
@@ -69,6 +77,7 @@ class Analysis:
                 "centre_of_pressure": list(self.rolling_patch.centre_of_pressure),
                 "grid_radius": self.rolling_map.radius,
             }
+        d["model"] = self.model_summary.to_dict()  # generalised model (fepost.friction.summary)
         return d
 
 

@@ -59,6 +59,7 @@ def format_analysis(a: Analysis) -> str:
             ("x_c (rolling CoP shift)", f"{c.x_c:.6g} m"),
             ("k_x", f"{c.k_x:.6g}"),
         ]
+    rows += a.model_summary.lines()  # generalised model (fepost.friction.summary)
     g = a.grid
     rows.append(("polar grid", f"{g.rule}, {g.shape[0]} x {g.shape[1]} (r x phi)"))
     width = max(len(k) for k, _ in rows)

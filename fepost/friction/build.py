@@ -100,6 +100,7 @@ def build_model(
     order="auto",
     grid=None,
     check: bool = True,
+    compare=None,
 ) -> GeneralisedModel:
     """The generalised model of the map ``quad`` under ``law`` (default Coulomb, f = 0.3).
 
@@ -111,17 +112,24 @@ def build_model(
     :data:`AUTO_TARGET` (72 numbers up to aspect ~2.5, more beyond).
     ``grid``: (θ nodes, t nodes) of the fit (default: :data:`FIT_GRID`, or the
     ladder's). ``check``: measure the accuracy on a staggered grid (module
-    docstring; always done with ``"auto"``). A speed-dependent law is refused.
+    docstring; always done with ``"auto"``). ``compare``: another model, a callable
+    (vx, vy, wz) → (Fx, Fy, Mz) such as the paper's closed forms, whose errors the
+    check also records (``accuracy["compare_force"]``, ``["compare_torque"]``).
+    A speed-dependent law is refused.
     """
     if isinstance(order, str):
         if order != "auto":
             raise ArgumentError(f"order must be (K, L) or 'auto', got {order!r}")
         for rung, rung_grid in AUTO_LADDER[:-1]:
-            model = build_model(quad, law, radius=radius, order=rung, grid=grid or rung_grid, check=True)
+            model = build_model(
+                quad, law, radius=radius, order=rung, grid=grid or rung_grid, check=True, compare=compare
+            )
             if max(model.accuracy["model_force"], model.accuracy["model_torque"]) <= AUTO_TARGET:
                 return model
         rung, rung_grid = AUTO_LADDER[-1]
-        return build_model(quad, law, radius=radius, order=rung, grid=grid or rung_grid, check=True)
+        return build_model(
+            quad, law, radius=radius, order=rung, grid=grid or rung_grid, check=True, compare=compare
+        )
     grid = FIT_GRID if grid is None else grid
     law = FrictionLaw() if law is None else law
     eq = effective_quadrature(quad, law)  # validates quad and law
@@ -190,7 +198,7 @@ def build_model(
         **{**_fields(base), "correction": correction, "correction_g": correction_g, "source": quad.source}
     )
     if check:
-        acc = measure_accuracy(model, quad, law, CHECK_GRID)
+        acc = measure_accuracy(model, quad, law, CHECK_GRID, compare=compare)
         model = GeneralisedModel(**{**_fields(model), "accuracy": acc})
     return model
 
@@ -215,9 +223,12 @@ def _fields(m: GeneralisedModel) -> dict:
     }
 
 
-def measure_accuracy(model: GeneralisedModel, quad: PressureQuadrature, law: FrictionLaw, grid) -> dict:
-    """Largest |ΔF|/F0 (vector difference) and |ΔM_z|/M0 of the model and of its base
-    against the exact integrals, on a θ × t grid with t at Chebyshev nodes (ends included)."""
+def measure_accuracy(
+    model: GeneralisedModel, quad: PressureQuadrature, law: FrictionLaw, grid, compare=None
+) -> dict:
+    """Largest |ΔF|/F0 (vector difference) and |ΔM_z|/M0 of the model, of its base (and of
+    ``compare``) against the exact integrals, on a θ × t grid with t at Chebyshev nodes
+    (ends included)."""
     n_theta, n_t = (int(v) for v in grid)
     t = 0.5 - 0.5 * np.cos(np.pi * np.arange(n_t) / (n_t - 1))
     vx, vy, u, th, _ = sphere_nodes(n_theta, t)
@@ -229,7 +240,10 @@ def measure_accuracy(model: GeneralisedModel, quad: PressureQuadrature, law: Fri
     out: dict[str, object] = {
         "grid": f"{n_theta} directions x {n_t} t-nodes (Chebyshev, ends included), staggered"
     }
-    for name, m in (("model", model), ("base", model.without_correction())):
+    models = [("model", model), ("base", model.without_correction())]
+    if compare is not None:
+        models.append(("compare", compare))
+    for name, m in models:
         fx, fy, mz = m(vx, vy, wz)
         out[f"{name}_force"] = float(np.max(np.hypot(fx - exact.Fx, fy - exact.Fy)) / model.F0)
         out[f"{name}_torque"] = float(np.max(np.abs(mz - exact.Mz)) / model.M0)

@@ -1,0 +1,63 @@
+"""``fepost predict STATIC [--rolling R] --kinematics CSV [--friction F] --out CSV [--model-json PATH]``.
+
+For each row (vx, vy, wz) of the kinematics CSV, writes the friction force and
+torque of the exact Coulomb integrals over the FE map, of the paper's closed
+forms and of the generalised model (columns in :mod:`fepost.friction.predict`),
+same rows in the same order, atomically. ``--model-json`` also writes the
+generalised model's coefficients (the export documented in ``docs/model.md``).
+Module-level imports stay light: the work is imported inside :func:`run`.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_parser(sub) -> None:
+    from ._common import add_friction_option, add_input_options
+
+    p = sub.add_parser(
+        "predict",
+        help="friction force and torque for given kinematics: exact integrals, paper, generalised model",
+        description=(
+            "Read vx, vy (m/s) and wz (rad/s) from a CSV and write, row by row, Fx, Fy (N) and Mz (N m, "
+            "about the patch origin) of the exact friction integrals over the FE map, of the paper's "
+            "closed forms and of the generalised model for non-circular patches. With --rolling the "
+            "rolling map is used (the tire rolls); without, the static map."
+        ),
+    )
+    p.add_argument("static", metavar="STATIC", help="static contact map (.vtu .vtk .vtp .e .exo)")
+    p.add_argument("--rolling", metavar="ROLLING", help="rolling contact map at the same deflection")
+    p.add_argument(
+        "--kinematics",
+        required=True,
+        metavar="CSV",
+        help="CSV with columns vx, vy (m/s) and wz (rad/s); other columns are ignored",
+    )
+    add_friction_option(p)
+    p.add_argument("--out", required=True, metavar="CSV", help="output CSV (written atomically)")
+    p.add_argument("--model-json", metavar="PATH", help="also write the generalised model's coefficients")
+    add_input_options(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..analysis import analyse
+    from ..friction.predict import predict, read_kinematics
+    from ..output import write_text_atomic
+    from ._common import analysis_kwargs
+
+    kin = read_kinematics(args.kinematics)  # bad CSV: fail before the FE work
+    result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
+    pred = predict(result, kin.vx, kin.vy, kin.wz)
+    write_text_atomic(args.out, pred.to_csv())
+    if args.model_json:
+        write_text_atomic(args.model_json, pred.model.to_json() + "\n")
+    acc = pred.model.accuracy
+    print(
+        f"{len(kin)} rows -> {args.out} ({pred.map} map, R = {result.coefficients.R:.6g} m); "
+        f"generalised model within {acc['model_force']:.1%} of F0 and {acc['model_torque']:.1%} of M0 "
+        f"of the exact integrals over the sphere (paper's forms: {acc['compare_force']:.0%}, "
+        f"{acc['compare_torque']:.0%})"
+    )
+    return 0

@@ -1,0 +1,222 @@
+"""Resultants of given kinematics by the three models: exact integrals, paper, generalised.
+
+Input CSV (header row, one row per kinematic point, other columns ignored;
+blank lines and lines starting with ``#`` skipped):
+
+======== ==============================================================
+``vx``   sliding velocity of the patch origin against the road, m/s
+``vy``   (patch frame: x rolling direction, y lateral)
+``wz``   spin about the road normal, rad/s
+======== ==============================================================
+
+Output CSV, same rows in the same order: ``vx, vy, wz``, then ``Fx, Fy, Mz``
+(forces on the tire in N, torque about the patch origin in N·m) of
+
+* ``*_exact``: the exact Coulomb integrals over the FE map,
+* ``*_paper``: the paper's closed forms (1.3)/(1.7) with F0, M0, a, m (and k_x),
+* ``*_model``: the generalised model built from the map (:mod:`fepost.friction.build`).
+
+With a rolling map the kinematics are those of the rolling tire: the exact
+integrals and the generalised model use the rolling map (in the static patch's
+frame), the closed forms add F⊥ with k_x. Without one, the static map and
+k_x = 0. Every problem with the CSV is a one-line
+:class:`~fepost.errors.DataError` naming the file, the line and the column.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .._arrays import frozen
+from ..errors import ArgumentError, DataError
+from .closed_form import components
+from .exact import Resultants, friction_resultants
+from .law import FrictionLaw
+from .model import GeneralisedModel
+from .quadrature import PressureQuadrature
+
+if TYPE_CHECKING:
+    from ..analysis import Analysis
+
+COLUMNS = ("vx", "vy", "wz")
+OUTPUT_COLUMNS = COLUMNS + tuple(
+    f"{q}_{m}" for m in ("exact", "paper", "model") for q in ("Fx", "Fy", "Mz")
+)
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """Kinematic points read from a CSV: ``vx``, ``vy`` (m/s), ``wz`` (rad/s) and the
+    1-based ``lines`` they came from."""
+
+    vx: np.ndarray
+    vy: np.ndarray
+    wz: np.ndarray
+    lines: np.ndarray
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        for name in ("vx", "vy", "wz"):
+            object.__setattr__(self, name, frozen(getattr(self, name)))
+        object.__setattr__(self, "lines", frozen(self.lines, dtype=int))
+
+    def __len__(self) -> int:
+        return int(self.vx.size)
+
+
+def _number(text: str, where: str, column: str) -> float:
+    cell = text.strip()
+    try:
+        value = float(cell)
+    except ValueError:
+        shown = cell if cell else "an empty cell"
+        raise DataError(f"{where}, column {column}: not a number: {shown!r}") from None
+    if not np.isfinite(value):
+        raise DataError(f"{where}, column {column}: not a finite number: {cell!r}")
+    return value
+
+
+def parse_kinematics(text: str, source: str = "") -> Kinematics:
+    """Parse the kinematics CSV ``text`` (module docstring); ``source`` names it in messages."""
+    src = f"{source}: " if source else ""
+    rows: list[tuple[int, list[str]]] = []
+    try:
+        for lineno, line in enumerate(io.StringIO(text), start=1):
+            stripped = line.strip()
+            if not stripped or stripped.startswith("#"):
+                continue
+            rows.append((lineno, next(csv.reader([line.rstrip("\r\n")]))))
+    except csv.Error as exc:
+        raise DataError(f"{src}not a CSV file ({exc})") from None
+    if not rows:
+        raise DataError(f"{src}no header row: the file is empty or only comments")
+    head_line, header = rows[0]
+    names = [h.strip() for h in header]
+    index: dict[str, int] = {}
+    for j, name in enumerate(names):
+        if name in index and name in COLUMNS:
+            raise DataError(f"{src}line {head_line}: column {name!r} appears twice in the header")
+        index.setdefault(name, j)
+    missing = [c for c in COLUMNS if c not in index]
+    if missing:
+        got = ", ".join(repr(n) for n in names if n) or "none"
+        raise DataError(f"{src}missing column(s) {', '.join(missing)} in the header (found {got})")
+    values: dict[str, list[float]] = {c: [] for c in COLUMNS}
+    lines = []
+    for lineno, fields in rows[1:]:
+        where = f"{src}line {lineno}"
+        for c in COLUMNS:
+            if index[c] >= len(fields):
+                raise DataError(
+                    f"{where}, column {c}: missing ({len(fields)} fields, the header has {len(names)})"
+                )
+            values[c].append(_number(fields[index[c]], where, c))
+        lines.append(lineno)
+    if not lines:
+        raise DataError(f"{src}no data rows after the header")
+    return Kinematics(
+        *(np.asarray(values[c], float) for c in COLUMNS), lines=np.asarray(lines), source=source
+    )
+
+
+def read_kinematics(path) -> Kinematics:
+    """Read a kinematics CSV file (module docstring)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise DataError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise DataError(f"{path}: is a folder, not a CSV file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DataError(f"{path}: cannot read the kinematics ({exc.__class__.__name__})") from None
+    if "\x00" in text:
+        raise DataError(f"{path}: not a text CSV file (binary data)")
+    return parse_kinematics(text, source=str(path))
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """The three models' resultants at the same kinematic points (module docstring).
+
+    ``map`` says which pressure map the exact integrals and the generalised model
+    used (``"static"`` or ``"rolling"``); ``model`` is that generalised model.
+    """
+
+    vx: np.ndarray
+    vy: np.ndarray
+    wz: np.ndarray
+    exact: Resultants
+    paper: Resultants
+    generalised: Resultants
+    model: GeneralisedModel
+    map: str
+
+    def __post_init__(self) -> None:
+        for name in ("vx", "vy", "wz"):
+            object.__setattr__(self, name, frozen(getattr(self, name)))
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The output columns, in the order of :data:`OUTPUT_COLUMNS`."""
+        out = {"vx": self.vx, "vy": self.vy, "wz": self.wz}
+        for tag, res in (("exact", self.exact), ("paper", self.paper), ("model", self.generalised)):
+            out[f"Fx_{tag}"], out[f"Fy_{tag}"], out[f"Mz_{tag}"] = res.Fx, res.Fy, res.Mz
+        return out
+
+    def to_csv(self) -> str:
+        """The output CSV text (repr-exact floats)."""
+        cols = self.columns()
+        buf = io.StringIO()
+        buf.write(",".join(OUTPUT_COLUMNS) + "\n")
+        table = np.column_stack([cols[c] for c in OUTPUT_COLUMNS])
+        for row in table:
+            buf.write(",".join(repr(float(v)) for v in row) + "\n")
+        return buf.getvalue()
+
+
+def predict(
+    analysis: Analysis,
+    vx,
+    vy,
+    wz,
+    *,
+    model: GeneralisedModel | None = None,
+) -> Prediction:
+    """Exact, paper and generalised resultants for the kinematics (vx, vy in m/s, wz in rad/s).
+
+    ``model``: the generalised model to use (default: built from the analysis's
+    rolling map when it has one, else its static map; see
+    :func:`fepost.friction.summary.map_model`).
+    """
+    from ..analysis import Analysis
+    from .summary import map_model
+
+    if not isinstance(analysis, Analysis):
+        raise ArgumentError(f"analysis must be an Analysis, got {type(analysis).__name__}")
+    vx, vy, wz = (np.atleast_1d(np.asarray(a, float)) for a in np.broadcast_arrays(vx, vy, wz))
+    c = analysis.coefficients
+    rolling = analysis.rolling_map is not None
+    pmap = analysis.rolling_map if rolling else analysis.static_map
+    if model is None:
+        model = map_model(analysis, rolling)
+    elif not isinstance(model, GeneralisedModel):
+        raise ArgumentError(f"model must be a GeneralisedModel, got {type(model).__name__}")
+    exact = friction_resultants(PressureQuadrature.from_polar(pmap), vx, vy, wz, FrictionLaw(f=c.f))
+    k_x = c.k_x if (rolling and c.k_x is not None) else 0.0
+    paper = Resultants(*components(vx, vy, wz, F0=c.F0, M0=c.M0, a=c.a, m=c.m, k_x=k_x, radius=c.R))
+    return Prediction(
+        vx=vx,
+        vy=vy,
+        wz=wz,
+        exact=exact,
+        paper=paper,
+        generalised=model.resultants(vx, vy, wz),
+        model=model,
+        map="rolling" if rolling else "static",
+    )
