@@ -34,11 +34,14 @@ from .identify import (
     DEFAULT_N_POINTS,
     DEFAULT_SPAN,
     BiasReport,
+    GeneralisedCurves,
     Identification,
     TestCurves,
     approximation_bias,
     fit_table1,
     make_test_curves,
+    rolling_model,
+    with_noise,
 )
 
 #: Seed of the committed Table 1 (``fepost table1`` without ``--seed``).
@@ -116,6 +119,42 @@ class Row:
 
 
 @dataclass(frozen=True)
+class GeneralisedTable:
+    """The generalised model fitted to the exact-integral curves (same grid, noise and seed).
+
+    ``rows``: f, F0, M0, a, m, k_x with ``theory`` from the FE maps (a, m along x,
+    β = 0: the direction of the test curves); ``identification``: the fit;
+    ``curves``: the noisy exact-integral data; ``form``: the fitted
+    :class:`~fepost.identify.GeneralisedCurves` (its two models).
+    """
+
+    rows: tuple[Row, ...]
+    identification: Identification
+    curves: TestCurves
+    form: GeneralisedCurves
+
+    def row(self, name: str) -> Row:
+        for r in self.rows:
+            if r.name == name:
+                return r
+        raise ArgumentError(f"name must be one of {', '.join(ROW_NAMES)}, got {name!r}")
+
+    def to_dict(self) -> dict:
+        models = {}
+        for tag, m in (("static", self.form.static), ("rolling", self.form.rolling)):
+            K, L = m.order
+            models[tag] = {"order": [K, L], "accuracy": dict(m.accuracy), "source": m.source}
+        return {
+            "rows": [r.to_dict() for r in self.rows],
+            "source": self.curves.source,
+            "form": "generalised",
+            "theory": "F0, M0 and a, m along x (beta = 0) of the generalised model built from the FE maps",
+            "fit": self.identification.to_dict(),
+            "models": models,
+        }
+
+
+@dataclass(frozen=True)
 class Table1:
     """The identification experiment's result (see the module docstring).
 
@@ -140,6 +179,7 @@ class Table1:
     span: float
     R: float
     N: float
+    generalised: GeneralisedTable | None = None
 
     def row(self, name: str) -> Row:
         for r in self.rows:
@@ -168,6 +208,7 @@ class Table1:
             "fit": self.identification.to_dict(),
             "noise_description": dict(self.curves.noise),
             "exact_bias": self.bias.to_dict() if self.bias is not None else None,
+            "generalised": self.generalised.to_dict() if self.generalised is not None else None,
             "notes": list(self.notes),
         }
 
@@ -242,8 +283,33 @@ def format_table(t: Table1) -> str:
             "  with the paper's noise, the 95 % bounds miss the asymptotic value of: "
             + (", ".join(missed) if missed else "none (the noise hides the bias at this sample size)"),
         ]
+    if t.generalised is not None:
+        out += ["", _format_generalised(t.generalised)]
     out += [""] + [f"note: {n}" for n in t.notes]
     return "\n".join(out)
+
+
+def _format_generalised(g: GeneralisedTable) -> str:
+    cols = ("coef", "theory", "fitted", "95 % bounds")
+    body = [
+        (
+            r.name + (f" ({r.unit})" if r.unit else ""),
+            _num(r.theory),
+            _num(r.fitted),
+            f"{_num(r.ci95[0])}, {_num(r.ci95[1])}" + ("" if r.covered else " !"),
+        )
+        for r in g.rows
+    ]
+    widths = [max(len(c), *(len(b[i]) for b in body)) for i, c in enumerate(cols)]
+    line = lambda cells: "  ".join(f"{c:<{w}}" for c, w in zip(cells, widths, strict=True)).rstrip()  # noqa: E731
+    acc = g.form.static.accuracy
+    head = (
+        "generalised model fitted to the exact-integral curves (same points, noise and seed); "
+        "theory a, m along x (beta = 0)\n"
+        f"model within {acc.get('model_force', float('nan')):.3f} F0 / "
+        f"{acc.get('model_torque', float('nan')):.3f} M0 of the exact integrals over the sphere (check grid)"
+    )
+    return "\n".join([head, "", line(cols), line(tuple("-" * w for w in widths))] + [line(b) for b in body])
 
 
 def table1(
@@ -258,6 +324,7 @@ def table1(
     k_x: float | None = None,
     bias: bool = True,
     profile: bool = True,
+    generalised: bool = True,
 ) -> Table1:
     """Run the identification experiment on ``analysis`` (see the module docstring).
 
@@ -267,6 +334,8 @@ def table1(
     analysis has no rolling map (default :data:`PAPER_K_X`); an error when it has one.
     ``bias``: also run :func:`fepost.identify.approximation_bias` (exact integrals).
     ``profile``: profile-likelihood bounds for a and m.
+    ``generalised``: also fit the generalised model to exact-integral curves made
+    with the same points, noise and seed (:class:`GeneralisedTable`).
     """
     if not isinstance(analysis, Analysis):
         raise ArgumentError(f"analysis must be an Analysis, got {type(analysis).__name__}")
@@ -330,6 +399,19 @@ def table1(
                 paper=PAPER_TABLE1[name],
             )
         )
+    gen = None
+    if generalised:
+        gen = _generalised_table(
+            c,
+            quad,
+            rolling_quad,
+            kx,
+            n_points=n_points,
+            span=span,
+            noise=noise,
+            amplitude=amplitude,
+            seed=seed,
+        )
     notes = [
         f"theory: a, m from the moments (asymptotic values), R = r_max = {c.R:.5g} m; f = F0/N with N known",
         "bounds: Wald, t-quantile on the covariance (theta = F0, M0, ln a, ln m, k_x; "
@@ -356,4 +438,40 @@ def table1(
         span=float(span),
         R=float(c.R),
         N=float(c.N),
+        generalised=gen,
     )
+
+
+def _generalised_table(
+    c, quad, rolling_quad, kx, *, n_points, span, noise, amplitude, seed
+) -> GeneralisedTable:
+    """Build the two generalised models, make the exact curves, fit (no profile bounds)."""
+    from .friction.build import build_model
+    from .friction.law import FrictionLaw
+
+    law = FrictionLaw(f=c.f)
+    roll = rolling_quad if rolling_quad is not None else rolling_model(quad, kx, c.R)
+    form = GeneralisedCurves(
+        static=build_model(quad, law, radius=c.R), rolling=build_model(roll, law, radius=c.R), k_ref=kx
+    )
+    truth = {"F0": c.F0, "M0": c.M0, "a": c.a, "m": c.m, "k_x": kx, "R": c.R, "N": c.N}
+    clean = make_test_curves(
+        "exact", truth, quad=quad, rolling_quad=roll, n_points=n_points, span=span, amplitude=0.0
+    )
+    curves = with_noise(clean, noise=noise, amplitude=amplitude, seed=seed)
+    fit = fit_table1(curves, c.N, form=form, profile=False)
+    theory = {"f": form.static.F0 / c.N, **form.theory()}
+    rows = tuple(
+        Row(
+            name=name,
+            theory=float(theory[name]),
+            fitted=fit.value(name),
+            ci95=fit.interval(name),
+            profile_ci95=None,
+            profile_agrees=None,
+            unit=_UNITS[name],
+            paper=PAPER_TABLE1[name],
+        )
+        for name in ROW_NAMES
+    )
+    return GeneralisedTable(rows=rows, identification=fit, curves=curves, form=form)

@@ -461,7 +461,7 @@ def test_failed_profile_refit_warns_and_leaves_nan(truth, monkeypatch):
     def fail(*args, **kwargs):
         raise FitError("least-squares fit did not converge (forced)")
 
-    monkeypatch.setattr(identify, "_profile", fail)
+    monkeypatch.setattr(identify.fit, "_profile", fail)
     c = make_test_curves("closed_form", truth, seed=1)
     with pytest.warns(FitWarning, match=r"^profile bounds of (a|m) not computed"):
         fit = fit_table1(c, truth["N"])

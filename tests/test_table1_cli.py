@@ -80,12 +80,32 @@ def test_table_carries_paper_values_notes_and_bias(committed):
         assert word in text
 
 
+def test_generalised_rows_beside_the_paper_rows(committed, analysis):
+    """The generalised model fitted to exact-integral curves: every interval holds the
+    map's value; the contract's ``rows`` are untouched."""
+    g = committed.generalised
+    assert g is not None and g.curves.source == "exact"
+    assert [r.name for r in g.rows] == list(ROW_NAMES)
+    c = analysis.coefficients
+    theory = {"f": c.f, "F0": c.F0, "M0": c.M0, "a": c.a, "m": c.m, "k_x": c.k_x}
+    for r in g.rows:  # circular map: a, m along x are the paper's a, m
+        assert r.theory == pytest.approx(theory[r.name], rel=1e-6), r.name
+        assert r.covered, r.name
+    d = committed.to_dict()
+    json.dumps(d, allow_nan=False)
+    assert [r["name"] for r in d["generalised"]["rows"]] == list(ROW_NAMES)
+    assert {"name", "theory", "fitted", "ci95"} <= set(d["generalised"]["rows"][0])
+    assert d["generalised"]["fit"]["form"] == "generalised" and d["fit"]["form"] == "paper"
+    assert [r["name"] for r in d["rows"]] == list(ROW_NAMES)
+    assert "generalised model fitted to the exact-integral curves" in format_table(committed)
+
+
 def test_without_rolling_map_k_x_is_assumed_and_said(meshes):
     a = analyse(meshes[0])
-    t = table1(a, bias=False, profile=False)
-    assert t.row("k_x").theory == 0.130
+    t = table1(a, bias=False, profile=False, generalised=False)
+    assert t.row("k_x").theory == 0.130 and t.generalised is None
     assert "assumed" in t.k_x_source and any("assumed" in n for n in t.notes)
-    assert table1(a, bias=False, profile=False, k_x=0.05).row("k_x").theory == 0.05
+    assert table1(a, bias=False, profile=False, k_x=0.05, generalised=False).row("k_x").theory == 0.05
 
 
 def test_k_x_with_a_rolling_map_is_refused(analysis):
@@ -94,7 +114,7 @@ def test_k_x_with_a_rolling_map_is_refused(analysis):
 
 
 def test_exact_source_runs_and_differs(analysis, committed):
-    t = table1(analysis, source="exact", bias=False)
+    t = table1(analysis, source="exact", bias=False, generalised=False)
     assert t.source == "exact" and t.curves.source == "exact"
     assert t.row("a").fitted != committed.row("a").fitted
 

@@ -166,6 +166,26 @@ class GeneralisedModel:
         q = np.einsum("...i,ij,...j->...", vh, self.Q, vh)
         return {"a": 1.0 / s**2, "m": (self.U0 / q) ** 2, "kappa1": q / self.U0**2, "kappa2": self.U0 * s}
 
+    def substituted(self, **arrays) -> GeneralisedModel:
+        """A copy with some of F0, M0 (positive floats) and Q, S, g, xc (arrays of their
+        shapes) replaced, without re-validating the rest (for fits that evaluate the
+        model at many coefficient values); ``accuracy`` is dropped."""
+        allowed = {"F0": (), "M0": (), "Q": (2, 2), "S": (2, 2), "g": (2,), "xc": (2,)}
+        new = object.__new__(GeneralisedModel)
+        new.__dict__.update(self.__dict__)
+        for name, value in arrays.items():
+            if name not in allowed:
+                raise ArgumentError(f"substituted takes {', '.join(allowed)}, got {name!r}")
+            if allowed[name]:
+                value = _matrix(name, value, allowed[name])
+            else:
+                value = float(value)
+                if not (np.isfinite(value) and value > 0):
+                    raise ArgumentError(f"{name} must be positive and finite, got {value!r}")
+            new.__dict__[name] = value
+        new.__dict__["accuracy"] = MappingProxyType({})
+        return new
+
     def without_correction(self) -> GeneralisedModel:
         """The base model alone (its tensors; no fitted correction): the interpretable level."""
         cg = None if self.correction_g is None else np.zeros_like(self.correction_g)

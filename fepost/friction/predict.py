@@ -45,9 +45,7 @@ if TYPE_CHECKING:
     from ..analysis import Analysis
 
 COLUMNS = ("vx", "vy", "wz")
-OUTPUT_COLUMNS = COLUMNS + tuple(
-    f"{q}_{m}" for m in ("exact", "paper", "model") for q in ("Fx", "Fy", "Mz")
-)
+OUTPUT_COLUMNS = COLUMNS + tuple(f"{q}_{m}" for m in ("exact", "paper", "model") for q in ("Fx", "Fy", "Mz"))
 
 
 @dataclass(frozen=True)
