@@ -119,7 +119,11 @@ def parse_kinematics(text: str, source: str = "") -> Kinematics:
     if not lines:
         raise DataError(f"{src}no data rows after the header")
     return Kinematics(
-        *(np.asarray(values[c], float) for c in COLUMNS), lines=np.asarray(lines), source=source
+        vx=np.asarray(values["vx"], float),
+        vy=np.asarray(values["vy"], float),
+        wz=np.asarray(values["wz"], float),
+        lines=np.asarray(lines),
+        source=source,
     )
 
 
@@ -200,7 +204,7 @@ def predict(
     vx, vy, wz = (np.atleast_1d(np.asarray(a, float)) for a in np.broadcast_arrays(vx, vy, wz))
     c = analysis.coefficients
     rolling = analysis.rolling_map is not None
-    pmap = analysis.rolling_map if rolling else analysis.static_map
+    pmap = analysis.rolling_map if analysis.rolling_map is not None else analysis.static_map
     if model is None:
         model = map_model(analysis, rolling)
     elif not isinstance(model, GeneralisedModel):
