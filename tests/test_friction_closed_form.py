@@ -185,3 +185,15 @@ def test_rolling_shift_of_shifted_map():
 def test_approximation_error_validates_upsilon():
     with pytest.raises(ArgumentError, match=r"^upsilon must hold at least 2 positive finite values"):
         approximation_error(make_quad("hertz"), F, upsilon=[1.0, -1.0])
+
+
+def test_asymptotic_a_weights_the_sliding_direction_on_an_ellipse():
+    """Near pure spin F = −(f/|ω|) S v: the slope along v̂ is v̂ᵀS v̂ (not the perpendicular
+    direction's), checked against the exact integrals on an ellipse of aspect 2."""
+    quad = make_quad("hertz").stretched(np.sqrt(2.0))
+    R, h = quad.radius, 1e-4
+    for beta in (0.0, np.pi / 2):
+        got = asymptotic_coefficients(quad, F, direction=beta)
+        ex = friction_resultants(quad, h * np.cos(beta), h * np.sin(beta), 1.0 / R, FrictionLaw(f=F))
+        slope = -(float(ex.Fx) * np.cos(beta) + float(ex.Fy) * np.sin(beta)) / (h * F * quad.load)
+        assert 1.0 / np.sqrt(got.a) == pytest.approx(slope, rel=1e-3)

@@ -154,3 +154,13 @@ def test_bad_forms_rejected(setup):
         fit_table1(clean, 1.0, form="paper")
     with pytest.raises(ArgumentError, match="R must be"):
         form("torque", [0.1], [1.0, 1.0, 1.0, 1.0, 0.1], RADIUS * 7)
+
+
+def test_curves_for_the_figures_are_the_form_at_the_maps_values(setup):
+    _, form, clean = setup
+    th = form.theory()
+    x = np.linspace(0.0, 5.0, 9)
+    got = form.curves(x)
+    for name in ("f_parallel", "torque", "f_perp"):
+        np.testing.assert_array_equal(got[name], form.values_of(name, x, [th[p] for p in PARAMETERS]))
+    assert got["f_parallel"][0] == pytest.approx(th["F0"], rel=1e-12)  # ψ = 0: pure sliding

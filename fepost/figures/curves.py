@@ -9,14 +9,21 @@ Each figure shows one quantity (F∥ against ψ = u/v, M_C and F⊥ against
 * ``test_x``, ``test_y`` — the noisy "test" points of the identification
   experiment (THEORY.md §6),
 * ``fit`` with ``band_lo`` … ``band_hi`` — the curve fitted to those points and
-  its 95 % prediction band.
+  its 95 % prediction band;
+* ``model`` — the generalised friction model built from the FE map
+  (:meth:`fepost.identify.GeneralisedCurves.curves`).
 
 Any of them but ``x`` and ``closed_form`` may be ``None``. The module computes
 nothing physical: the report assembles the arrays.
+
+Labels are plain text with subscripts written as ``M_C``, ``F_y``, ``ω_z``
+(and ``F_{xy}`` for longer ones); :func:`mathtext` turns them into matplotlib
+mathtext, so they render as subscripts, not as literal underscores.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -26,7 +33,36 @@ from .._arrays import frozen
 from ..errors import ArgumentError
 from . import theme
 
-_ARRAYS = ("x", "closed_form", "exact", "fit", "band_lo", "band_hi", "test_x", "test_y")
+_ARRAYS = ("x", "closed_form", "exact", "fit", "band_lo", "band_hi", "test_x", "test_y", "model")
+
+#: Line colour of the generalised model (purple: apart from the theme's exact/closed/fit colours).
+MODEL_COLOUR = "#7d3c98"
+#: Unicode letters mathtext spells by name.
+_TEX = {
+    "α": r"\alpha", "β": r"\beta", "ε": r"\varepsilon", "θ": r"\theta", "μ": r"\mu",
+    "ρ": r"\rho", "σ": r"\sigma", "τ": r"\tau", "υ": r"\upsilon", "φ": r"\varphi",
+    "ψ": r"\psi", "ω": r"\omega", "∥": r"\parallel", "⊥": r"\perp",
+}  # fmt: skip
+_SUBSCRIPT = re.compile(r"([A-Za-zα-ωΑ-Ω∥⊥]+)_(\{[^{}$]*\}|[A-Za-z0-9∥⊥]+)")
+
+
+def mathtext(label: str) -> str:
+    """``label`` with each ``base_sub`` turned into ``$base_{sub}$`` (mathtext).
+
+    Greek letters and ∥, ⊥ inside the math are spelled as TeX commands; text
+    already inside ``$…$`` is left alone. ``"M_C (N·m)"`` → ``"$M_{C}$ (N·m)"``.
+    """
+
+    def tex(text: str) -> str:
+        return "".join(_TEX.get(ch, ch) + (" " if ch in _TEX else "") for ch in text).strip()
+
+    def sub(m: re.Match) -> str:
+        inner = m.group(2)[1:-1] if m.group(2).startswith("{") else m.group(2)
+        return f"${tex(m.group(1))}_{{{tex(inner)}}}$"
+
+    parts = label.split("$")
+    # even parts are outside math
+    return "$".join(_SUBSCRIPT.sub(sub, p) if i % 2 == 0 else p for i, p in enumerate(parts))
 
 
 @dataclass(frozen=True)
@@ -54,6 +90,7 @@ class CurveData:
     test_x: np.ndarray | None = None
     test_y: np.ndarray | None = None
     labels: dict = field(default_factory=dict)
+    model: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         for name in _ARRAYS:
@@ -61,7 +98,7 @@ class CurveData:
             if v is not None:
                 object.__setattr__(self, name, frozen(np.ravel(v)))
         n = self.x.size
-        for name in ("closed_form", "exact", "fit", "band_lo", "band_hi"):
+        for name in ("closed_form", "exact", "fit", "band_lo", "band_hi", "model"):
             v = getattr(self, name)
             if v is not None and v.size != n:
                 raise ArgumentError(f"{self.name}: {name} has {v.size} values, x has {n}")
@@ -84,17 +121,20 @@ class CurveData:
 
 def plot_curve(data: CurveData, ax=None):
     """Plot one of Figures 4–6; return the figure. Series carry ``gid`` =
-    their field name so tests can find them."""
+    their field name so tests can find them. Title, axis labels and legend
+    entries go through :func:`mathtext`."""
     import matplotlib.pyplot as plt
 
     lab = {
         "exact": "exact integral (FE map)",
         "closed_form": "closed form (1.8)",
+        "model": "generalised model (FE map)",
         "test": "test points (20 % noise)",
         "fit": "fitted (1.8)",
         "band": "95 % prediction band",
         **data.labels,
     }
+    lab = {k: mathtext(v) for k, v in lab.items()}
     with theme.mpl_style():
         if ax is None:
             fig, ax = plt.subplots(layout="constrained")
@@ -140,6 +180,16 @@ def plot_curve(data: CurveData, ax=None):
             label=lab["closed_form"],
             gid="closed_form",
         )
+        if data.model is not None:
+            ax.plot(
+                data.x,
+                data.model,
+                color=MODEL_COLOUR,
+                lw=1.6,
+                ls=":",
+                label=lab["model"],
+                gid="model",
+            )
         if data.fit is not None:
             ax.plot(
                 data.x,
@@ -150,9 +200,9 @@ def plot_curve(data: CurveData, ax=None):
                 label=lab["fit"],
                 gid="fit",
             )
-        ax.set_xlabel(data.x_label)
-        ax.set_ylabel(data.y_label)
-        ax.set_title(data.title, fontsize=10)
+        ax.set_xlabel(mathtext(data.x_label))
+        ax.set_ylabel(mathtext(data.y_label))
+        ax.set_title(mathtext(data.title), fontsize=10)
         ax.set_xlim(float(data.x[0]), float(data.x[-1]))
         ax.axhline(0.0, color="black", lw=0.6)
         ax.legend(loc="best")
@@ -165,7 +215,7 @@ def curve_table(curves: Iterable[CurveData]) -> tuple[list[str], list[list]]:
     header = ["figure", "x_name", "series", "x", "value", "unit"]
     rows: list[list] = []
     for c in curves:
-        for series in ("exact", "closed_form", "fit", "band_lo", "band_hi"):
+        for series in ("exact", "closed_form", "model", "fit", "band_lo", "band_hi"):
             y = getattr(c, series)
             if y is not None:
                 rows += [

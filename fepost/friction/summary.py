@@ -167,3 +167,33 @@ def model_lines(analysis: Analysis) -> list[str]:
     rows = analysis.model_summary.lines()
     width = max(len(k) for k, _ in rows)
     return [f"{k:<{width}}  {v}" for k, v in rows]
+
+
+def analysis_error_map(analysis: Analysis, *, rolling: bool = False, n_beta: int = 37, n_t: int = 65):
+    """The :class:`~fepost.friction.sphere.ErrorMap` of the paper's closed forms, the
+    generalised base and the generalised model on the static (or rolling) map of
+    ``analysis``, errors scaled by the analysis's F0 and M0 (the data of
+    :func:`fepost.figures.errormap.plot_error_map`)."""
+    from .sphere import error_map
+
+    summary = analysis.model_summary
+    model = summary.rolling if rolling else summary.static
+    pmap = analysis.rolling_map if rolling else analysis.static_map
+    if model is None or pmap is None:
+        raise ArgumentError("analysis has no rolling map (give one to analyse)")
+    c = analysis.coefficients
+    k_x = c.k_x if (rolling and c.k_x is not None) else 0.0
+    return error_map(
+        PressureQuadrature.from_polar(pmap),
+        {
+            "paper": paper_model(c.F0, c.M0, c.a, c.m, k_x, c.R),
+            "base": model.without_correction(),
+            "model": model,
+        },
+        law=FrictionLaw(f=c.f),
+        F0=c.F0,
+        M0=c.M0,
+        R=c.R,
+        n_beta=n_beta,
+        n_t=n_t,
+    )

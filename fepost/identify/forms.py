@@ -197,3 +197,10 @@ class GeneralisedCurves:
             dn[j] -= h
             grad[..., j] = (self.values_of(name, x, up) - self.values_of(name, x, dn)) / (2.0 * h)
         return y, grad
+
+    def curves(self, x) -> dict[str, np.ndarray]:
+        """The three curves at the FE maps' own values (:meth:`theory`), for Figures 4–6:
+        F∥ (N) at ψ = ``x``, M_C (N·m) and F⊥ (N) at υ = ``x``."""
+        th = self.theory()
+        values = [th[p] for p in PARAMETERS]
+        return {name: self.values_of(name, x, values) for name in CURVES}
