@@ -1,4 +1,4 @@
-"""Monte-Carlo coverage of the Table 1 intervals (THEORY.md §6).
+"""Monte-Carlo coverage of the Table 1 intervals.
 
 For each seed, make closed-form test curves with the paper's noise, fit them with
 :func:`fepost.identify.fit_table1`, and count whether each 95 % interval holds the

@@ -4,14 +4,14 @@
 (:func:`fepost.identify.make_test_curves`; closed forms with the paper's 20 %
 uniform noise by default), fits them (:func:`fepost.identify.fit_table1`) and
 lays the result beside the paper's printed table, with the inconsistencies
-THEORY.md §6 lists. It also fits the closed forms to curves made by the exact
+docs/theory.md lists. It also fits the closed forms to curves made by the exact
 integrals (:func:`fepost.identify.approximation_bias`) and reports the bias the
 approximation itself causes.
 
 k_x without a rolling map
 -------------------------
-INTERFACE.md requires a k_x row. With a rolling map, k_x is the moment form
-R·x_c/⟨x²⟩ of THEORY.md §2 and the exact F⊥ curve is integrated over the real
+The table1 JSON contract has a k_x row. With a rolling map, k_x is the moment form
+R·x_c/⟨x²⟩ and the exact F⊥ curve is integrated over the real
 rolling map. Without one, the theoretical k_x is *assumed* to be the paper's
 0.130 (:data:`PAPER_K_X`, or the ``k_x`` argument), the F⊥ curve is made with it
 (closed form, or the exact integrals over σ0(1 + k_x x/R)), and the table says so:
@@ -46,7 +46,7 @@ from .identify import (
 
 #: Seed of the committed Table 1 (``fepost table1`` without ``--seed``).
 DEFAULT_SEED = 20240611
-#: Row names, in the order of INTERFACE.md.
+#: Row names, in the order of the table1 JSON contract.
 ROW_NAMES = ("f", "F0", "M0", "a", "m", "k_x")
 #: k_x assumed when no rolling map is given: the paper's theoretical value.
 PAPER_K_X = 0.130
@@ -63,7 +63,7 @@ PAPER_TABLE1: Mapping[str, tuple[float, float, tuple[float, float]]] = MappingPr
     }
 )
 
-#: Why the paper's numbers cannot be matched (THEORY.md §6).
+#: Why the paper's numbers cannot be matched.
 PAPER_NOTES = (
     "paper: N = 2.41e5 N with F0 = 72219 N fits f = 0.3, but M0/F0 = 0.045 m implies a patch "
     "radius near 7 cm, far too small for that load at P* = 200 kPa",
@@ -188,7 +188,7 @@ class Table1:
         raise ArgumentError(f"name must be one of {', '.join(ROW_NAMES)}, got {name!r}")
 
     def to_dict(self) -> dict:
-        """INTERFACE.md's table1 JSON (``rows``) with settings, bias and notes."""
+        """The table1 JSON (``rows``, the contract) with settings, bias, generalised rows and notes."""
         return {
             "rows": [r.to_dict() for r in self.rows],
             "settings": {
@@ -222,7 +222,8 @@ def _num(v: float) -> str:
 def format_table(t: Table1) -> str:
     """Readable text: theory | fitted | 95 % bounds | profile bounds | the paper's row."""
     head = (
-        f"Table 1 (THEORY.md 6): {t.source} curves, {t.noise} noise {t.amplitude:g} x max, "
+        f"Table 1 (the paper's identification experiment): {t.source} curves, "
+        f"{t.noise} noise {t.amplitude:g} x max, "
         f"seed {t.seed}, "
         f"{t.n_points} points per curve on [0, {t.span:g}]\n"
         f"R = {t.R:.5g} m (r_max), N = {t.N:.6g} N, k_x theory: {t.k_x_source}"

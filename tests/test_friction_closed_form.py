@@ -7,7 +7,7 @@ Tolerance tiers:
   exact (pure sliding, pure spin), limited by the quadrature (~1e-7).
 - LIMIT: the closed forms match the exact asymptotes to first order; at υ = 1e-3
   (or 1e3) the next-order terms leave a relative difference far below 1e-2.
-- Error bands for THEORY.md §4 figures: that note quotes 0.12·F0 and 0.21·M0
+- Error bands for the theory note (docs/theory.md): it quotes 0.12·F0 and 0.21·M0
   (asymptotic a, m) and 0.07–0.08 (fitted); the bands are ±0.02 around those.
 """
 
@@ -114,7 +114,7 @@ def test_closed_form_torque_omits_the_offset_of_the_centre_of_pressure(shifted_h
 
 
 def test_theory_sign_statement(shifted_hertz):
-    # THEORY.md §4: v_x > 0, ω_z > 0, k_x > 0 gives F_y < 0 and M_z < 0.
+    # sign convention: v_x > 0, ω_z > 0, k_x > 0 gives F_y < 0 and M_z < 0.
     quad, _ = shifted_hertz
     res = friction_resultants(quad, 0.1, 0.0, 2.0, FrictionLaw(f=F))
     assert float(res.Fy) < 0 and float(res.Mz) < 0 and float(res.Fx) < 0

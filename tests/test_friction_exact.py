@@ -3,7 +3,7 @@
 Tolerance tiers:
 - IDENTITY (1e-12): relations that hold node by node (symmetries of the grid,
   pure sliding, shift covariance), up to round-off.
-- TABLE (1e-5): THEORY.md §5 reference values (adaptive quadrature, trusted to
+- TABLE (1e-5): the reference values of docs/theory.md (adaptive quadrature, trusted to
   ~1e-7); the brief asks for 1e-5 relative; the 64x128 sine grid measures ~1e-7.
 - BRUTE (2e-6 of fN): scipy dblquad in polar coordinates about the ICR, an
   independent computation; our discretisation error on 64x128 is ~1e-7.
@@ -27,7 +27,7 @@ TABLE = 1e-5
 BRUTE = 2e-6
 
 EPS = [0.0, 0.25, 0.5, 0.75, 1.5, 2.0, 5.0]
-REFERENCE = {  # THEORY.md §5: |F|/fN, |M|/fNR for sliding along x at v = ε ω R
+REFERENCE = {  # reference table (docs/theory.md): |F|/fN, |M|/fNR for sliding along x at v = ε ω R
     "uniform": (
         [0, 0.24803131, 0.48384376, 0.69267323, 0.94081938, 0.96768751, 0.99497468],
         [0.66666667, 0.63578612, 0.54774835, 0.41798322, 0.17379811, 0.12780920, 0.05016857],

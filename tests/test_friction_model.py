@@ -213,7 +213,7 @@ def test_reduction_on_a_circular_map(models):
     quad, model = models["hertz", 1.0]
     paper = paper_coefficients(map_tensors(quad), F)
     F0, M0, a, m, R = paper["F0"], paper["M0"], paper["a"], paper["m"], paper["radius"]
-    assert a == pytest.approx((8 / (3 * np.pi)) ** 2, rel=INTEGRAL)  # THEORY §5 values
+    assert a == pytest.approx((8 / (3 * np.pi)) ** 2, rel=INTEGRAL)  # the reference values of docs/theory.md
     assert m == pytest.approx((15 * np.pi / 16) ** 2, rel=INTEGRAL)
     d = model.direction_coefficients(np.linspace(0, np.pi, 7))
     np.testing.assert_allclose(d["a"], a, rtol=INTEGRAL)
@@ -254,7 +254,7 @@ def test_circular_model_beats_the_paper(models, profile):
         n_t=81,
     )
     paper, base, full = em.worst("paper"), em.worst("base"), em.worst("model")
-    assert paper["force"] > 0.10 and paper["torque"] > 0.20  # THEORY §4: 0.12 / 0.21
+    assert paper["force"] > 0.10 and paper["torque"] > 0.20  # the theory note quotes 0.12 / 0.21
     assert base["force"] < 0.035 and base["torque"] < 0.045
     assert full["force"] < 0.01 and full["torque"] < 0.01
 

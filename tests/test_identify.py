@@ -4,7 +4,7 @@ Tolerances:
 * IDENTITY = 1e-12: algebraic identities (f = F0/N, read-only arrays, ...).
 * RECOVERY = 1e-8: noise-free closed-form data must give the coefficients back
   (solver tolerances 1e-12 on O(1) parameters).
-* TABLE_TOL = 5e-7: exact integrals against THEORY.md §5's table (trusted to ~1e-7,
+* TABLE_TOL = 5e-7: exact integrals against the reference table of docs/theory.md (trusted to ~1e-7,
   plus ~1e-7 quadrature error of the 48 x 96 edge grid, measured).
 * AGREE = 1e-6: our fit against scipy.optimize.curve_fit on the same weighted problem
   (two solvers stopping at ~1e-8 relative changes).
@@ -127,7 +127,7 @@ def test_exact_curves_match_theory_table(hertz_quad, truth):
 
 
 def test_exact_lateral_force_sign_and_pure_spin_value(hertz_quad, truth):
-    """THEORY §3/§5: forward shift, v_x > 0, w_z > 0 -> F_y < 0; pure spin |F_y| = k M0/(2R)."""
+    """Sign convention: forward shift, v_x > 0, w_z > 0 -> F_y < 0; pure spin |F_y| = k M0/(2R)."""
     roll = rolling_model(hertz_quad, K_X, R)
     ups = np.array([0.0, 0.5, 2.0])
     _, _, fperp = exact_curves(hertz_quad, ups, ups, R, rolling_quad=roll, friction=FRICTION)
@@ -430,7 +430,7 @@ def test_degenerate_design_warns_and_gives_nan_intervals():
 def test_bias_of_the_closed_forms_on_exact_data(hertz_quad, truth):
     b = approximation_bias(truth, hertz_quad, seed=4)
     # Noise-free exact curves: the square-root forms cannot follow them; the best fit moves
-    # a and m by several percent (THEORY §4: structural error ~0.07-0.12 of the curve max).
+    # a and m by several percent (the theory note: structural error ~0.07-0.12 of the curve max).
     assert abs(b.relative_bias("a")) > 0.03 and abs(b.relative_bias("m")) > 0.03
     for name, s in b.structure.items():
         assert 0.02 < s["max_abs_error_relative"] < 0.2, name

@@ -26,7 +26,7 @@ def add_parser(sub) -> None:
         "table1",
         help="the paper's identification experiment (Table 1) on FE maps, with 95 % bounds",
         description=(
-            "Make the friction curves of THEORY.md 4 from the coefficients of the FE maps, "
+            "Make the paper's friction curves (1.8) from the coefficients of the FE maps, "
             "add the paper's 20 % noise, fit them back and print theory | fitted | "
             "95 % bounds | the paper's values."
         ),

@@ -3,11 +3,11 @@
 Each figure shows one quantity (F∥ against ψ = u/v, M_C and F⊥ against
 υ = v/u, with u = ω_z R) as plain arrays held in a :class:`CurveData`:
 
-* ``exact`` — the exact Coulomb integrals of the FE map (THEORY.md §3),
+* ``exact`` — the exact Coulomb integrals of the FE map,
 * ``closed_form`` — the paper's square-root approximation with the map's
-  coefficients (THEORY.md §4),
+  coefficients,
 * ``test_x``, ``test_y`` — the noisy "test" points of the identification
-  experiment (THEORY.md §6),
+  experiment,
 * ``fit`` with ``band_lo`` … ``band_hi`` — the curve fitted to those points and
   its 95 % prediction band;
 * ``model`` — the generalised friction model built from the FE map

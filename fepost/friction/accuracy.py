@@ -1,4 +1,4 @@
-"""How far the closed forms (THEORY.md §4) stray from the exact integrals (§3).
+"""How far the paper's closed forms stray from the exact Coulomb integrals.
 
 For sliding along x at v = υ·u with u = ω_z R (ω_z > 0), over a range of υ, the
 exact resultants of a pressure map give the curves
@@ -100,7 +100,7 @@ class ApproximationError:
 
 
 def rolling_shift(quad: PressureQuadrature, radius: float) -> float:
-    """k_x = R x_c/⟨x²⟩ of the map itself, about the origin (THEORY.md §2, dimensionless)."""
+    """k_x = R x_c/⟨x²⟩ of the map itself, about the origin (dimensionless, the moment form)."""
     n = quad.load
     xc = float(quad.sigma @ (quad.x * quad.dA)) / n
     x2 = float(quad.sigma @ (quad.x**2 * quad.dA)) / n

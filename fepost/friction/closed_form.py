@@ -1,4 +1,4 @@
-"""The paper's closed-form friction approximations (THEORY.md §4, paper 1.3, 1.7, 1.8).
+"""The paper's closed-form friction approximations (paper eqs. 1.3, 1.7, 1.8; docs/theory.md).
 
 With u = ω_z R (m/s) and v = |v| (m/s):
 
@@ -7,8 +7,8 @@ With u = ω_z R (m/s) and v = |v| (m/s):
     F⊥ = k_x (M0 / 2R) u / √(u² + (m/4) v²)    (N, lateral)
 
 Magnitudes are returned; the signs of the components on the tire follow from
-THEORY.md §3 and are applied by :func:`components`. :func:`asymptotic_coefficients`
-derives a and m of any pressure map from the asymptotes of the exact integrals.
+the exact integrals (:mod:`fepost.friction.exact`) and are applied by
+:func:`components`. :func:`asymptotic_coefficients` derives a and m of any pressure map from the asymptotes of the exact integrals.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def torque(v, u, M0: float, m: float) -> np.ndarray:
 
 
 def f_perpendicular(v, u, M0: float, m: float, k_x: float, radius: float) -> np.ndarray:
-    """|F⊥| in N (THEORY.md §4, with the 1/R the paper omits)."""
+    """|F⊥| in N (with the 1/R the paper omits)."""
     v = np.asarray(v, float)
     u = np.abs(np.asarray(u, float))
     den = np.sqrt(u**2 + 0.25 * m * v**2)
@@ -64,7 +64,7 @@ def components(vx, vy, wz, *, F0: float, M0: float, a: float, m: float, k_x: flo
     """Closed-form force (N) and torque (N·m) components on the tire: (Fx, Fy, Mz).
 
     ``vx``, ``vy``: sliding velocity of the patch origin (m/s); ``wz``: spin (rad/s);
-    ``radius``: R (m), so u = |ω_z| R. Signs, derived from THEORY.md §3 and tested
+    ``radius``: R (m), so u = |ω_z| R. Signs, derived from the Coulomb integrals and tested
     against :func:`fepost.friction.exact.friction_resultants`:
 
     - F∥ acts along −v̂ (Coulomb friction opposes sliding);
@@ -106,7 +106,7 @@ class AsymptoticCoefficients:
 def asymptotic_coefficients(
     quad: PressureQuadrature, f: float = 0.3, *, radius: float | None = None, direction: float = 0.0
 ) -> AsymptoticCoefficients:
-    """a and m matched to the asymptotes of the exact integrals (THEORY.md §3–4).
+    """a and m matched to the asymptotes of the exact integrals.
 
     Sliding at speed v along v̂ = (cos β, sin β) (β = ``direction``), spinning at ω,
     u = |ω| R; σ-weighted integrals about the patch origin, n̂ = v̂ rotated by +90°:
@@ -121,7 +121,7 @@ def asymptotic_coefficients(
       Matching M0 u/(√m v) gives √m = M0 R / (f ∬ σ (v̂·p)² dA).
 
     For an axisymmetric map, T = π R A⁰ and ∬σ x² dA = π R⁴ A³ while N = 2πR²A¹
-    and M0 = 2π f R³ A², so √a = 2A¹/A⁰ and √m = 2A²/A³, THEORY.md §2.
+    and M0 = 2π f R³ A², so √a = 2A¹/A⁰ and √m = 2A²/A³, the paper's (1.5).
     ``radius`` defaults to ``quad.radius``.
     """
     if not isinstance(quad, PressureQuadrature):

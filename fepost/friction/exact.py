@@ -1,4 +1,4 @@
-"""Exact dry-friction resultants of a pressure map (THEORY.md §3), by quadrature.
+"""Exact dry-friction resultants of a pressure map (Coulomb's law at every point), by quadrature.
 
 For a patch sliding at (v_x, v_y) (m/s) and spinning at ω_z (rad/s) the tire
 point (x, y) slides at w = (v_x − ω_z y, v_y + ω_z x) and carries the traction

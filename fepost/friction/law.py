@@ -1,4 +1,4 @@
-"""The local friction law: Coulomb (THEORY.md §3), optionally generalised.
+"""The local friction law: Coulomb, optionally generalised.
 
 At a tire point with contact pressure σ (Pa) sliding at w (m/s) relative to the
 road, the traction on the tire (Pa) is
@@ -14,7 +14,7 @@ sliding speed; ``pressure_coef`` c_p is the relative change of μ per relative
 change of pressure about σ_ref; ``speed_coef`` c_v is the relative change of μ per
 m/s of sliding speed; ``anisotropy`` α = f_y/f_x scales the lateral traction;
 ``pressure_ref`` σ_ref (Pa) defaults to the map's mean contact pressure N/area.
-With c_p = c_v = 0 and α = 1 this is THEORY.md §3: τ = −f σ ŵ.
+With c_p = c_v = 0 and α = 1 this is Coulomb's law: τ = −f σ ŵ.
 """
 
 from __future__ import annotations

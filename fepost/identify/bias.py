@@ -57,7 +57,7 @@ def runs_test(x) -> tuple[int, float, float]:
 
 @dataclass(frozen=True)
 class BiasReport:
-    """How the closed forms fit exact-integral data (THEORY.md §4, §6 "going further").
+    """How the closed forms fit exact-integral data (the study the paper does not make).
 
     ``theory``: the asymptotic coefficients (from the moments); ``noise_free``: the
     fit to noise-free exact curves, so its departures from ``theory`` are the bias

@@ -165,7 +165,7 @@ def _coefficient_values(coefficients) -> dict[str, float]:
 
 
 def rolling_model(quad: PressureQuadrature, k_x: float, R: float) -> PressureQuadrature:
-    """The rolling map σ0(1 + k_x x/R) (THEORY.md §1, first order in k_x) of a static map."""
+    """The rolling map σ0(1 + k_x x/R) (first order in k_x) of a static map."""
     if not isinstance(quad, PressureQuadrature):
         raise ArgumentError(f"quad must be a PressureQuadrature, got {type(quad).__name__}")
     k, R = float(k_x), float(R)
@@ -194,7 +194,7 @@ def exact_curves(
     rolling_quad: PressureQuadrature | None = None,
     friction: float = 0.3,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """F∥(ψ), M_C(υ), F⊥(υ) (N, N·m, N) from the exact Coulomb integrals (THEORY.md §3).
+    """F∥(ψ), M_C(υ), F⊥(υ) (N, N·m, N) from the exact Coulomb integrals.
 
     F∥: sliding v_x = 1 m/s with ω_z = ψ·(1 m/s)/R, F∥ = −F_x (on ``quad``).
     M_C, F⊥: ω_z = (1 m/s)/R, v_x = υ·(1 m/s); M_C = −M_z on ``quad`` and
