@@ -8,7 +8,8 @@ With u = ω_z R (m/s) and v = |v| (m/s):
 
 Magnitudes are returned; the signs of the components on the tire follow from
 the exact integrals (:mod:`fepost.friction.exact`) and are applied by
-:func:`components`. :func:`asymptotic_coefficients` derives a and m of any pressure map from the asymptotes of the exact integrals.
+:func:`components`. :func:`asymptotic_coefficients` derives a and m of any
+pressure map from the asymptotes of the exact integrals.
 """
 
 from __future__ import annotations
