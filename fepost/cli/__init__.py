@@ -1,63 +1,234 @@
 """Command-line interface: a thin shell over the Python API.
 
-Each subcommand lives in its own module exposing ``add_parser(subparsers)``
-and ``run(args) -> int``. Errors derived from :class:`fepost.errors.FepostError`
-become a one-line message on stderr and exit status 2 (a traceback only with
-``--debug``).
+Each subcommand is a module of this package named in :data:`COMMANDS`, exposing
+``add_parser(subparsers)`` and ``run(args) -> int``. A subcommand module is light
+at import (argparse, this package's helpers, :mod:`fepost.errors`): the whole
+parser is built from them on every run, so ``fepost --help`` and usage errors
+never import numpy, scipy, VTK or matplotlib; ``run`` imports what it needs.
+Option types and ranges are in :mod:`fepost.cli._validate`.
+
+:func:`main` is the edge where exceptions become exit statuses
+(:data:`EXIT_STATUSES`, also in ``docs/cli-exit-codes.md``): every failure is
+one line on stderr, a traceback only with ``--debug``; fepost's warnings are
+printed as one line each, other libraries' warnings (numpy's RuntimeWarnings
+among them) are not shown to users (``--debug`` shows them; the test suite
+turns them into errors, so each one is a defect to fix where it arises).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
+import threading
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from importlib import import_module
 
+from .. import __version__
 from ..errors import FepostError, FepostWarning
 
-_COMMANDS = ("coefficients", "table1", "report", "diagnose")
+#: The subcommands, in the order ``fepost --help`` lists them; each is the module
+#: ``fepost.cli.<name>``. Registering a new command is one line here.
+COMMANDS = [
+    "coefficients",
+    "table1",
+    "report",
+    "diagnose",
+]
+
+#: Exit statuses of ``fepost`` (the ``--help`` epilog and docs/cli-exit-codes.md).
+EXIT_STATUSES = {
+    0: "success",
+    1: "finished, but some inputs failed (a table or report marks them)",
+    2: "bad input or usage: a file or option refused, named in one line",
+    3: "internal error: a bug in fepost or a library, or out of memory (--debug shows it)",
+    130: "interrupted (Ctrl-C); nothing half-written is left",
+    141: "the output pipe was closed (e.g. '| head'); stopped quietly",
+    143: "terminated (SIGTERM; 129 for SIGHUP); nothing half-written is left",
+}
+OK, FAILED_INPUTS, BAD_INPUT, INTERNAL = 0, 1, 2, 3
+INTERRUPTED, BROKEN_PIPE = 130, 141
+
+
+class UsageError(Exception):
+    """A command line the parser refuses (printed as one line, exit status 2)."""
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP arrived: unwinds like Ctrl-C so temporary outputs are removed."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+class _Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line (no usage block) and do not exit."""
+
+    def error(self, message: str):  # type: ignore[override]
+        raise UsageError(f"{message} (see '{self.prog} --help')")
+
+
+def _epilog() -> str:
+    lines = ["exit status:"]
+    lines += [f"  {code:>3}  {text}" for code, text in EXIT_STATUSES.items()]
+    lines.append("Details: docs/cli-exit-codes.md.")
+    return "\n".join(lines)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from importlib import import_module
-
-    parser = argparse.ArgumentParser(
+    """The ``fepost`` parser with every subcommand in :data:`COMMANDS` (light imports only)."""
+    parser = _Parser(
         prog="fepost",
         description="FE tire-road contact results -> coupled dry-friction model coefficients.",
+        epilog=_epilog(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    parser.add_argument("--version", action="version", version=f"fepost {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks and library warnings")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in _COMMANDS:
+    for name in COMMANDS:
         import_module(f"{__name__}.{name}").add_parser(sub)
     return parser
 
 
-def _show_warning(message, category, filename, lineno, file=None, line=None):
-    name = category.__name__
-    print(f"fepost: warning ({name}): {message}", file=sys.stderr)
+def _one_line(text: object) -> str:
+    return " ".join(str(text).split())
+
+
+class _Warnings:
+    """``warnings.showwarning`` for a run: fepost's as one line, others only with --debug."""
+
+    def __init__(self) -> None:
+        self.debug = False
+
+    def show(self, message, category, filename, lineno, file=None, line=None) -> None:
+        if issubclass(category, FepostWarning):
+            print(f"fepost: warning ({category.__name__}): {_one_line(message)}", file=sys.stderr)
+        elif self.debug:
+            where = f"{os.path.basename(filename)}:{lineno}"
+            print(f"fepost: debug: {category.__name__} at {where}: {_one_line(message)}", file=sys.stderr)
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise Terminated(signum)
+
+
+@contextmanager
+def _termination_unwinds() -> Iterator[None]:
+    """SIGTERM/SIGHUP raise :class:`Terminated` while the command runs (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    names = ("SIGTERM", "SIGHUP")
+    old = {}
+    for name in names:
+        sig = getattr(signal, name, None)
+        if sig is not None:
+            old[sig] = signal.signal(sig, _raise_terminated)
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush cannot fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+def _error(message: str) -> None:
+    try:
+        print(f"fepost: error: {_one_line(message)}", file=sys.stderr)
+    except (OSError, ValueError):
+        pass
+
+
+def _run(argv: list[str], shown: _Warnings) -> int:
+    from ._validate import check_grid, resolve_defaults
+
+    debug = "--debug" in argv[: next((i for i, a in enumerate(argv) if a in COMMANDS), len(argv))]
+    shown.debug = debug
+    try:
+        args = build_parser().parse_args(argv)
+        resolve_defaults(args)
+        check_grid(args)
+        status = int(args.func(args) or 0)
+        sys.stdout.flush()
+        return status
+    except SystemExit as exc:  # --help, --version
+        sys.stdout.flush()
+        return exc.code if isinstance(exc.code, int) else (OK if exc.code is None else BAD_INPUT)
+    except UsageError as exc:
+        _error(str(exc))
+        return BAD_INPUT
+    except FepostError as exc:
+        if debug:
+            raise
+        _error(str(exc))
+        return BAD_INPUT
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        if debug:
+            raise
+        if exc.filename is not None:  # names the file: a file problem the library did not anticipate
+            _error(f"{exc.filename}: {exc.strerror or exc}")
+            return BAD_INPUT
+        _error(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug and report it)")
+        return INTERNAL
+    except MemoryError:
+        if debug:
+            raise
+        _error("out of memory (a smaller grid, --nr/--nphi, or a smaller model may fit)")
+        return INTERNAL
+    except Exception as exc:
+        if debug:
+            raise
+        _error(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug and report it)")
+        return INTERNAL
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit status."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    old = warnings.showwarning
-    warnings.showwarning = _show_warning
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("always", FepostWarning)
-            return int(args.func(args) or 0)
-    except FepostError as exc:
-        if args.debug:
-            raise
-        print(f"fepost: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("fepost: interrupted", file=sys.stderr)
-        return 130
-    finally:
-        warnings.showwarning = old
+    """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit status.
+
+    Never raises (except with ``--debug``) and never exits: the status follows
+    :data:`EXIT_STATUSES`.
+    """
+    argv = list(sys.argv[1:] if argv is None else argv)
+    shown = _Warnings()
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", FepostWarning)
+        warnings.showwarning = shown.show
+        try:
+            with _termination_unwinds():
+                return _run(argv, shown)
+        except KeyboardInterrupt:
+            _error("interrupted")
+            return INTERRUPTED
+        except Terminated as exc:
+            _error(f"terminated by {signal.Signals(exc.signum).name}")
+            return 128 + exc.signum
+        except BrokenPipeError:
+            _silence_stdout()
+            return BROKEN_PIPE
 
 
 def console_main() -> None:
-    sys.exit(main())
+    """Entry point of the ``fepost`` script."""
+    status = main()
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+        status = status or BROKEN_PIPE
+    sys.exit(status)

@@ -1,13 +1,17 @@
-"""``fepost report [STATIC [ROLLING]] --out DIR [--force]``, plus friction, P* and seed options."""
+"""``fepost report [STATIC [ROLLING]] --out DIR [--force]``, plus friction, P* and seed options.
+
+``--force`` replaces a non-empty DIR, but never one that holds the inputs, the
+sample meshes, the current folder, the home folder or the root
+(:func:`fepost.output.check_replaceable`).
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-from ..report import build_report
-from ..table1 import DEFAULT_SEED
-from ._common import add_friction_option, add_input_options, analysis_kwargs, sample_mesh
+from . import _validate as v
+from ._common import add_friction_option, add_input_options, analysis_kwargs, repo_meshes, sample_mesh
 
 
 def add_parser(sub) -> None:
@@ -24,21 +28,27 @@ def add_parser(sub) -> None:
         "static", metavar="STATIC", nargs="?", help="static contact map (default: the sample mesh)"
     )
     p.add_argument("rolling", metavar="ROLLING", nargs="?", help="rolling contact map at the same deflection")
-    p.add_argument("--out", metavar="DIR", required=True, help="output folder (created; must be empty)")
-    p.add_argument("--force", action="store_true", help="replace a non-empty output folder")
+    p.add_argument(
+        "--out", metavar="DIR", required=True, type=v.nonempty, help="output folder (created; must be empty)"
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace a non-empty output folder (never one holding the inputs or the current folder)",
+    )
     add_friction_option(p)
     p.add_argument(
         "--inflation-pressure",
-        type=float,
+        type=v.positive,
         metavar="P",
         help="inflation pressure P* in Pa for sigma/P* (default: sidecar 'inflation_pressure', else 200e3)",
     )
     p.add_argument(
         "--seed",
-        type=int,
-        default=DEFAULT_SEED,
+        type=v.seed,
+        default=v.LibraryDefault("fepost.table1", "DEFAULT_SEED"),
         metavar="S",
-        help=f"seed of the Table 1 noise (default {DEFAULT_SEED}, as fepost table1)",
+        help="seed of the Table 1 noise (default %(default)s, as fepost table1)",
     )
     add_input_options(p)
     p.set_defaults(func=run)
@@ -49,10 +59,14 @@ def _progress(k: int, n: int, step: str, seconds: float) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..output import check_replaceable
+    from ..report import build_report
+
     static, rolling = args.static, args.rolling
     if static is None:
         static = sample_mesh("static.vtu")
         rolling = sample_mesh("rolling.vtu")
+    check_replaceable(args.out, [static, rolling, repo_meshes()])
     result = build_report(
         static,
         rolling,
