@@ -110,7 +110,7 @@ def remove_stale_temporaries(folder: str | Path) -> list[Path]:
     an entry is stale when its process is gone, or when the process now holding
     that pid started after the entry was last modified. Returns what was removed.
     """
-    removed = []
+    removed: list[Path] = []
     try:
         names = os.listdir(folder)
     except OSError:
@@ -139,18 +139,21 @@ def _folder_of(path: Path) -> Path:
 
 def write_text_atomic(path: str | Path, text: str) -> Path:
     """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same folder, then rename."""
-    path = Path(path)
+    given = Path(path)
+    path = Path(os.path.realpath(given)) if given.is_symlink() else given  # keep the link
     folder = _folder_of(path)
     if path.is_dir():
-        raise OutputError(f"{path}: is a folder, not a file")
+        raise OutputError(f"{given}: is a folder, not a file")
+    if path.exists() and not path.is_file():  # /dev/stdout, a FIFO: write through, never replace
+        return _write_through(given, text)
     if not folder.is_dir():
-        raise OutputError(f"{path}: folder {folder} does not exist")
+        raise OutputError(f"{given}: folder {folder} does not exist")
     remove_stale_temporaries(folder)
     tmp = folder / _temporary_name(path.name)
     try:
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
     except OSError as exc:
-        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        raise OutputError(f"{given}: cannot write ({exc.strerror or exc})") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
@@ -159,10 +162,19 @@ def write_text_atomic(path: str | Path, text: str) -> Path:
         os.replace(tmp, path)
     except OSError as exc:
         tmp.unlink(missing_ok=True)
-        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        raise OutputError(f"{given}: cannot write ({exc.strerror or exc})") from None
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+    return given
+
+
+def _write_through(path: Path, text: str) -> Path:
+    try:
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
     return path
 
 
@@ -220,7 +232,7 @@ def staged_folder(
     home folder is always refused (:func:`check_replaceable`). On any error or
     interruption the temporary folder is removed and ``out`` is left as it was.
     """
-    out = Path(out)
+    out = Path(os.path.realpath(out)) if Path(out).is_symlink() else Path(out)
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: exists and is not a folder")
     if out.is_dir():

@@ -95,8 +95,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Longest message printed; longer ones (a 200 kB CSV cell quoted back) lose their middle.
+MESSAGE_MAX = 1000
+
+
 def _one_line(text: object) -> str:
-    return " ".join(str(text).split())
+    line = " ".join(str(text).split())
+    if len(line) > MESSAGE_MAX:
+        cut = len(line) - MESSAGE_MAX + 40
+        half = (MESSAGE_MAX - 40) // 2
+        line = f"{line[:half]} ...[{cut} characters]... {line[-half:]}"
+    return line
 
 
 class _Warnings:
@@ -154,13 +163,15 @@ def _error(message: str) -> None:
 
 
 def _run(argv: list[str], shown: _Warnings) -> int:
-    from ._validate import check_grid, resolve_defaults
+    from ._validate import check_grid, check_not_empty, resolve_defaults
 
     debug = "--debug" in argv[: next((i for i, a in enumerate(argv) if a in COMMANDS), len(argv))]
     shown.debug = debug
     try:
-        args = build_parser().parse_args(argv)
+        parser = build_parser()
+        args = parser.parse_args(argv)
         resolve_defaults(args)
+        check_not_empty(parser, args)
         check_grid(args)
         status = int(args.func(args) or 0)
         sys.stdout.flush()

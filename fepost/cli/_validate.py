@@ -42,10 +42,10 @@ FRICTION_PLAUSIBLE = 1.5
 #: by 256 x 512; the default is 64 x 128).
 NR_MAX = 4096
 NPHI_MAX = 16384
-#: Memory held per polar-grid node while one map is resampled and integrated
-#: (coordinates, values, weights, locating indices, the per-node copies of the
-#: moments and friction quadratures), bytes; measured by ``benchmarks/bench_cli.py``
-#: style tracemalloc runs at 256 x 512 and rounded up.
+#: Memory per polar-grid node budgeted for one run, bytes. Measured (tracemalloc
+#: peak of ``analyse`` and of ``table1(source="exact")`` on a small FE map): per
+#: node it falls to 140 and 220 bytes at 2-8 million nodes (2048 x 4096 peaked
+#: at 2.1 GB resident); doubled for the report's extra maps and rounded.
 BYTES_PER_GRID_NODE = 400
 
 
@@ -120,12 +120,17 @@ def positive(text: str) -> float:
     return x
 
 
-def non_negative(text: str) -> float:
-    """A finite number >= 0 (a noise amplitude, ...)."""
-    x = _number(text)
-    if not (math.isfinite(x) and x >= 0):
-        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {_text(text)}")
-    return x
+def number_in(lo: float, hi: float):
+    """Type for a number in [lo, hi]."""
+
+    def check(text: str) -> float:
+        x = _number(text)
+        if not (lo <= x <= hi):
+            raise argparse.ArgumentTypeError(f"must be a number in [{lo:g}, {hi:g}], got {_text(text)}")
+        return x
+
+    check.__name__ = "number"
+    return check
 
 
 def finite(text: str) -> float:
@@ -136,11 +141,24 @@ def finite(text: str) -> float:
     return x
 
 
-def nonempty(text: str) -> str:
-    """A non-empty string (paths, array names): ``--json ''`` is refused here."""
-    if not str(text).strip():
-        raise argparse.ArgumentTypeError("must not be empty")
-    return text
+def check_not_empty(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse an empty string given to any option or input (``--json ''``), naming it.
+
+    Raises :class:`~fepost.errors.ArgumentError`.
+    """
+    actions = list(parser._actions)
+    command = getattr(args, "command", None)
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction) and command in action.choices:
+            actions += action.choices[command]._actions
+    for action in actions:
+        value = getattr(args, action.dest, None)
+        for item in value if isinstance(value, list) else [value]:
+            if isinstance(item, str) and not item.strip():
+                from ..errors import ArgumentError
+
+                name = "/".join(action.option_strings) or str(action.metavar or action.dest)
+                raise ArgumentError(f"argument {name}: must not be empty")
 
 
 radial_nodes = integer_in(2, NR_MAX)

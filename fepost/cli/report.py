@@ -28,9 +28,7 @@ def add_parser(sub) -> None:
         "static", metavar="STATIC", nargs="?", help="static contact map (default: the sample mesh)"
     )
     p.add_argument("rolling", metavar="ROLLING", nargs="?", help="rolling contact map at the same deflection")
-    p.add_argument(
-        "--out", metavar="DIR", required=True, type=v.nonempty, help="output folder (created; must be empty)"
-    )
+    p.add_argument("--out", metavar="DIR", required=True, help="output folder (created; must be empty)")
     p.add_argument(
         "--force",
         action="store_true",

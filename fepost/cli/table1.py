@@ -46,7 +46,7 @@ def add_parser(sub) -> None:
     p.add_argument("--noise", choices=("uniform", "gaussian"), default="uniform", help="noise distribution")
     p.add_argument(
         "--amplitude",
-        type=v.non_negative,
+        type=v.number_in(0.0, 10.0),
         default=v.LibraryDefault("fepost.identify", "DEFAULT_AMPLITUDE"),
         metavar="A",
         help="noise amplitude as a fraction of each curve's maximum (default %(default)s)",
