@@ -71,6 +71,11 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # type: ignore[override]
         raise UsageError(f"{message} (see '{self.prog} --help')")
 
+    def _print_message(self, message: str, file=None) -> None:
+        # argparse swallows OSError here; a closed pipe must reach main() (exit status 141)
+        if message:
+            (file or sys.stderr).write(message)
+
 
 def _epilog() -> str:
     lines = ["exit status:"]
