@@ -168,7 +168,7 @@ def _error(message: str) -> None:
 
 
 def _run(argv: list[str], shown: _Warnings) -> int:
-    from ._validate import check_grid, check_not_empty, resolve_defaults
+    from ._validate import check_grid, check_strings, resolve_defaults
 
     debug = "--debug" in argv[: next((i for i, a in enumerate(argv) if a in COMMANDS), len(argv))]
     shown.debug = debug
@@ -176,7 +176,7 @@ def _run(argv: list[str], shown: _Warnings) -> int:
         parser = build_parser()
         args = parser.parse_args(argv)
         resolve_defaults(args)
-        check_not_empty(parser, args)
+        check_strings(parser, args)
         check_grid(args)
         status = int(args.func(args) or 0)
         sys.stdout.flush()

@@ -141,8 +141,9 @@ def finite(text: str) -> float:
     return x
 
 
-def check_not_empty(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
-    """Refuse an empty string given to any option or input (``--json ''``), naming it.
+def check_strings(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse an empty string (``--json ''``) or one holding a NUL character (no file
+    name can) given to any option or input, naming it.
 
     Raises :class:`~fepost.errors.ArgumentError`.
     """
@@ -154,11 +155,12 @@ def check_not_empty(parser: argparse.ArgumentParser, args: argparse.Namespace) -
     for action in actions:
         value = getattr(args, action.dest, None)
         for item in value if isinstance(value, list) else [value]:
-            if isinstance(item, str) and not item.strip():
+            if isinstance(item, str) and (not item.strip() or "\x00" in item):
                 from ..errors import ArgumentError
 
                 name = "/".join(action.option_strings) or str(action.metavar or action.dest)
-                raise ArgumentError(f"argument {name}: must not be empty")
+                problem = "must not be empty" if not item.strip() else "contains a NUL character"
+                raise ArgumentError(f"argument {name}: {problem}")
 
 
 radial_nodes = integer_in(2, NR_MAX)
