@@ -207,7 +207,7 @@ def test_bad_options_are_one_line_exit_2(capsys, small_map, tmp_path, extra, mes
         (["table1", "--amplitude", "1e300"], r"argument --amplitude: must be a number in \[0, 10\]"),
         (["table1", "--k-x", "nan"], r"argument --k-x: must be a finite number, got 'nan'"),
         (["report", "--out", "x", "--seed", "-7"], r"argument --seed: must be an integer >= 0, got '-7'"),
-        (["report", "--out", "x", "--inflation-pressure", "0"], r"argument --inflation-pressure: must be"),
+        (["report", "--out", "x", "--inflation-pressure", "abc"], r"argument --inflation-pressure: invalid"),
         (["report"], r"the following arguments are required: --out"),
         (["diagnose", "--simulation", "s.vtu", "--measured", "m.csv", "--out", "o", "--folds", "1"],
          r"argument --folds: must be an integer >= 2, got '1'"),
@@ -299,7 +299,7 @@ def test_ctrl_c_is_exit_130(monkeypatch, capsys, small_map):
 
     _replace_run(monkeypatch, interrupted)
     code, _, err = run(capsys, ["coefficients", small_map])
-    assert code == 130 and err == "fepost: error: interrupted\n"
+    assert code == 130 and err == "fepost: interrupted\n"
 
 
 def test_sigterm_unwinds_with_exit_143_and_restores_the_handler(monkeypatch, capsys, small_map):
@@ -313,8 +313,54 @@ def test_sigterm_unwinds_with_exit_143_and_restores_the_handler(monkeypatch, cap
     _replace_run(monkeypatch, terminated)
     before = signal.getsignal(signal.SIGTERM)
     code, _, err = run(capsys, ["coefficients", small_map])
-    assert code == 143 and err == "fepost: error: terminated by SIGTERM\n" and not reached
+    assert code == 143 and err == "fepost: terminated by SIGTERM\n" and not reached
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_a_signal_during_an_import_waits_for_the_import_to_finish(monkeypatch, capsys, small_map, tmp_path):
+    """Raising inside an import crashes VTK's extension modules (SIGSEGV): the signal is
+    recorded, the import completes, and the run stops right after it."""
+    (tmp_path / "slow_module_for_signal.py").write_text(
+        "import os, signal, time\n"
+        "os.kill(os.getpid(), signal.SIGTERM)\n"
+        "for _ in range(200):\n"
+        "    time.sleep(0.001)  # the handler runs here, inside the import\n"
+        "DONE = True\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    reached = []
+
+    def importing(args):
+        import time
+
+        import slow_module_for_signal
+
+        reached.append(slow_module_for_signal.DONE)
+        time.sleep(5)  # the deferred signal ends the run here
+        reached.append("slept")
+        return 0
+
+    _replace_run(monkeypatch, importing)
+    code, _, err = run(capsys, ["coefficients", small_map])
+    assert code == 143 and err == "fepost: terminated by SIGTERM\n"
+    assert reached == [True]
+    sys.modules.pop("slow_module_for_signal", None)
+
+
+def test_a_signal_changed_into_another_exception_still_stops_the_run(monkeypatch, capsys, small_map):
+    """A library may turn the signal's exception into its own (VTK: an interrupted import
+    becomes ImportError, then "cannot read the file"): the exit status follows the signal."""
+    from fepost.errors import InputFileError
+
+    def swallowed(args):
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+        except BaseException:
+            raise InputFileError("map.vtu: cannot read .vtu file (Failed to load vtkIOXML)") from None
+
+    _replace_run(monkeypatch, swallowed)
+    code, _, err = run(capsys, ["coefficients", small_map])
+    assert code == 143 and err == "fepost: terminated by SIGTERM\n"
 
 
 # --- warnings at the edge ------------------------------------------------------------------

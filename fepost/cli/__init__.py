@@ -113,39 +113,89 @@ def _one_line(text: object) -> str:
     return line
 
 
-class _Warnings:
-    """``warnings.showwarning`` for a run: fepost's as one line, others only with --debug."""
+class _Run:
+    """State of one run: ``--debug``, and the signal that stopped it, if any.
+
+    The signal is recorded before its exception is raised because a library may
+    turn that exception into another one on its way up (an interrupted import
+    inside VTK surfaces as ImportError and then as "cannot read the file"); the
+    recorded signal decides the exit status.
+    """
 
     def __init__(self) -> None:
         self.debug = False
+        self.signum: int | None = None
 
-    def show(self, message, category, filename, lineno, file=None, line=None) -> None:
+    def show_warning(self, message, category, filename, lineno, file=None, line=None) -> None:
+        """``warnings.showwarning``: fepost's warnings as one line, others only with --debug."""
         if issubclass(category, FepostWarning):
             print(f"fepost: warning ({category.__name__}): {_one_line(message)}", file=sys.stderr)
         elif self.debug:
             where = f"{os.path.basename(filename)}:{lineno}"
             print(f"fepost: debug: {category.__name__} at {where}: {_one_line(message)}", file=sys.stderr)
 
+    def on_signal(self, signum, frame) -> None:
+        """SIGINT/SIGTERM/SIGHUP: record it and raise, unless an import is running.
 
-def _raise_terminated(signum, frame) -> None:
-    raise Terminated(signum)
+        An exception raised while VTK's extension modules initialise crashes the
+        process (SIGSEGV, seen in testing); inside an import the raise waits for
+        a SIGALRM 50 ms later that checks again (:meth:`on_alarm`).
+        """
+        self.signum = self.signum or signum
+        self.on_alarm(signal.SIGALRM, frame)
+
+    def on_alarm(self, signum, frame) -> None:
+        if self.signum is None:
+            return
+        if _importing(frame):
+            signal.setitimer(signal.ITIMER_REAL, _RECHECK)
+            return
+        if self.signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise Terminated(self.signum)
+
+    def stopped(self) -> int:
+        """Report the recorded signal; the exit status 128 + signal number (130 for Ctrl-C)."""
+        assert self.signum is not None
+        if self.signum == signal.SIGINT:
+            _say("fepost: interrupted")
+        else:
+            _say(f"fepost: terminated by {signal.Signals(self.signum).name}")
+        return 128 + self.signum
+
+
+#: Delay (s) before a signal that arrived during an import is checked again.
+_RECHECK = 0.05
+
+
+def _importing(frame) -> bool:
+    """Whether ``frame`` (a signal handler's) runs inside an import."""
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib._bootstrap"):
+            return True
+        frame = frame.f_back
+    return False
 
 
 @contextmanager
-def _termination_unwinds() -> Iterator[None]:
-    """SIGTERM/SIGHUP raise :class:`Terminated` while the command runs (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
+def _signals_unwind(run: _Run) -> Iterator[None]:
+    """SIGINT, SIGTERM and SIGHUP raise (recorded in ``run``) while the command runs.
+
+    Only in the main thread, and only for signals not set to be ignored (``nohup``).
+    SIGALRM is used to defer a signal that arrives during an import.
+    """
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
         yield
         return
-    names = ("SIGTERM", "SIGHUP")
-    old = {}
-    for name in names:
+    old = {signal.SIGALRM: signal.signal(signal.SIGALRM, run.on_alarm)}
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
         sig = getattr(signal, name, None)
-        if sig is not None:
-            old[sig] = signal.signal(sig, _raise_terminated)
+        if sig is not None and signal.getsignal(sig) is not signal.SIG_IGN:
+            old[sig] = signal.signal(sig, run.on_signal)
     try:
         yield
     finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
         for sig, handler in old.items():
             signal.signal(sig, handler)
 
@@ -160,18 +210,26 @@ def _silence_stdout() -> None:
         pass
 
 
-def _error(message: str) -> None:
+def _say(line: str) -> None:
     try:
-        print(f"fepost: error: {_one_line(message)}", file=sys.stderr)
+        print(line, file=sys.stderr)
     except (OSError, ValueError):
         pass
 
 
-def _run(argv: list[str], shown: _Warnings) -> int:
+def _error(message: object) -> None:
+    _say(f"fepost: error: {_one_line(message)}")
+
+
+def _internal(exc: BaseException) -> int:
+    _error(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug and report it)")
+    return INTERNAL
+
+
+def _run(argv: list[str], run: _Run) -> int:
     from ._validate import check_grid, check_strings, resolve_defaults
 
-    debug = "--debug" in argv[: next((i for i, a in enumerate(argv) if a in COMMANDS), len(argv))]
-    shown.debug = debug
+    run.debug = "--debug" in argv[: next((i for i, a in enumerate(argv) if a in COMMANDS), len(argv))]
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
@@ -185,33 +243,25 @@ def _run(argv: list[str], shown: _Warnings) -> int:
         sys.stdout.flush()
         return exc.code if isinstance(exc.code, int) else (OK if exc.code is None else BAD_INPUT)
     except UsageError as exc:
-        _error(str(exc))
+        _error(exc)
         return BAD_INPUT
-    except FepostError as exc:
-        if debug:
-            raise
-        _error(str(exc))
-        return BAD_INPUT
-    except BrokenPipeError:
+    except (KeyboardInterrupt, Terminated, BrokenPipeError):
         raise
-    except OSError as exc:
-        if debug:
+    except Exception as exc:
+        if run.signum is not None:  # a signal's exception, changed on its way up
+            return run.stopped()
+        if run.debug:
             raise
-        if exc.filename is not None:  # names the file: a file problem the library did not anticipate
+        if isinstance(exc, FepostError):
+            _error(exc)
+            return BAD_INPUT
+        if isinstance(exc, OSError) and exc.filename is not None:  # names the file
             _error(f"{exc.filename}: {exc.strerror or exc}")
             return BAD_INPUT
-        _error(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug and report it)")
-        return INTERNAL
-    except MemoryError:
-        if debug:
-            raise
-        _error("out of memory (a smaller grid, --nr/--nphi, or a smaller model may fit)")
-        return INTERNAL
-    except Exception as exc:
-        if debug:
-            raise
-        _error(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug and report it)")
-        return INTERNAL
+        if isinstance(exc, MemoryError):
+            _error("out of memory (a smaller grid, --nr/--nphi, or a smaller model may fit)")
+            return INTERNAL
+        return _internal(exc)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -221,19 +271,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     :data:`EXIT_STATUSES`.
     """
     argv = list(sys.argv[1:] if argv is None else argv)
-    shown = _Warnings()
+    run = _Run()
     with warnings.catch_warnings():
         warnings.simplefilter("always", FepostWarning)
-        warnings.showwarning = shown.show
+        warnings.showwarning = run.show_warning
         try:
-            with _termination_unwinds():
-                return _run(argv, shown)
+            with _signals_unwind(run):
+                return _run(argv, run)
         except KeyboardInterrupt:
-            _error("interrupted")
-            return INTERRUPTED
+            run.signum = run.signum or signal.SIGINT
+            return run.stopped()
         except Terminated as exc:
-            _error(f"terminated by {signal.Signals(exc.signum).name}")
-            return 128 + exc.signum
+            run.signum = exc.signum
+            return run.stopped()
         except BrokenPipeError:
             _silence_stdout()
             return BROKEN_PIPE

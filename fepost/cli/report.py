@@ -37,7 +37,7 @@ def add_parser(sub) -> None:
     add_friction_option(p)
     p.add_argument(
         "--inflation-pressure",
-        type=v.positive,
+        type=float,
         metavar="P",
         help="inflation pressure P* in Pa for sigma/P* (default: sidecar 'inflation_pressure', else 200e3)",
     )
