@@ -203,9 +203,12 @@ def test_bad_options_are_one_line_exit_2(capsys, small_map, tmp_path, extra, mes
         (["table1", "--seed", "-1"], r"argument --seed: must be an integer >= 0, got '-1'"),
         (["table1", "--seed", "1e3"], r"argument --seed: not an integer: '1e3'"),
         (["table1", "--n-points", "1"], r"argument --n-points: must be an integer in \[2, 1000000\]"),
-        (["table1", "--span", "0"], r"argument --span: must be a positive finite number, got '0'"),
-        (["table1", "--amplitude", "1e300"], r"argument --amplitude: must be a number in \[0, 10\]"),
-        (["table1", "--k-x", "nan"], r"argument --k-x: must be a finite number, got 'nan'"),
+        (["table1", "--span", "0"], r"argument --span: must be a number in \(0, 100\], got '0'"),
+        (["table1", "--span", "1000"], r"argument --span: must be a number in \(0, 100\], got '1000'"),
+        (["table1", "--amplitude", "5"], r"argument --amplitude: must be a number in \[0, 2\], got '5'"),
+        (["table1", "--k-x", "nan"], r"argument --k-x: must be a number in \[-10, 10\], got 'nan'"),
+        (["table1", "--friction", "1e-300"], r"argument --friction: must be a friction coefficient in \["),
+        (["report", "--out", "x", "--friction", "11"], r"argument --friction: must be a friction coeff"),
         (["report", "--out", "x", "--seed", "-7"], r"argument --seed: must be an integer >= 0, got '-7'"),
         (["report", "--out", "x", "--inflation-pressure", "abc"], r"argument --inflation-pressure: invalid"),
         (["report"], r"the following arguments are required: --out"),
@@ -241,7 +244,7 @@ def test_validators_directly():
     import argparse
 
     assert v.friction("0.3") == 0.3 and v.seed("0") == 0 and v.fraction("0.5") == 0.5
-    assert v.integer_in(2)("7") == 7 and v.number_in(0, 10)("10") == 10.0
+    assert v.integer_in(2)("7") == 7 and v.number_in(0, 10)("10") == 10.0 and v.span("100") == 100.0
     with pytest.raises(argparse.ArgumentTypeError, match="not an integer: '9{10}"):
         v.seed("9" * 5000)  # longer than int() converts: still a one-line refusal
     with pytest.warns(fepost.errors.OptionWarning):

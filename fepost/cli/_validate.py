@@ -9,14 +9,20 @@ implausible are accepted with an :class:`~fepost.errors.OptionWarning`.
 The ranges (documented in ``docs/cli-exit-codes.md`` and each option's help):
 
 ================  ======================================================
-``--friction``    a finite number > 0; above :data:`FRICTION_PLAUSIBLE`
-                  (1.5) accepted with a warning: tire rubber on a road
-                  reaches about 1.2 (dry asphalt), racing compounds ~1.5
+``--friction``    a number in [0.001, 10] (:data:`FRICTION_RANGE`); above
+                  :data:`FRICTION_PLAUSIBLE` (1.5) accepted with a warning:
+                  tire rubber on a road reaches about 1.2 (dry asphalt)
 ``--threshold``   a number strictly between 0 and 1 (fraction of the peak)
 ``--seed``        an integer >= 0 (numpy's generators take no negative seed)
 ``--nr``          an integer in [2, 4096]; ``--nphi`` in [4, 16384]; and
                   the grid must fit in memory (:func:`check_grid`)
+table1            ``--span`` in (0, 100], ``--k-x`` in [-10, 10],
+                  ``--amplitude`` in [0, 2], ``--n-points`` in [2, 10^6]
 ================  ======================================================
+
+The outer limits are where the computations stop being meaningful in floating
+point (Table 1's curves overflow for ψ spans of 1000, a noise amplitude of 5 or
+f = 1e-300), far outside any physical case.
 
 This module is light on purpose (argparse and the standard library only): the
 parser is built from it on every run, including ``fepost --help``, which must not
@@ -38,6 +44,9 @@ from ..errors import OptionWarning
 #: Above this friction coefficient ``--friction`` warns (accepted: rubber on
 #: glass or on a clean dry surface can reach 2-3, so it is not refused).
 FRICTION_PLAUSIBLE = 1.5
+#: ``--friction`` outside this range is refused: not a friction coefficient of a
+#: tire (ice is about 0.05), and the friction curves over- or underflow beyond it.
+FRICTION_RANGE = (0.001, 10.0)
 #: Largest grid sizes accepted per option (a million-node FE patch is resolved
 #: by 256 x 512; the default is 64 x 128).
 NR_MAX = 4096
@@ -68,10 +77,15 @@ def _integer(text: str) -> int:
 
 
 def friction(text: str) -> float:
-    """Friction coefficient f: finite and > 0; a warning above :data:`FRICTION_PLAUSIBLE`."""
+    """Friction coefficient f in :data:`FRICTION_RANGE`; a warning above :data:`FRICTION_PLAUSIBLE`."""
     f = _number(text)
+    lo, hi = FRICTION_RANGE
     if not (math.isfinite(f) and f > 0):
         raise argparse.ArgumentTypeError(f"must be a positive number, got {_text(text)}")
+    if not lo <= f <= hi:
+        raise argparse.ArgumentTypeError(
+            f"must be a friction coefficient in [{lo:g}, {hi:g}], got {_text(text)}"
+        )
     if f > FRICTION_PLAUSIBLE:
         warnings.warn(
             f"--friction {f:g} is above {FRICTION_PLAUSIBLE:g}, implausible for a tire on a road "
@@ -112,14 +126,6 @@ def integer_in(lo: int, hi: int | None = None, what: str = "an integer"):
     return check
 
 
-def positive(text: str) -> float:
-    """A finite number > 0 (a pressure, a span, ...)."""
-    x = _number(text)
-    if not (math.isfinite(x) and x > 0):
-        raise argparse.ArgumentTypeError(f"must be a positive finite number, got {_text(text)}")
-    return x
-
-
 def number_in(lo: float, hi: float):
     """Type for a number in [lo, hi]."""
 
@@ -133,11 +139,11 @@ def number_in(lo: float, hi: float):
     return check
 
 
-def finite(text: str) -> float:
-    """Any finite number."""
+def span(text: str) -> float:
+    """Largest ψ and υ of Table 1's curves: in (0, 100]."""
     x = _number(text)
-    if not math.isfinite(x):
-        raise argparse.ArgumentTypeError(f"must be a finite number, got {_text(text)}")
+    if not (0.0 < x <= 100.0):
+        raise argparse.ArgumentTypeError(f"must be a number in (0, 100], got {_text(text)}")
     return x
 
 

@@ -46,7 +46,7 @@ def add_parser(sub) -> None:
     p.add_argument("--noise", choices=("uniform", "gaussian"), default="uniform", help="noise distribution")
     p.add_argument(
         "--amplitude",
-        type=v.number_in(0.0, 10.0),
+        type=v.number_in(0.0, 2.0),
         default=v.LibraryDefault("fepost.identify", "DEFAULT_AMPLITUDE"),
         metavar="A",
         help="noise amplitude as a fraction of each curve's maximum (default %(default)s)",
@@ -60,14 +60,14 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--span",
-        type=v.positive,
+        type=v.span,
         default=v.LibraryDefault("fepost.identify", "DEFAULT_SPAN"),
         metavar="X",
         help="largest psi and upsilon of the curves (default %(default)s)",
     )
     p.add_argument(
         "--k-x",
-        type=v.finite,
+        type=v.number_in(-10.0, 10.0),
         metavar="K",
         help="assumed k_x when no rolling map is used (default 0.130)",
     )
