@@ -189,10 +189,16 @@ def _text(plotter, text: str, xyz, size: int, h: str = "center", v: str = "cente
     prop.SetFontSize(size)
     prop.SetFontFamilyToArial()
     prop.SetColor(*_rgb(color))
-    {"left": prop.SetJustificationToLeft, "center": prop.SetJustificationToCentered,
-     "right": prop.SetJustificationToRight}[h]()  # fmt: skip
-    {"bottom": prop.SetVerticalJustificationToBottom, "center": prop.SetVerticalJustificationToCentered,
-     "top": prop.SetVerticalJustificationToTop}[v]()  # fmt: skip
+    {
+        "left": prop.SetJustificationToLeft,
+        "center": prop.SetJustificationToCentered,
+        "right": prop.SetJustificationToRight,
+    }[h]()
+    {
+        "bottom": prop.SetVerticalJustificationToBottom,
+        "center": prop.SetVerticalJustificationToCentered,
+        "top": prop.SetVerticalJustificationToTop,
+    }[v]()
     coord = actor.GetPositionCoordinate()
     coord.SetCoordinateSystemToWorld()
     coord.SetValue(*map(float, xyz))
@@ -213,6 +219,15 @@ def text_box(actor, renderer) -> tuple[float, float, float, float]:
     coord = actor.GetPositionCoordinate()
     x, y = coord.GetComputedDoubleDisplayValue(renderer)
     return (x + bb[0], x + bb[1], y + bb[2], y + bb[3])
+
+
+def viewport_box(actor, renderer) -> tuple[float, float, float, float]:
+    """(x0, x1, y0, y1) in display pixels of a 2-D actor placed in normalised viewport
+    coordinates (legend, colour bar)."""
+    w, h = renderer.GetSize()
+    x, y = actor.GetPosition()
+    dx, dy = actor.GetPosition2()
+    return (x * w, (x + dx) * w, y * h, (y + dy) * h)
 
 
 def boxes_overlap(a, b, pad: float = 0.0) -> bool:
@@ -369,8 +384,17 @@ def pressure_surface(
         shaft_radius=0.03,
     )
     plotter.add_mesh(arrow, color=theme.ROLLING_COLOUR)
-    texts = [_text(plotter, "rolling direction +x", (-0.6 * r, y_arrow, 0.0), TICK_FONT, "right", "center",
-                   theme.ROLLING_COLOUR)]  # fmt: skip
+    texts = [
+        _text(
+            plotter,
+            "rolling direction +x",
+            (-0.6 * r, y_arrow, 0.0),
+            TICK_FONT,
+            "right",
+            "center",
+            theme.ROLLING_COLOUR,
+        )
+    ]
 
     # Fixed camera: from the front-left, above the patch.
     peak_dimless = float(np.max(nodes)) if len(nodes) else 0.0
@@ -389,6 +413,26 @@ def pressure_surface(
     cam.position = tuple(np.add(cam.position, shift))
     cam.focal_point = tuple(np.add(cam.focal_point, shift))
 
+    heading = f"height p/P* (P* = {p_star / 1e3:.0f} kPa), colour p (kPa)"
+    head = _text(
+        plotter, f"{title}\n{heading}" if title else heading, (0.5, 0.985, 0.0), TITLE_FONT, "center", "top"
+    )
+    head.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+    legend = plotter.add_legend(
+        [
+            [f"circle of radius R = {r:.4g} m", theme.RMAX_COLOUR],
+            [f"fitted ellipse, aspect {patch.aspect:.3f}", theme.ELLIPSE_COLOUR],
+            [f"contact edge, p = {EDGE_FRACTION:.0%} of peak", theme.EDGE_COLOUR],
+        ],
+        bcolor="white",
+        border=False,
+        loc="upper right",
+        size=LEGEND_SIZE,
+        face="line",
+    )
+    legend.SetPosition(*LEGEND_ORIGIN)
+    legend.SetPosition2(*LEGEND_SIZE)
+
     # Axes: x along the front edge, y along the left edge (z = 0), height at the back-left corner.
     frame = np.array([[-ext, -ext, 0], [ext, -ext, 0], [ext, ext, 0], [-ext, ext, 0], [-ext, -ext, 0]], float)
     plotter.add_mesh(pv.lines_from_points(frame), color="#555555", line_width=1.5, pickable=False)
@@ -396,7 +440,8 @@ def pressure_surface(
     plotter.add_mesh(pv.lines_from_points(zline), color="black", line_width=2, pickable=False)
     tick = 0.04 * ext
     xy_ticks = nice_ticks(-ext, ext)
-    occupied = [text_box(texts[0], renderer)]
+    occupied = [text_box(texts[0], renderer), text_box(head, renderer)]
+    occupied += [viewport_box(legend, renderer), viewport_box(plotter.scalar_bar, renderer)]
 
     def axis(ticks, start, direction, outward, offset, h, v, scale=1.0):
         return _thin(
@@ -419,27 +464,6 @@ def pressure_surface(
         _text(plotter, "p/P*", (-ext, ext, z_top * 1.12 + 0.02 * ext), AXIS_TITLE_FONT, "center", "bottom")
     )
 
-    heading = f"height p/P* (P* = {p_star / 1e3:.0f} kPa), colour p (kPa)"
-    head = plotter.add_text(
-        f"{title}\n{heading}" if title else heading,
-        position="upper_edge",
-        font_size=TITLE_FONT // 2,
-        color="black",
-    )
-    legend = plotter.add_legend(
-        [
-            [f"circle r_max = R = {r:.4g} m", theme.RMAX_COLOUR],
-            [f"fitted ellipse, aspect {patch.aspect:.3f}", theme.ELLIPSE_COLOUR],
-            [f"contact edge, p = {EDGE_FRACTION:.0%} of peak", theme.EDGE_COLOUR],
-        ],
-        bcolor="white",
-        border=False,
-        loc="upper right",
-        size=LEGEND_SIZE,
-        face="line",
-    )
-    legend.SetPosition(*LEGEND_ORIGIN)
-    legend.SetPosition2(*LEGEND_SIZE)
     plotter._fepost_layout = SurfaceLayout(tuple(texts), head, legend, surface)
     return plotter
 

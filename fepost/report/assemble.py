@@ -231,8 +231,14 @@ def _row(key, label, kind, definition, value, prefix):
 
     unit = units.UNITS[kind] if kind else ""
     scale = 1e-3 if kind == "pressure" else 1.0
-    return {"key": f"{prefix}.{key}", "label": label, "value": value, "unit": unit, "scale": scale,
-            "definition": definition}  # fmt: skip
+    return {
+        "key": f"{prefix}.{key}",
+        "label": label,
+        "value": value,
+        "unit": unit,
+        "scale": scale,
+        "definition": definition,
+    }
 
 
 def page_context(

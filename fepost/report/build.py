@@ -201,8 +201,11 @@ def build_report(
         fc = steps.run("exact friction integrals (Figures 4-6)", friction_curves, a, t)
 
         def curve_figs():
-            stems = {"F_parallel": ("fig4_f_parallel", "fig4"), "M_C": ("fig5_torque", "fig5"),
-                     "F_perp": ("fig6_f_perp", "fig6")}  # fmt: skip
+            stems = {
+                "F_parallel": ("fig4_f_parallel", "fig4"),
+                "M_C": ("fig5_torque", "fig5"),
+                "F_perp": ("fig6_f_perp", "fig6"),
+            }
             made = {}
             for cd in fc.curves:
                 stem, key = stems[cd.name]
