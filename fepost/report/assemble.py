@@ -98,8 +98,8 @@ def friction_curves(analysis: Analysis, table: Table1) -> FrictionCurves:
     (:meth:`fepost.identify.Identification.prediction_band`); and the noisy test
     points of ``table.curves``. Figure 6 only with a rolling map.
     """
-    from .figures.curves import CurveData
-    from .friction.quadrature import PressureQuadrature
+    from ..figures.curves import CurveData
+    from ..friction.quadrature import PressureQuadrature
 
     c = analysis.coefficients
     R = table.R
@@ -221,7 +221,7 @@ PATCH_ROWS = (
     ("r_equiv", "r_equiv = √(area/π)", "length"),
     ("aspect", "aspect (ellipse length/width)", None),
     ("area", "area of the loaded faces", "area"),
-    ("load_outside_r_equiv", "share of the load outside r_equiv", None),
+    ("load_outside_r_equiv", "share of the load outside r_equiv", "fraction"),
     ("planarity_rms", "RMS distance from the plane", "length"),
 )
 
@@ -229,14 +229,14 @@ PATCH_ROWS = (
 def _row(key, label, kind, definition, value, prefix):
     from . import units
 
-    unit = units.UNITS[kind] if kind else ""
-    scale = 1e-3 if kind == "pressure" else 1.0
+    unit = units.UNITS[kind] if kind and kind != "fraction" else ""
     return {
         "key": f"{prefix}.{key}",
         "label": label,
         "value": value,
         "unit": unit,
-        "scale": scale,
+        "scale": 1e-3 if kind == "pressure" else 1.0,
+        "fmt": "{:.2%}" if kind == "fraction" else "{:.6g}",
         "definition": definition,
     }
 
@@ -267,7 +267,7 @@ def page_context(
         if coef.get(key) is not None
     ]
     coefficient_rows += [
-        {**_row(f"A.{j}", f"A{j}", "pressure", f"∫₀¹ σ̄₀(ρ) ρ^{j} dρ", coef["A"][j], "coefficients")}
+        {**_row(f"A.{j}", f"A{j}", "pressure", f"∫₀¹ σ̄₀(ρ) ρ{'⁰¹²³'[j]} dρ", coef["A"][j], "coefficients")}
         for j in range(4)
     ]
     if coef.get("reaction_z") is not None:

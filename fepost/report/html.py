@@ -58,6 +58,7 @@ def environment():
         kpa=units.kpa,
         number=units.number,
         unit=units.display_unit,
+        text=units.normalise,
         pct=lambda v, fmt="{:.1%}": units.number(v, fmt).replace("%", f"{units.NNBSP}%"),
     )
     return env

@@ -12,6 +12,7 @@ The JSON and CSV files are plain SI (Pa, m, N, N·m) whatever the display.
 from __future__ import annotations
 
 import math
+import re
 
 #: Narrow no-break space, between a number and its unit.
 NNBSP = "\u202f"
@@ -54,3 +55,14 @@ def display_unit(unit: str | None) -> str:
     if not unit or unit == "1":
         return ""
     return {"N m": "N·m", "1/m^2": "m⁻²", "1/m²": "m⁻²", "m^2": "m²", "Pa": "Pa"}.get(unit, unit)
+
+
+_UNIT_AFTER_NUMBER = re.compile(r"(\d) (N m|N·m|kPa|MPa|Pa|m²|m|N|s)(?![\w²])")
+
+
+def normalise(text: str) -> str:
+    """Free text from elsewhere (notes, rules) in the report's style: "N m" -> "N·m",
+    "<=" -> "≤", a narrow no-break space between a number and its unit."""
+    text = text.replace("<=", "≤").replace(">=", "≥")
+    text = _UNIT_AFTER_NUMBER.sub(lambda m: f"{m.group(1)}{NNBSP}{display_unit(m.group(2))}", text)
+    return text.replace(" N m", f"{NNBSP}N·m")

@@ -12,7 +12,8 @@ vectors), so ParaView's *Transform* filter can put it back into the model.
     between neighbouring rings (closed in φ). Point data ``sigma`` (Pa),
     ``dA`` (the quadrature weight of the node, m²; Σ sigma·dA = N), ``valid``
     (1 where the node fell on a loaded FE face). Field data ``R`` (m), ``centre``
-    (m, patch frame), ``N`` (N), ``rule``.
+    (m, patch frame), ``N`` (N); numbers only, so that other readers (meshio)
+    read it too.
 ``<map>_patch.vtp`` (:func:`patch_surface`)
     The loaded FE faces (triangles) flat in the patch plane, with the FE
     pressure ``pressure`` (Pa) where the FE values live (point or cell data).
@@ -72,7 +73,6 @@ def polar_map_grid(pmap: PolarMap, patch: Patch):
     grid.field_data["R"] = np.array([pmap.radius])
     grid.field_data["centre"] = np.array([cx, cy])
     grid.field_data["N"] = np.array([pmap.integrate()])
-    grid.field_data["rule"] = np.array([g.rule])
     _frame_data(grid, patch)
     return grid
 
@@ -119,9 +119,10 @@ def patch_outline(patch: Patch, frame_of: Patch | None = None):
         part.append(np.full(len(ln), PARTS.index(name)))
         offset += len(pts)
     p2 = np.concatenate(points)
-    mesh = pv.PolyData(np.column_stack([p2, np.zeros(len(p2))]))
     seg = np.concatenate(lines)
-    mesh.lines = np.column_stack([np.full(len(seg), 2), seg]).ravel()
+    mesh = pv.PolyData(
+        np.column_stack([p2, np.zeros(len(p2))]), lines=np.column_stack([np.full(len(seg), 2), seg]).ravel()
+    )
     mesh.cell_data["part"] = np.concatenate(part).astype(np.int32)
     mesh.field_data["part_names"] = np.array(PARTS)
     mesh.field_data["centre_of_pressure"] = cp
