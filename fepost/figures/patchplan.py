@@ -63,7 +63,7 @@ def plot_patch_plan(patch: Patch, ax=None):
         edge = contact_edge(patch)
         ax.add_collection(
             LineCollection(
-                edge,
+                list(edge),
                 colors=theme.EDGE_COLOUR,
                 linewidths=1.2,
                 label=f"contact edge (p = {EDGE_FRACTION:.0%} of peak)",

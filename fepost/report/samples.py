@@ -22,7 +22,7 @@ def meshes_folder() -> Path:
 
 def sample_inputs() -> tuple[Path, Path | None]:
     """(static, rolling) sample paths; a one-line :class:`ArgumentError` when one is missing."""
-    paths = []
+    paths: list[Path | None] = []
     for name in (SAMPLE_STATIC, SAMPLE_ROLLING):
         if name is None:
             paths.append(None)
@@ -31,4 +31,6 @@ def sample_inputs() -> tuple[Path, Path | None]:
         if not p.is_file():
             raise ArgumentError(f"{p}: sample mesh not found (give the FE exports explicitly)")
         paths.append(p)
-    return paths[0], paths[1]
+    static = paths[0]
+    assert static is not None  # SAMPLE_STATIC is a name
+    return static, paths[1]

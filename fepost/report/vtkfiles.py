@@ -60,9 +60,9 @@ def polar_map_grid(pmap: PolarMap, patch: Patch):
     cx, cy = pmap.centre
     pts = np.column_stack([x.ravel() + cx, y.ravel() + cy, np.zeros(x.size)])
     i, j = np.meshgrid(np.arange(nr - 1), np.arange(nphi), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    jn = (j + 1) % nphi
-    quads = np.column_stack([i * nphi + j, (i + 1) * nphi + j, (i + 1) * nphi + jn, i * nphi + jn])
+    ii, jj = i.ravel(), j.ravel()
+    jn = (jj + 1) % nphi
+    quads = np.column_stack([ii * nphi + jj, (ii + 1) * nphi + jj, (ii + 1) * nphi + jn, ii * nphi + jn])
     cells = np.column_stack([np.full(len(quads), 4), quads]).ravel()
     types = np.full(len(quads), pv.CellType.QUAD, dtype=np.uint8)
     grid = pv.UnstructuredGrid(cells, types, pts)
