@@ -252,11 +252,9 @@ def project(tmp_path, monkeypatch, small_map):
     meshes.mkdir(parents=True)
     for name in ("static.vtu", "rolling.vtu"):
         shutil.copy(small_map, meshes / name)
-    import fepost.cli._common as common
-    import fepost.cli.report as report
+    import fepost.report.samples as samples
 
-    monkeypatch.setattr(common, "repo_meshes", lambda: meshes)
-    monkeypatch.setattr(report, "repo_meshes", lambda: meshes)
+    monkeypatch.setattr(samples, "meshes_folder", lambda: meshes)
     home = tmp_path / "home"
     (home / "work").mkdir(parents=True)
     monkeypatch.setenv("HOME", str(home))

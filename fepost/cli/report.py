@@ -11,7 +11,7 @@ import argparse
 import sys
 
 from . import _validate as v
-from ._common import add_friction_option, add_input_options, analysis_kwargs, repo_meshes, sample_mesh
+from ._common import add_friction_option, add_input_options, analysis_kwargs
 
 
 def add_parser(sub) -> None:
@@ -19,9 +19,10 @@ def add_parser(sub) -> None:
         "report",
         help="HTML report with Figures 1-6, the coefficients and Table 1",
         description=(
-            "Write DIR/report.html with the figures (PNG, and SVG/PDF for the plots), coefficients.json, "
-            "table1.json and curves.csv. With no inputs, uses the sample meshes meshes/static.vtu and "
-            "meshes/rolling.vtu shipped with fepost."
+            "Write DIR/report.html (self-contained, figures embedded) with the figures beside it (PNG, "
+            "and SVG/PDF for the plots), coefficients.json, table1.json, curves.csv and VTK files of the "
+            "polar maps and patches. With no inputs, uses the sample meshes shipped in meshes/. "
+            "File formats: docs/formats.md."
         ),
     )
     p.add_argument(
@@ -59,15 +60,13 @@ def _progress(k: int, n: int, step: str, seconds: float) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..output import check_replaceable
     from ..report import build_report
+    from ..report.samples import meshes_folder, sample_inputs
 
-    static, rolling = args.static, args.rolling
-    if static is None:
-        static = sample_mesh("static.vtu")
-        rolling = sample_mesh("rolling.vtu")
-    check_replaceable(args.out, [static, rolling, repo_meshes()])
+    inputs = [args.static, args.rolling] if args.static is not None else [*sample_inputs()]
+    check_replaceable(args.out, [*inputs, meshes_folder()])
     result = build_report(
-        static,
-        rolling,
+        args.static,  # None: the sample meshes (fepost.report.samples)
+        args.rolling,
         args.out,
         force=args.force,
         friction=args.friction,
