@@ -188,20 +188,27 @@ def _contains(folder: Path, other: Path) -> bool:
 
 
 def check_replaceable(out: str | Path, inputs: Iterable[str | Path | None] = ()) -> None:
-    """Refuse replacing ``out`` when that would delete an input or a folder one works in.
+    """Refuse writing ``out`` when that would delete an input or a folder one works in.
 
-    ``out`` must not be, or contain, any of ``inputs`` (files or folders), the
+    ``out`` (a file or a folder) must not be, or contain, any of ``inputs``, the
     current folder, the home folder or the file-system root. Raises
     :class:`~fepost.errors.OutputError` with one line naming what it holds.
     """
-    target = Path(out).resolve()
+    try:
+        target = Path(out).resolve()
+    except OSError as exc:  # a name too long, a symlink loop
+        raise OutputError(f"{out}: cannot write here ({exc.strerror or exc})") from None
     guarded = [(Path(p).resolve(), f"the input {p}") for p in inputs if p is not None]
     guarded.append((Path.cwd().resolve(), "the current folder"))
-    guarded.append((Path.home().resolve(), "the home folder"))
+    try:
+        guarded.append((Path.home().resolve(), "the home folder"))
+    except (RuntimeError, KeyError):  # no HOME and no password entry
+        pass
+    kind = "overwrite this file" if os.path.isfile(target) else "replace this folder"
     for path, what in guarded:
         if _contains(target, path):
             rel = "is" if target == path else "contains"
-            raise OutputError(f"{out}: refusing to replace this folder: it {rel} {what}")
+            raise OutputError(f"{out}: refusing to {kind}: it {rel} {what}")
     if target == Path(target.anchor):
         raise OutputError(f"{out}: refusing to replace the file-system root")
 

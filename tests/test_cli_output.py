@@ -302,3 +302,25 @@ def test_home_and_root_are_never_replaced(tmp_path, monkeypatch):
         check_replaceable(tmp_path)
     other = tmp_path.parent / f"{tmp_path.name}-other"
     check_replaceable(other, [tmp_path / "x.vtu"])  # a sibling: fine
+
+
+def test_no_command_writes_over_its_inputs(capsys, small_map, tmp_path):
+    """--json or --out naming an input (or a folder holding one) is refused before any work."""
+    static = Path(shutil.copy(small_map, tmp_path / "static.vtu"))
+    before = static.read_bytes()
+    csv = tmp_path / "rig" / "measured.csv"
+    csv.parent.mkdir()
+    csv.write_text("vx,vy,wz,Fx,Fy,Mz\n")
+    for argv, message in [
+        (["coefficients", static, "--json", static], f"{static}: refusing to overwrite this file: it is the"),
+        (["table1", "--static", static, "--json", static], f"{static}: refusing to overwrite this file"),
+        (["diagnose", "--simulation", static, "--measured", csv, "--out", csv.parent, "--force"],
+         f"{csv.parent}: refusing to replace this folder: it contains the input {csv}"),
+        (["diagnose", "--simulation", static, "--measured", csv, "--out", tmp_path, "--force"],
+         f"{tmp_path}: refusing to replace this folder: it contains the input {static}"),
+    ]:  # fmt: skip
+        assert main([str(a) for a in argv]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1, err
+        assert err[0].startswith(f"fepost: error: {message}")
+    assert static.read_bytes() == before and csv.is_file()

@@ -227,7 +227,7 @@ def _internal(exc: BaseException) -> int:
 
 
 def _run(argv: list[str], run: _Run) -> int:
-    from ._validate import check_grid, check_strings, resolve_defaults
+    from ._validate import check_grid, check_outputs, check_strings, resolve_defaults
 
     run.debug = "--debug" in argv[: next((i for i, a in enumerate(argv) if a in COMMANDS), len(argv))]
     try:
@@ -236,6 +236,7 @@ def _run(argv: list[str], run: _Run) -> int:
         resolve_defaults(args)
         check_strings(parser, args)
         check_grid(args)
+        check_outputs(args)
         status = int(args.func(args) or 0)
         sys.stdout.flush()
         return status

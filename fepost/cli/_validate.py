@@ -169,6 +169,38 @@ def check_strings(parser: argparse.ArgumentParser, args: argparse.Namespace) -> 
                 raise ArgumentError(f"argument {name}: {problem}")
 
 
+#: Destinations of the options that name outputs, in every subcommand.
+OUTPUT_OPTIONS = ("out", "json")
+
+
+def check_outputs(args: argparse.Namespace) -> None:
+    """Refuse an output (``--out``, ``--json``) that is or contains one of the run's
+    inputs, or whose folder does not exist, before any work is done.
+
+    The inputs are every other path given on the command line that exists; the
+    current and home folders are guarded too (:func:`fepost.output.check_replaceable`).
+    Raises :class:`~fepost.errors.OutputError`.
+    """
+    values = []
+    for key, value in vars(args).items():
+        if key in OUTPUT_OPTIONS or key in ("func", "command"):
+            continue
+        for item in value if isinstance(value, list) else [value]:
+            if isinstance(item, str) and os.path.exists(item):
+                values.append(item)
+    outputs = {key: getattr(args, key) for key in OUTPUT_OPTIONS if isinstance(getattr(args, key, None), str)}
+    if outputs:
+        from ..errors import OutputError
+        from ..output import check_replaceable
+
+        for key, out in outputs.items():
+            check_replaceable(out, values)
+            parent = os.path.dirname(out) or "."
+            if not os.path.isdir(parent):  # fail now, not after the computation
+                where = "parent folder" if key == "out" else "folder"
+                raise OutputError(f"{out}: {where} {parent} does not exist")
+
+
 radial_nodes = integer_in(2, NR_MAX)
 angular_nodes = integer_in(4, NPHI_MAX)
 
