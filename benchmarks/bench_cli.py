@@ -37,7 +37,7 @@ def wall(cmd: list[str]) -> float:
 
 def medians(commands: dict[str, list[str]], repeat: int) -> dict[str, float]:
     times: dict[str, list[float]] = {name: [] for name in commands}
-    for name, cmd in commands.items():  # warm the file cache once
+    for cmd in commands.values():  # warm the file cache once
         wall(cmd)
     for _ in range(repeat):
         for name, cmd in commands.items():
