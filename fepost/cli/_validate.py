@@ -169,8 +169,8 @@ def check_strings(parser: argparse.ArgumentParser, args: argparse.Namespace) -> 
                 raise ArgumentError(f"argument {name}: {problem}")
 
 
-#: Destinations of the options that name outputs, in every subcommand.
-OUTPUT_OPTIONS = ("out", "json")
+#: Destinations of the options that name outputs, in every subcommand (``predict --model-json`` too).
+OUTPUT_OPTIONS = ("out", "json", "model_json")
 
 
 def check_outputs(args: argparse.Namespace) -> None:
