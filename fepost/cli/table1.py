@@ -47,21 +47,21 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--amplitude",
         type=v.number_in(0.0, 2.0),
-        default=v.LibraryDefault("fepost.identify", "DEFAULT_AMPLITUDE"),
+        default=v.LibraryDefault("fepost.identify.curves", "DEFAULT_AMPLITUDE"),
         metavar="A",
         help="noise amplitude as a fraction of each curve's maximum (default %(default)s)",
     )
     p.add_argument(
         "--n-points",
         type=v.integer_in(2, 1_000_000),
-        default=v.LibraryDefault("fepost.identify", "DEFAULT_N_POINTS"),
+        default=v.LibraryDefault("fepost.identify.curves", "DEFAULT_N_POINTS"),
         metavar="N",
         help="points per curve (default %(default)s)",
     )
     p.add_argument(
         "--span",
         type=v.span,
-        default=v.LibraryDefault("fepost.identify", "DEFAULT_SPAN"),
+        default=v.LibraryDefault("fepost.identify.curves", "DEFAULT_SPAN"),
         metavar="X",
         help="largest psi and upsilon of the curves (default %(default)s)",
     )
