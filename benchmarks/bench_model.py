@@ -113,7 +113,14 @@ def speed(model, runs: int = 7, n: int = 1_000_000) -> None:
     vx, vy = rng.normal(size=(2, n))
     wz = rng.normal(size=n) * 10.0
     paper = paper_model(model.F0, model.M0, 1.0, 8.0, 0.1, model.R)
-    cands = {"paper closed forms": paper, "base": model.without_correction(), "model": model}
+    big = build_model(ellipse_quad("uniform", 3.0), FrictionLaw(f=F), order=(8, 12), check=False)
+    K, L = model.order
+    cands = {
+        "paper closed forms": paper,
+        "base": model.without_correction(),
+        f"model ({(2 * K + 1) * L} numbers)": model,
+        "model (204 numbers)": big,
+    }
     times = {k: [] for k in cands}
     for _ in range(runs):
         for k, fn in cands.items():
@@ -148,8 +155,8 @@ def main(argv: list[str] | None = None) -> None:
         reference_rows(order, args.n_beta, args.n_t)
         if not args.no_samples:
             model = sample_rows(order, args.n_beta, args.n_t)
-    if model is None:
-        model = build_model(ellipse_quad("hertz", 2.0), FrictionLaw(f=F), order=order)
+    if model is None or model.order != (4, 8):
+        model = build_model(ellipse_quad("hertz", 2.0), FrictionLaw(f=F), order=(4, 8))
     speed(model)
 
 
