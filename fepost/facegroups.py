@@ -13,6 +13,7 @@ up its height).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -126,8 +127,11 @@ def refine(
     field cannot dip below its nodal values (linear and bilinear faces).
     """
     pts_parts = [points]
-    tri_parts, val_parts, id_parts, lin_parts = [], [], [], []
-    nvals_parts = [values] if location == "point" else []
+    tri_parts: list[Any] = []
+    val_parts: list[Any] = []
+    id_parts: list[Any] = []
+    lin_parts: list[Any] = []
+    nvals_parts: list[Any] = [values] if location == "point" else []
     base = len(points)
     for g in groups:
         if g.ftype == "tri3" or (g.ftype == "quad4" and level == 1):
@@ -153,7 +157,7 @@ def refine(
         if location == "point":
             nvals_parts.append(nv)
         else:
-            val_parts.append(np.repeat(g.values, per))
+            val_parts.append(np.repeat(np.asarray(g.values), per))
         base += len(p)
     pts = pts_parts[0] if len(pts_parts) == 1 else np.concatenate(pts_parts)
     tri = np.concatenate(tri_parts) if tri_parts else np.empty((0, 3), np.int64)
@@ -169,7 +173,7 @@ def exact_load(groups: list[FaceGroup], xy: np.ndarray, values: np.ndarray, loca
     """Exact (N, ∬σx, ∬σy) of the faces with their own shape functions, in the plane of ``xy``."""
     tot = np.zeros(3)
     for g in groups:
-        vals = values if location == "point" else g.values
+        vals = values if location == "point" else np.asarray(g.values)
         tot += quadratic.face_moments(g.ftype, xy, g.conn, vals, location).sum(axis=0)
     return tot
 

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, Literal
 
@@ -68,8 +69,8 @@ class ContactField:
     reaction_z: float | None = None
     arrays: tuple[str, ...] = ()
     sidecar: dict | None = None
-    faces: Mapping[str, np.ndarray] = field(default_factory=dict)
-    reactions: Mapping[str, float] = field(default_factory=dict)
+    faces: Mapping[str, np.ndarray] = dataclasses.field(default_factory=dict)
+    reactions: Mapping[str, float] = dataclasses.field(default_factory=dict)
     steps: tuple[float, ...] = ()
     body: str = ""
     units: Any = None

@@ -402,7 +402,7 @@ def _separate_surfaces(fld: ContactField, groups: list[FaceGroup], hot: np.ndarr
             area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
         else:
             area = 0.5 * np.linalg.norm(np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1]), axis=1)
-        val = fld.values[g.corners()].mean(axis=1) if fld.location == "point" else g.values
+        val = fld.values[g.corners()].mean(axis=1) if fld.location == "point" else np.asarray(g.values)
         loads.append(area * np.nan_to_num(val))
         start += m
     nf = start

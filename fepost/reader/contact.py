@@ -223,7 +223,7 @@ def _contact(
         used = np.zeros(len(points), bool)
         for conn in surf.conn.values():
             used[conn.ravel()] = True
-        if not used.all():
+        if not used.all() and point_values is not None:
             remap = np.cumsum(used) - 1
             points = points[used]
             point_values = point_values[used]
@@ -231,7 +231,7 @@ def _contact(
 
     tri = surf.conn.get("tri3", np.empty((0, 3), np.int64))
     faces = {t: surf.conn[t] for t in OTHER_FACE_TYPES if t in surf.conn}
-    if choice.location == "point":
+    if point_values is not None:
         values = point_values
     else:
         vals = surf.values or {}

@@ -233,18 +233,19 @@ def _pattern(ftype: str, level: int) -> tuple[np.ndarray, np.ndarray]:
         # each sub-quad split along its diagonal (0, 2), as VTK and the readers split a quad
         tris = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
         return grid, tris
-    pts, index = [], {}
+    pts: list[tuple[float, float]] = []
+    index: dict[tuple[int, int], int] = {}
     for i in range(L + 1):
         for j in range(L + 1 - i):
             index[(i, j)] = len(pts)
             pts.append((i / L, j / L))
-    tris = []
+    tri_list: list[tuple[int, int, int]] = []
     for i in range(L):
         for j in range(L - i):
-            tris.append((index[(i, j)], index[(i + 1, j)], index[(i, j + 1)]))
+            tri_list.append((index[(i, j)], index[(i + 1, j)], index[(i, j + 1)]))
             if i + j < L - 1:
-                tris.append((index[(i + 1, j)], index[(i + 1, j + 1)], index[(i, j + 1)]))
-    return np.array(pts), np.array(tris, np.int64)
+                tri_list.append((index[(i + 1, j)], index[(i + 1, j + 1)], index[(i, j + 1)]))
+    return np.array(pts), np.array(tri_list, np.int64)
 
 
 def refine(

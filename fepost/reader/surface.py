@@ -82,10 +82,10 @@ def _named_surface(
     for bi, b in enumerate(raw.blocks):
         ident = b.label.lower()
         if key == ident or ident.startswith(f"element block {key} ") or f"'{key}'" in ident:
-            faces, vals = _faces_of(
+            faces, fvals = _faces_of(
                 [(b.cell_type, b.conn)], None if cell_values is None else [cell_values[bi]]
             )
-            return faces.conn, vals, b.label
+            return faces.conn, fvals, b.label
     sets = ", ".join(f"{s.id}" + (f" '{s.name}'" if s.name else "") for s in raw.side_sets) or "none"
     blocks = ", ".join(b.label for b in raw.blocks) or "none"
     raise FieldError(
@@ -180,7 +180,7 @@ def _choose_parts(
         sizes = [len(b.conn) for b in raw.blocks]
         block_of_cell = np.repeat(np.arange(len(raw.blocks)), sizes)
         part_of_cell = np.repeat(part_of_cell, sizes)
-    parts = {}
+    parts: dict[int, dict] = {}
     for t, conn in faces.conn.items():
         pc = part_of_cell[faces.cell[t]]
         if point_values is not None:

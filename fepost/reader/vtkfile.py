@@ -116,7 +116,7 @@ def read_vtk(path: Path) -> RawMesh:
     if errors:
         raise InputFileError(f"{path}: corrupt or truncated {suffix} file ({errors[0]})")
     if reader.GetErrorCode():
-        from vtkmodules.vtkCommonCore import vtkErrorCode
+        from vtkmodules.vtkCommonCore import vtkErrorCode  # type: ignore[attr-defined]
 
         raise InputFileError(
             f"{path}: cannot read {suffix} file "
@@ -285,10 +285,10 @@ def _join(pieces: list[dict[str, np.ndarray]], sizes: list[int]) -> dict[str, np
             shapes.setdefault(name, a.shape[1:])
     out = {}
     for name, tail in shapes.items():
-        parts = []
+        parts: list[np.ndarray] = []
         for p, n in zip(pieces, sizes, strict=True):
-            a = p.get(name)
-            parts.append(np.zeros((n, *tail)) if a is None or a.shape[1:] != tail else a)
+            got = p.get(name)
+            parts.append(got if got is not None and got.shape[1:] == tail else np.zeros((n, *tail)))
         out[name] = np.concatenate(parts)
     return out
 
