@@ -26,16 +26,25 @@ STEEP_DEG = 60.0
 
 @dataclass(frozen=True)
 class FaceGroup:
-    """Faces of one type: ``conn`` (m, k); ``values`` per face (face data) or None; ``ids`` (m,) face ids."""
+    """Faces of one type.
+
+    ``conn`` (m, k); ``values`` per face (face data) or None; ``ids`` (m,) face
+    ids; ``partial`` (m,) true where some node is not loaded (the rim of the patch).
+    """
 
     ftype: str
     conn: np.ndarray
     values: np.ndarray | None
     ids: np.ndarray
+    partial: np.ndarray
 
     def subset(self, keep: np.ndarray) -> FaceGroup:
         return FaceGroup(
-            self.ftype, self.conn[keep], None if self.values is None else self.values[keep], self.ids[keep]
+            self.ftype,
+            self.conn[keep],
+            None if self.values is None else self.values[keep],
+            self.ids[keep],
+            self.partial[keep],
         )
 
     def corners(self) -> np.ndarray:
@@ -45,21 +54,27 @@ class FaceGroup:
 def loaded_groups(fld: ContactField, v: np.ndarray, thr: float) -> list[FaceGroup]:
     """The faces of ``fld`` with pressure above ``thr`` at a node (nodal data) or on the face."""
     out = []
+    hot = v > thr if fld.location == "point" else None
     for ftype, conn, sl in fld.face_groups():
-        if fld.location == "point":
-            hot = v > thr
-            loaded = hot[conn[:, 0]]
+        if hot is not None:
+            h = hot[conn[:, 0]]
+            loaded, full = h.copy(), h
             for k in range(1, conn.shape[1]):
-                loaded |= hot[conn[:, k]]
+                h = hot[conn[:, k]]
+                loaded |= h
+                full &= h
             fv = None
+            partial = ~full
         else:
             fv = v[sl]
             loaded = fv > thr
+            partial = np.ones(len(conn), bool)
         ids = np.arange(sl.start, sl.stop)
         if loaded.all():
-            out.append(FaceGroup(ftype, conn, fv, ids))
+            out.append(FaceGroup(ftype, conn, fv, ids, partial))
         elif loaded.any():
-            out.append(FaceGroup(ftype, conn[loaded], None if fv is None else fv[loaded], ids[loaded]))
+            sub = None if fv is None else fv[loaded]
+            out.append(FaceGroup(ftype, conn[loaded], sub, ids[loaded], partial[loaded]))
     return out
 
 
@@ -85,7 +100,15 @@ def drop_edge_faces(
     with flat loaded faces. Returns the groups kept and the count dropped.
     """
     cos_max = np.cos(np.radians(STEEP_DEG))
-    steep = [np.abs(_normals(points, g) @ normal) < cos_max for g in groups]
+    # only faces at the rim of the patch (some node not loaded) can be a side face touching it;
+    # for face data every loaded face is examined
+    steep = []
+    for g in groups:
+        s = np.zeros(len(g.conn), bool)
+        rim = np.flatnonzero(g.partial)
+        if rim.size:
+            s[rim] = np.abs(_normals(points, g.subset(rim)) @ normal) < cos_max
+        steep.append(s)
     if not any(s.any() for s in steep):
         return groups, 0
     flat_nodes = np.zeros(len(points), bool)

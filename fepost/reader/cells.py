@@ -244,7 +244,8 @@ def boundary_faces(blocks: list[tuple[str, np.ndarray]]) -> Faces:
         if spec.dim < 2 or m == 0:
             continue
         for ftype, local in spec.face_nodes():
-            nodes = conn[:, list(local)]
+            # a surface element is its own face: its connectivity is used as it is (no copy)
+            nodes = conn if list(local) == list(range(conn.shape[1])) else conn[:, list(local)]
             ncorner = 3 if ftype.startswith("tri") else 4
             chunks.append((ftype, nodes, nodes[:, :ncorner], cells))
     if not chunks:
@@ -266,12 +267,15 @@ def boundary_faces(blocks: list[tuple[str, np.ndarray]]) -> Faces:
     conn_out: dict[str, list[np.ndarray]] = {}
     cell_out: dict[str, list[np.ndarray]] = {}
     for (ftype, nodes, _, cells), k in zip(chunks, keep, strict=True):
-        if k.any():
+        if k.all():
+            conn_out.setdefault(ftype, []).append(nodes)
+            cell_out.setdefault(ftype, []).append(cells)
+        elif k.any():
             conn_out.setdefault(ftype, []).append(nodes[k])
             cell_out.setdefault(ftype, []).append(cells[k])
     return Faces(
-        {t: np.concatenate(v) for t, v in conn_out.items()},
-        {t: np.concatenate(v) for t, v in cell_out.items()},
+        {t: v[0] if len(v) == 1 else np.concatenate(v) for t, v in conn_out.items()},
+        {t: v[0] if len(v) == 1 else np.concatenate(v) for t, v in cell_out.items()},
     )
 
 

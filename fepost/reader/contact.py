@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._arrays import adopted
 from ..errors import DimensionError, FieldError, InputFileError, PressureError, SentinelWarning
 from ..field import OTHER_FACE_TYPES, ContactField
 from .cells import SPECS
@@ -243,11 +244,12 @@ def _contact(
     if time is not None and units is not None:
         time *= units.time
     names = tuple(a.name for a in catalogue)
+    # every array here was made by this reader from the file: shared with the field, not copied
     return ContactField(
         source=source,
-        points=points,
-        triangles=tri,
-        values=values,
+        points=adopted(np.ascontiguousarray(points)),
+        triangles=adopted(np.ascontiguousarray(tri, dtype=np.int64)),
+        values=adopted(np.ascontiguousarray(values, dtype=float)),
         location=choice.location,  # type: ignore[arg-type]
         field=choice.label,
         step=raw.step,
@@ -255,7 +257,7 @@ def _contact(
         reaction_z=None if reaction is None else float(reaction),
         arrays=names,
         sidecar=side,
-        faces=faces,
+        faces={t: adopted(np.ascontiguousarray(c, dtype=np.int64)) for t, c in faces.items()},
         reactions=_reactions(raw, units),
         steps=tuple(t * (1.0 if units is None else units.time) for t in raw.steps),
         body=surf.body,

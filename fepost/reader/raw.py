@@ -94,6 +94,7 @@ class RawMesh:
     step_values: Callable[[str], np.ndarray] | None = None  # nodal variable over all steps (Exodus)
     ncomp: dict[str, int] = field(default_factory=dict)  # components of lazily loaded point arrays
     closer: Callable[[], None] | None = None
+    connectivity_size: int = 0  # VTK files: node references of all cells as read
 
     def close(self) -> None:
         """Release the file (lazy arrays cannot be loaded afterwards)."""

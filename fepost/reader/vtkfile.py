@@ -106,7 +106,7 @@ def read_vtk(path: Path) -> RawMesh:
     from .vtkcheck import check_file
 
     suffix = path.suffix.lower()
-    check_file(path)
+    counts = check_file(path)
     reader = _reader_for(suffix)
     with _ErrorWindow() as win:
         reader.SetFileName(str(path))
@@ -125,7 +125,14 @@ def read_vtk(path: Path) -> RawMesh:
     leaves = [leaf for leaf in _leaves(out) if leaf is not None and leaf.GetNumberOfPoints() > 0]
     if not leaves:
         raise InputFileError(f"{path}: the file holds no mesh (0 nodes or 0 cells)")
-    return _assemble(path, leaves, f"VTK {'legacy' if suffix == '.vtk' else 'XML'} ({suffix})")
+    raw = _assemble(path, leaves, f"VTK {'legacy' if suffix == '.vtk' else 'XML'} ({suffix})")
+    declared = sum(counts.connectivity)
+    if declared and suffix != ".vtm" and declared != raw.connectivity_size:
+        raise InputFileError(
+            f"{path}: the header disagrees with the data: the connectivity holds {declared} values, "
+            f"the declared cells use {raw.connectivity_size}"
+        )
+    return raw
 
 
 def _as_unstructured(ds):
@@ -196,6 +203,7 @@ def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
     skipped: dict[str, int] = {}
     base = 0
     first_cell = 0
+    conn_size = 0
     for piece, leaf in enumerate(leaves):
         ds = _as_unstructured(leaf)
         n = int(ds.GetNumberOfPoints())
@@ -207,6 +215,7 @@ def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
         point_pieces.append(_point_data(path, ds, n, components))
         sizes.append(n)
         types, off, con = _cells(ds)
+        conn_size += len(con)
         if len(off) != len(types) + 1:
             raise InputFileError(f"{path}: cell offsets and cell types disagree in length (corrupt file)")
         if len(types):
@@ -217,36 +226,50 @@ def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
             check_connectivity(con, n, str(path))
         cdata = _cell_data(path, ds, len(types), components)
         where = f" of piece {piece + 1}" if len(leaves) > 1 else ""
-        for t in np.unique(types):
-            sel = np.flatnonzero(types == t)
+        present = np.flatnonzero(np.bincount(types, minlength=256)) if len(types) else []
+        for t in present:
+            single = len(present) == 1
+            sel = slice(None) if single else np.flatnonzero(types == t)
             spec = VTK_TYPES.get(int(t))
+            count = len(types) if single else len(sel)
             if spec is None:
                 name = _NAMED_SKIPS.get(int(t), f"VTK type {int(t)}")
-                skipped[name] = skipped.get(name, 0) + len(sel)
+                skipped[name] = skipped.get(name, 0) + count
                 continue
             canon, perm = spec
             k = SPECS[canon].n_nodes
-            size = off[sel + 1] - off[sel]
-            if np.any(size != k):
-                raise InputFileError(
-                    f"{path}: {canon} cells with {int(size[size != k][0])} nodes instead of {k} "
-                    "(corrupt file)"
-                )
-            conn = con[off[sel][:, None] + np.arange(k)[None, :]]
+            if single and len(con) == k * count:
+                # one cell type throughout: the offsets must step by k, the connectivity is a (m, k) view
+                if np.any(off != np.arange(0, k * count + 1, k)):
+                    raise InputFileError(
+                        f"{path}: cell offsets are inconsistent with {canon} cells (corrupt file)"
+                    )
+                conn = con.reshape(count, k)
+            else:
+                idx = np.arange(len(types)) if single else sel
+                size = off[idx + 1] - off[idx]
+                if np.any(size != k):
+                    raise InputFileError(
+                        f"{path}: {canon} cells with {int(size[size != k][0])} nodes instead of {k} "
+                        "(corrupt file)"
+                    )
+                conn = con[off[idx][:, None] + np.arange(k)[None, :]]
             if perm is not None:
                 conn = conn[:, list(perm)]
-            conn = conn + base
-            block = Block(f"{canon.upper()} cells{where} ({len(sel)})", canon, conn, first_cell, piece)
+            if base:
+                conn = conn + base
+            block = Block(f"{canon.upper()} cells{where} ({count})", canon, conn, first_cell, piece)
             for name, arr in cdata.items():
                 block.cell_data.add(name, arr[sel])
             blocks.append(block)
-            first_cell += len(sel)
+            first_cell += count
         base += n
     points = pts_parts[0] if len(pts_parts) == 1 else np.concatenate(pts_parts)
     raw = RawMesh(path=str(path), format=fmt, points=points, blocks=blocks, components=components)
     for name, arr in _join(point_pieces, sizes).items():
         raw.point_data.add(name, arr)
     raw.skipped = skipped
+    raw.connectivity_size = conn_size
     return raw
 
 
