@@ -129,7 +129,7 @@ class _Piece:
 
 
 class _Xml:
-    def __init__(self, path: Path, data: bytes, depth: int):
+    def __init__(self, path: Path, data: bytes | mmap.mmap, depth: int):
         self.path, self.data, self.depth = path, data, depth
 
     def check(self) -> Counts:
@@ -528,7 +528,7 @@ class _Legacy:
                     )
                 counts["attr"] = n
                 return []
-            n = counts.get("attr")
+            n = int(counts.get("attr", 0))
             if key == b"SCALARS":
                 ncomp = self._count(words[3]) if len(words) > 3 else 1
                 counts["pending"] = (n * ncomp, words[2].decode().lower())

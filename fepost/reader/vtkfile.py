@@ -226,12 +226,12 @@ def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
             check_connectivity(con, n, str(path))
         cdata = _cell_data(path, ds, len(types), components)
         where = f" of piece {piece + 1}" if len(leaves) > 1 else ""
-        present = np.flatnonzero(np.bincount(types, minlength=256)) if len(types) else []
+        present = np.flatnonzero(np.bincount(types, minlength=256)) if len(types) else np.empty(0, np.int64)
+        single = len(present) == 1
         for t in present:
-            single = len(present) == 1
-            sel = slice(None) if single else np.flatnonzero(types == t)
+            sel: np.ndarray | slice = slice(None) if single else np.flatnonzero(types == t)
             spec = VTK_TYPES.get(int(t))
-            count = len(types) if single else len(sel)
+            count = len(types) if isinstance(sel, slice) else len(sel)
             if spec is None:
                 name = _NAMED_SKIPS.get(int(t), f"VTK type {int(t)}")
                 skipped[name] = skipped.get(name, 0) + count
@@ -246,7 +246,7 @@ def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
                     )
                 conn = con.reshape(count, k)
             else:
-                idx = np.arange(len(types)) if single else sel
+                idx = sel if isinstance(sel, np.ndarray) else np.arange(len(types))
                 size = off[idx + 1] - off[idx]
                 if np.any(size != k):
                     raise InputFileError(
