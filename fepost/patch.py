@@ -50,7 +50,15 @@ import numpy as np
 
 from ._arrays import frozen, sealed
 from .errors import ArgumentError, DimensionError, PatchError, PatchWarning, PressureError, PressureWarning
-from .facegroups import FaceGroup, drop_edge_faces, exact_load, loaded_groups, only_triangles, refine
+from .facegroups import (
+    STEEP_DEG,
+    FaceGroup,
+    drop_edge_faces,
+    exact_load,
+    loaded_groups,
+    only_triangles,
+    refine,
+)
 from .facesums import FaceSums, face_loads, face_sums, load_outside, triangle_areas
 from .field import ContactField
 from .reader.units import check_scale
@@ -490,7 +498,7 @@ def build_patch(
     groups, n_edge = drop_edge_faces(groups, points, hot, base.axes[2], fld.location)
     if n_edge:
         notes.append(
-            f"{n_edge} loaded face(s) steeper than 60 deg to the patch plane, touching the contact only "
+            f"{n_edge} loaded face(s) steeper than {STEEP_DEG:g} deg to the patch plane, touching the contact only "
             "at its edge (sides of the loaded body), are not part of the patch"
         )
 

@@ -13,8 +13,9 @@ Rules (why each: see ``docs/reading.md``):
   carry nothing, and a large model's boundary is not extracted.
 * **Bodies**: those elements split into connected parts (elements sharing a
   node). Parts whose faces carry pressure at the same place are the two sides
-  of one contact: the one carrying the larger load is kept (the note says
-  which, and the other's load). Loaded parts apart from each other are all kept:
+  of one contact: the one with more loaded nodes (the finer mesh, which
+  resolves the pressure better; on a tie the larger load) is kept, and the
+  note says which and the other's load. Loaded parts apart from each other are all kept:
   the patch step decides whether they are one patch, fragments or several patches.
 * ``surface=NAME`` restricts the faces to an Exodus side set (by name or id) or
   to an element block (by name or id): the way to pick one contact surface
@@ -192,7 +193,10 @@ def _choose_parts(
         for p in np.unique(pc[loaded]):
             sel = loaded & (pc == p)
             d = parts.setdefault(int(p), {"nodes": [], "load": 0.0, "blocks": set()})
-            d["nodes"].append(conn[sel][:, : (3 if t.startswith("tri") else 4)].ravel())
+            hot_nodes = conn[sel].ravel()
+            if point_values is not None:
+                hot_nodes = hot_nodes[np.nan_to_num(point_values[hot_nodes], nan=0.0) > 0]
+            d["nodes"].append(hot_nodes)
             d["blocks"].update(int(b) for b in np.unique(block_of_cell[faces.cell[t][sel]]))
             d["load"] += _rough_load(raw.points, conn[sel], t, point_values, surf, sel)
     if len(parts) < 2:
@@ -203,7 +207,9 @@ def _choose_parts(
             if len({raw.blocks[b].body for b in range(len(raw.blocks))}) > 1 or len(raw.blocks) > 1:
                 surf.notes.append(f"loaded faces from {surf.body}")
         return
-    keys = sorted(parts, key=lambda p: -parts[p]["load"])
+    for d in parts.values():
+        d["hot"] = len(np.unique(np.concatenate(d["nodes"]))) if d["nodes"] else 0
+    keys = sorted(parts, key=lambda p: (-parts[p]["hot"], -parts[p]["load"]))
     pts = raw.points
     from scipy.spatial import cKDTree
 
