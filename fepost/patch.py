@@ -498,8 +498,8 @@ def build_patch(
     groups, n_edge = drop_edge_faces(groups, points, hot, base.axes[2], fld.location)
     if n_edge:
         notes.append(
-            f"{n_edge} loaded face(s) steeper than {STEEP_DEG:g} deg to the patch plane, touching the contact only "
-            "at its edge (sides of the loaded body), are not part of the patch"
+            f"{n_edge} loaded face(s) steeper than {STEEP_DEG:g} deg to the patch plane, touching the "
+            "contact only at its edge (sides of the loaded body), are not part of the patch"
         )
 
     def cut(groups, level):

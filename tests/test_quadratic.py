@@ -11,7 +11,7 @@ from scipy import integrate
 from fepost.field import ContactField
 from fepost.patch import REFINE_TOL, build_patch
 from fepost.reader import quadratic
-from fepost.reader.quadratic import face_loads, refine, reference_nodes, shape, surface_integrals
+from fepost.reader.quadratic import face_loads, reference_nodes, refine, shape, surface_integrals
 
 TYPES = ("tri3", "tri6", "tri7", "quad4", "quad8", "quad9")
 A_CURV = 0.4  # the face lies on z = A (x² + y²)
@@ -52,7 +52,7 @@ def _domain(ftype, h=0.5):
     """scipy dblquad limits of the face's footprint in (x, y)."""
     if ftype.startswith("quad"):
         return (-h, h, lambda x: -h, lambda x: h)
-    # reference triangle scaled by 2h and shifted by -h/2 ... footprint: corners (-h/2,-h/2), (3h/2,-h/2), (-h/2,3h/2)
+    # the reference triangle scaled by 2h, shifted by -h/2: corners (-h/2, -h/2), (3h/2, -h/2), (-h/2, 3h/2)
     lo = -0.5 * h
     return (lo, lo + 2 * h, lambda x: lo, lambda x: lo + 2 * h - (x - lo))
 
@@ -130,9 +130,8 @@ def test_quadratic_faces_keep_the_load_the_mid_side_nodes_carry():
     exact = P0 * (4 * s * s - (8 / 3) * s**4 / a**2)
     assert patch.N_fe == pytest.approx(exact, rel=1e-12)
     assert abs(patch.refine_error) <= REFINE_TOL
-    from fepost.resample import resample
-
     from fepost.moments import moments
+    from fepost.resample import resample
 
     m = moments(resample(patch, radius=patch.r_max))
     assert m.N == pytest.approx(exact, rel=5e-3)  # a square patch on a polar grid (corners)

@@ -9,8 +9,8 @@ import re
 
 import numpy as np
 import pytest
-
 from exodus_files import hex_grid, write
+
 from fepost import analyse
 from fepost.cli import main
 from fepost.errors import DimensionError, FieldError, PressureError, ScaleWarning
