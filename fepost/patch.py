@@ -484,6 +484,8 @@ def build_patch(
         if np.count_nonzero(w) < 3:
             raise PatchError(f"{src}: the contact patch has fewer than 3 loaded nodes")
         c, normal, var = _plane(pts_sel, w)
+        hz = np.abs(pts_sel @ normal - c @ normal)[w > 0]
+        flat = bool(hz.max() <= 1e-9 * np.sqrt(var[2]))
         if var[1] <= LINE_TOL**2 * var[2]:
             raise DimensionError(
                 f"{src}: the loaded nodes lie on one line: the contact is a line, not a patch "
@@ -495,7 +497,8 @@ def build_patch(
         base = Frame(origin=c, axes=axes)
     else:
         base = frame
-    groups, n_edge = drop_edge_faces(groups, points, hot, base.axes[2], fld.location)
+        flat = False
+    groups, n_edge = drop_edge_faces(groups, points, hot, base.axes[2], fld.location, flat=flat)
     if n_edge:
         notes.append(
             f"{n_edge} loaded face(s) steeper than {STEEP_DEG:g} deg to the patch plane, touching the "

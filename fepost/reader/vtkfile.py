@@ -148,6 +148,12 @@ def _as_unstructured(ds):
     return f.GetOutput()
 
 
+def _vtk_at_least(major: int, minor: int) -> bool:
+    from vtkmodules.vtkCommonCore import vtkVersion
+
+    return (vtkVersion.GetVTKMajorVersion(), vtkVersion.GetVTKMinorVersion()) >= (major, minor)
+
+
 def _np(arr) -> np.ndarray:
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
@@ -188,7 +194,9 @@ def _cells(ds) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     cells = ds.GetCells()
     if cells is None or ds.GetNumberOfCells() == 0:
         return np.empty(0, np.uint8), np.zeros(1, np.int64), np.empty(0, np.int64)
-    types = np.asarray(_np(ds.GetCellTypesArray()), np.uint8)
+    # GetCellTypes returns the array from VTK 9.6 on (GetCellTypesArray is deprecated there)
+    getter = ds.GetCellTypes if _vtk_at_least(9, 6) else ds.GetCellTypesArray
+    types = np.asarray(_np(getter()), np.uint8)
     off = np.asarray(_np(cells.GetOffsetsArray()), np.int64)
     con = np.asarray(_np(cells.GetConnectivityArray()), np.int64)
     return types, off, con
