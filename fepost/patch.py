@@ -61,6 +61,7 @@ from .facegroups import (
 )
 from .facesums import FaceSums, face_loads, face_sums, load_outside, triangle_areas
 from .field import ContactField
+from .reader.quadratic import face_surface_loads
 from .reader.units import check_scale
 
 DEFAULT_THRESHOLD = 1e-6
@@ -405,13 +406,8 @@ def _separate_surfaces(fld: ContactField, groups: list[FaceGroup], hot: np.ndarr
         sel = hot[nodes]
         rows.append(fid[sel])
         cols.append(nodes[sel])
-        p = points[g.corners()]
-        if g.corners().shape[1] == 3:
-            area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-        else:
-            area = 0.5 * np.linalg.norm(np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1]), axis=1)
-        val = fld.values[g.corners()].mean(axis=1) if fld.location == "point" else np.asarray(g.values)
-        loads.append(area * np.nan_to_num(val))
+        vals = np.nan_to_num(fld.values if fld.location == "point" else np.asarray(g.values))
+        loads.append(face_surface_loads(g.ftype, points, g.conn, vals, fld.location))
         start += m
     nf = start
     r, c = np.concatenate(rows), np.concatenate(cols)

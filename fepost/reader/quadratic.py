@@ -203,6 +203,21 @@ def face_moments(
     return np.column_stack([f.sum(1), (f * (X @ N.T)).sum(1), (f * (Y @ N.T)).sum(1)])
 
 
+def face_surface_loads(
+    ftype: str, points: np.ndarray, conn: np.ndarray, values: np.ndarray, location: str = "point"
+) -> np.ndarray:
+    """∬ σ dA of each face over its curved surface in 3-D (N): an (m,) array."""
+    xi, eta, w = gauss_rule("tri" if ftype.startswith("tri") else "quad")
+    N, dxi, deta = shape(ftype, xi, eta)
+    P = points[conn]
+    dA = (
+        np.linalg.norm(np.cross(np.einsum("qk,mkd->mqd", dxi, P), np.einsum("qk,mkd->mqd", deta, P)), axis=-1)
+        * w
+    )
+    sig = np.asarray(values, float)[conn] @ N.T if location == "point" else np.asarray(values, float)[:, None]
+    return np.sum(sig * dA, axis=1)
+
+
 def surface_integrals(
     ftype: str, points: np.ndarray, conn: np.ndarray, values: np.ndarray, location: str = "point"
 ) -> tuple[float, np.ndarray]:
