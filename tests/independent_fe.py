@@ -14,7 +14,7 @@ import numpy as np
 
 
 def exodus(path, step=-1):
-    """(reference coordinates (n, 3), displacement (n, 3), blocks [(elem_type, (m, k))], nodal {name: (n,)}, globals)."""
+    """Reference coordinates (n, 3), displacement (n, 3), blocks [(elem_type, (m, k))], nodal and globals."""
     ds = netCDF4.Dataset(str(path))
     ds.set_auto_mask(False)
     try:

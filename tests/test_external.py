@@ -202,7 +202,7 @@ def test_calculix_beam_between_two_plates_is_two_patches():
     m = meshio.read(EXT / "ccx_beamcontact.vtu")
     x = m.points.astype(float)
     p = m.point_data["CONTACT"][:, 3].astype(float)
-    # VTK's quadratic hexahedron lists its mid-edge nodes after the 8 corners: face nodes are found by position
+    # VTK's quadratic hexahedron lists its mid-edge nodes after the 8 corners; they are found by position
     beam = m.cells_dict["hexahedron20"]
     loads = []
     for value in (0.0, 1.0):
