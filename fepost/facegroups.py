@@ -208,5 +208,19 @@ def exact_load(groups: list[FaceGroup], xy: np.ndarray, values: np.ndarray, loca
     return tot
 
 
+def folded_faces(groups: list[FaceGroup], xy: np.ndarray) -> int:
+    """How many faces (other than linear triangles) fold over in the plane of ``xy``."""
+    return sum(int(quadratic.folded(g.ftype, xy, g.conn).sum()) for g in groups if g.ftype != "tri3")
+
+
+def next_triangles(groups: list[FaceGroup], level: int) -> int:
+    """Triangles the cut at ``level`` makes of the faces other than linear triangles."""
+    return sum(
+        len(g.conn) * quadratic.triangles_per_face(g.ftype, START_LEVEL[g.ftype] * level)
+        for g in groups
+        if g.ftype != "tri3"
+    )
+
+
 def only_triangles(groups: list[FaceGroup]) -> bool:
     return all(g.ftype == "tri3" for g in groups)

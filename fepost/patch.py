@@ -55,7 +55,9 @@ from .facegroups import (
     FaceGroup,
     drop_edge_faces,
     exact_load,
+    folded_faces,
     loaded_groups,
+    next_triangles,
     only_triangles,
     refine,
 )
@@ -520,17 +522,30 @@ def build_patch(
 
     level = 1
     exact = None
+    previous = np.inf
+    if not only_triangles(groups):
+        xy_native = points @ base.axes[:2].T - base.origin @ base.axes[:2].T
+        bad = folded_faces(groups, xy_native)
+        if bad:
+            raise PatchError(
+                f"{src}: {bad} loaded element face(s) fold over in the patch plane (repeated or "
+                "crossed corner nodes): corrupt or inverted elements"
+            )
     while True:
         pts, tri, vals, parent = cut(groups, level)
         geo = _geometry(src, pts, tri, vals, fld.location, thr, base)
         if parent is None:
             break
-        xy_native = points @ base.axes[:2].T - base.origin @ base.axes[:2].T
         exact = exact_load(groups, xy_native, v, fld.location)
-        err = geo.sums.N / exact[0] - 1.0
-        finer = sum(len(g.conn) for g in groups) * 4 * (2 * level) ** 2 * 16
-        if abs(err) <= REFINE_TOL or finer > REFINE_MAX_TRIANGLES:
+        err = abs(geo.sums.N / exact[0] - 1.0)
+        # finer until the triangles carry the element load, while that converges (error / 4 per level)
+        if (
+            err <= REFINE_TOL
+            or next_triangles(groups, 2 * level) > REFINE_MAX_TRIANGLES
+            or err > 0.5 * previous
+        ):
             break
+        previous = err
         level *= 2
 
     ncomp, labels = _components(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)

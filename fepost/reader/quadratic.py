@@ -189,6 +189,16 @@ def face_loads(ftype: str, xy: np.ndarray, conn: np.ndarray, values: np.ndarray,
     return np.asarray(values, float) * jac.sum(axis=1)
 
 
+def folded(ftype: str, xy: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """True for faces whose map onto the plane of ``xy`` folds over (its Jacobian changes sign)."""
+    xi, eta, _ = gauss_rule("tri" if ftype.startswith("tri") else "quad")
+    _, dxi, deta = shape(ftype, xi, eta)
+    X, Y = xy[:, 0][conn], xy[:, 1][conn]
+    det = (X @ dxi.T) * (Y @ deta.T) - (X @ deta.T) * (Y @ dxi.T)
+    scale = np.max(np.abs(det), axis=1)
+    return (det.min(axis=1) < -1e-9 * scale) & (det.max(axis=1) > 1e-9 * scale)
+
+
 def face_moments(
     ftype: str, xy: np.ndarray, conn: np.ndarray, values: np.ndarray, location: str
 ) -> np.ndarray:
