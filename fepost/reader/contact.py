@@ -43,7 +43,8 @@ def _absurd(source: str, what: str, values: np.ndarray, limit: float) -> None:
     finite = values[np.isfinite(values)]
     if finite.size and np.abs(finite).max() > limit:
         raise InputFileError(
-            f"{source}: {what} up to {np.abs(finite).max():.3g} (beyond {limit:g}): corrupt file?"
+            f"{source}: {what} up to {np.abs(finite).max():.3g} (beyond {limit:g}, in any unit system): "
+            "corrupt file?"
         )
 
 
