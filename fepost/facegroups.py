@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ._arrays import sealed
 from .field import ContactField
 from .reader import quadratic
 
@@ -76,7 +77,8 @@ def loaded_groups(fld: ContactField, v: np.ndarray, thr: float) -> list[FaceGrou
             out.append(FaceGroup(ftype, conn, fv, ids, partial))
         elif loaded.any():
             sub = None if fv is None else fv[loaded]
-            out.append(FaceGroup(ftype, conn[loaded], sub, ids[loaded], partial[loaded]))
+            # a new array no caller holds: sealed, so the patch shares it instead of copying
+            out.append(FaceGroup(ftype, sealed(conn[loaded]), sub, ids[loaded], partial[loaded]))
     return out
 
 

@@ -79,7 +79,10 @@ class ContactField:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", frozen(self.points))
-        object.__setattr__(self, "triangles", frozen(self.triangles, dtype=np.int64).reshape(-1, 3))
+        tri = self.triangles
+        if np.ndim(tri) != 2:  # an empty list: no triangles (a reshaped view would not be shared)
+            tri = np.reshape(np.asarray(tri, np.int64), (-1, 3))
+        object.__setattr__(self, "triangles", frozen(tri, dtype=np.int64))
         object.__setattr__(self, "values", frozen(self.values))
         faces = {t: frozen(self.faces[t], dtype=np.int64) for t in OTHER_FACE_TYPES if t in self.faces}
         unknown = set(self.faces) - set(OTHER_FACE_TYPES)
@@ -127,7 +130,7 @@ def _restore(state: dict) -> ContactField:
     """Rebuild an unpickled field; its arrays are new and held by nobody else: shared, not copied."""
     for key in ("points", "triangles", "values"):
         a = state[key]
-        if isinstance(a, np.ndarray) and a.flags.writeable:
+        if isinstance(a, np.ndarray):
             state[key] = adopted(a)
-    state["faces"] = {t: adopted(a) if a.flags.writeable else a for t, a in state["faces"].items()}
+    state["faces"] = {t: adopted(a) for t, a in state["faces"].items()}
     return ContactField(**state)

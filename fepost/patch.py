@@ -375,7 +375,7 @@ def _geometry(source, points, tri, vals, location, thr, base: Frame) -> _Geometr
     else:
         used = np.flatnonzero(used_mask)
         remap = np.cumsum(used_mask) - 1
-        tri_local = remap[tri]
+        tri_local = sealed(remap[tri])  # new here: the patch shares it
         pts = points[used]
         nvals = vals[used] if location == "point" else vals
     w = np.where(nvals > thr, nvals, 0.0) if location == "point" else np.ones(len(pts))

@@ -185,31 +185,53 @@ def test_element_variable_pressure(tmp_path):
 
 @pytest.mark.parametrize(
     "etype,order",
-    [("HEX20", "hex20"), ("HEX27", "hex27"), ("TETRA10", "tet10"), ("WEDGE15", "wedge15"), ("HEX8", "hex8")],
+    [
+        ("HEX8", "hex8"),
+        ("HEX20", "hex20"),
+        ("HEX27", "hex27"),
+        ("TETRA", "tet4"),
+        ("TETRA10", "tet10"),
+        ("WEDGE", "wedge6"),
+        ("WEDGE15", "wedge15"),
+        ("PYRAMID", "pyramid5"),
+        ("PYRAMID13", "pyramid13"),
+        ("SHELL4", "quad4"),
+        ("SHELL8", "quad8"),
+        ("SHELL9", "quad9"),
+        ("TRISHELL3", "tri3"),
+        ("TRI6", "tri6"),
+        ("TRISHELL7", "tri7"),
+    ],
 )
-def test_volume_element_faces_carry_their_element_load(tmp_path, etype, order):
-    """One element of each type, its nodes placed by its reference coordinates on the unit cube/tet/wedge,
-    a field p0 (1 + x − y²/2) on its z = 0 face: N_fe equals the closed form over that face."""
-    ref = {
-        "hex": np.array(
-            [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float
-        ),
-        "tet": np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float),
-        "wedge": np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [0, 1, 1]], float),
-    }
+def test_element_faces_carry_their_element_load(tmp_path, etype, order):
+    """One element of each type, its nodes placed on the unit cube, tetrahedron, wedge, pyramid,
+    square or triangle; a field p0 (1 + x − y²/2) on the nodes of z = 0: N_fe equals the closed
+    form of the face's own interpolant (exact for quadratic faces, which hold y²)."""
     from fepost.reader.cells import SPECS
 
+    square = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    triangle = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+    ref = {
+        "hex": square + [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+        "tet": triangle + [[0, 0, 1]],
+        "wedge": triangle + [[0, 0, 1], [1, 0, 1], [0, 1, 1]],
+        "pyramid": square + [[0.5, 0.5, 1]],
+        "quad": square,
+        "tri": triangle,
+    }
     spec = SPECS[order]
     fam = order.rstrip("0123456789")
-    corners = ref[fam]
-    nodes = [c for c in corners]
+    corners = np.array(ref[fam], float)
+    nodes = list(corners)
     for a, b in spec.edges if spec.quadratic else ():
         nodes.append(0.5 * (corners[a] + corners[b]))
-    if order == "hex27":
-        extra = [None] * 7
-        extra[0] = corners.mean(axis=0)
+    extra = [None] * (spec.n_nodes - len(nodes))  # volume centre and face centres
+    if extra:
+        first = len(nodes)
         for k, face in enumerate(spec.faces):
-            extra[spec.face_centres[k] - 20] = corners[list(face)].mean(axis=0)
+            extra[spec.face_centres[k] - first] = corners[list(face)].mean(axis=0)
+        if order == "hex27":
+            extra[20 - first] = corners.mean(axis=0)
         nodes += extra
     pts = np.array(nodes)
     p = P * (1 + pts[:, 0] - 0.5 * pts[:, 1] ** 2) * np.isclose(pts[:, 2], 0.0)
@@ -220,10 +242,19 @@ def test_volume_element_faces_carry_their_element_load(tmp_path, etype, order):
         nodal={"contact_pressure": p[None]},
     )
     patch = analyse(path).static_patch
-    if fam == "hex":  # unit square: ∬ (1 + x − y²/2) = 1 + 1/2 − 1/6
-        exact = P * (1 + 0.5 - 1 / 6)
-    else:  # unit right triangle: ∬ (1 + x − y²/2) = 1/2 + 1/6 − 1/24
-        exact = P * (0.5 + 1 / 6 - 1 / 24)
-    if not spec.quadratic:  # a linear face cannot hold y²: the exact integral of its own (bilinear) field
-        exact = P * (1 + 0.5 - 0.25)
+    on_square = fam in ("hex", "pyramid", "quad")
+    face = {
+        "hex": "quad",
+        "pyramid": "quad",
+        "quad": "quad",
+        "tet": "tri",
+        "wedge": "tri",
+        "tri": "tri",
+    }[fam]
+    if spec.quadratic:  # ∬ (1 + x − y²/2) over the unit square, over the unit right triangle
+        exact = P * ((1 + 0.5 - 1 / 6) if on_square else (0.5 + 1 / 6 - 1 / 24))
+    elif face == "quad":  # the bilinear interpolant of the corner values: their mean
+        exact = P * (1 + 2 + 1.5 + 0.5) / 4
+    else:  # the linear interpolant over the triangle: area × mean of the corners
+        exact = P * 0.5 * (1 + 2 + 0.5) / 3
     assert patch.N_fe == pytest.approx(exact, rel=1e-12)

@@ -39,9 +39,20 @@ MAX_COORDINATE = 1e12
 MAX_PRESSURE = 1e30
 
 
+def _range(values: np.ndarray) -> tuple[float, float]:
+    """(smallest, largest) value, NaN passed over (±inf kept); (nan, nan) when all are NaN or none."""
+    if values.size == 0:
+        return float("nan"), float("nan")
+    return float(np.fmin.reduce(values, axis=None)), float(np.fmax.reduce(values, axis=None))
+
+
 def _absurd(source: str, what: str, values: np.ndarray, limit: float) -> None:
-    finite = values[np.isfinite(values)]
-    if finite.size and np.abs(finite).max() > limit:
+    lo, hi = _range(values)
+    big = max(abs(lo), abs(hi)) if np.isfinite(lo) and np.isfinite(hi) else np.nan
+    if not big <= limit:
+        finite = values[np.isfinite(values)]  # the slow path, only on refusal
+        if not finite.size or np.abs(finite).max() <= limit:
+            return
         raise InputFileError(
             f"{source}: {what} up to {np.abs(finite).max():.3g} (beyond {limit:g}, in any unit system): "
             "corrupt file?"
@@ -196,8 +207,7 @@ def _contact(
     what = f"{source}: array {choice.name!r}"
     if choice.location == "point":
         point_values = _mask_sentinels(source, _column(raw.point_data[choice.name], choice.component, what))
-        finite = point_values[np.isfinite(point_values)]
-        positive = bool(finite.size and finite.max() > 0)
+        checked = point_values
     else:
         cell_values = []
         for b in raw.blocks:
@@ -208,15 +218,16 @@ def _contact(
         allv = _mask_sentinels(source, np.concatenate(cell_values)) if cell_values else np.empty(0)
         sizes = np.cumsum([len(v) for v in cell_values])[:-1]
         cell_values = np.split(allv, sizes)
-        finite = allv[np.isfinite(allv)]
-        positive = bool(finite.size and finite.max() > 0)
-    if not positive:
+        checked = allv
+    if not _range(checked)[1] > 0:  # NaN passed over; +inf counts (refused later as not finite)
         _no_contact(raw, path, choice)
-    _absurd(source, f"pressure values of {choice.label!r}", finite, MAX_PRESSURE)
+    _absurd(source, f"pressure values of {choice.label!r}", checked, MAX_PRESSURE)
 
-    points = np.array(raw.points, float)
+    points = np.asarray(raw.points, float)
     _absurd(source, "node coordinates", points, MAX_COORDINATE)
     disp = pick_displacement(source, catalogue, displacement)
+    if disp is not None or (units is not None and not units.is_si):
+        points = points.copy()  # changed below: the file's array stays as read
     if disp is not None:
         u = np.asarray(raw.point_data[disp], float)
         if u.ndim != 2 or len(u) != len(points):
