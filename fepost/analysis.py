@@ -20,9 +20,9 @@ from .coefficients import Coefficients, coefficients_from_moments
 from .errors import PatchWarning, ScaleWarning
 from .field import ContactField
 from .moments import Moments, moments
-from .patch import DEFAULT_THRESHOLD, Patch, build_patch
+from .patch import DEFAULT_THRESHOLD, Patch, build_patch, warm_up
 from .polar import PolarGrid, PolarMap
-from .reader import read_contact
+from .reader import isolate, start_reading
 from .reader.units import describe, unit_system
 from .resample import resample
 
@@ -142,10 +142,11 @@ def _check_resampling(patch: Patch, mom: Moments) -> None:
         )
 
 
-def _as_field(src, field, step, displacement, units, surface) -> ContactField:
+def _start(src, field, step, displacement, units, surface) -> isolate.Pending:
+    """The reading of ``src`` under way (a :class:`ContactField` is taken as it is)."""
     if isinstance(src, ContactField):
-        return src
-    return read_contact(
+        return isolate.Pending(str(src.source), value=src)
+    return start_reading(
         Path(src), field=field, step=step, displacement=displacement, units=units, surface=surface
     )
 
@@ -176,15 +177,28 @@ def analyse(
     """
     grid = grid or PolarGrid.make()
     units = unit_system(units)
-    sf = _as_field(static, field, step, displacement, units, surface)
+    # both files are read at once in their own children; the patch step's imports run meanwhile
+    pending = [_start(static, field, step, displacement, units, surface)]
+    try:
+        if rolling is not None:
+            pending.append(_start(rolling, field, step, displacement, units, surface))
+        warm_up()
+        return _pipeline(pending, rolling is not None, friction, grid, threshold, rolling_axis)
+    finally:
+        for p in pending:
+            p.cancel()
+
+
+def _pipeline(pending, with_rolling, friction, grid, threshold, rolling_axis) -> Analysis:
+    sf = pending[0].result()
     sp = build_patch(sf, threshold=threshold, rolling_axis=rolling_axis)
     _check_reaction(sf, sp)
     sm = resample(sp, grid, radius=sp.r_max)
     smo = moments(sm)
     _check_resampling(sp, smo)
     rf = rp = rm = rmo = None
-    if rolling is not None:
-        rf = _as_field(rolling, field, step, displacement, units, surface)
+    if with_rolling:
+        rf = pending[1].result()
         rp = build_patch(rf, threshold=threshold, frame=sp.frame)
         r_roll = float(np.max(np.hypot(rp.xy[:, 0], rp.xy[:, 1])))
         rm = resample(rp, grid, radius=max(sp.r_max, r_roll))

@@ -266,6 +266,11 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
     return (v if v is fld.values else sealed(v)), peak
 
 
+def warm_up() -> None:
+    """Import what the patch step needs beyond numpy (scipy.ndimage, ~0.3 s), e.g. while a file is read."""
+    from scipy import ndimage  # noqa: F401
+
+
 def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
     """Separate loaded regions: (count, label per face).
 

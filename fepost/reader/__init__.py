@@ -51,6 +51,7 @@ __all__ = [
     "TimeStep",
     "UnitSystem",
     "read_contact",
+    "start_reading",
     "supported_suffixes",
     "time_steps",
     "unit_system",
@@ -125,11 +126,30 @@ def read_contact(
     PressureError
         No positive pressure at the step read (the steps that have some are named).
     """
+    return start_reading(path, field, step, displacement, units=units, surface=surface).result()
+
+
+def start_reading(
+    path: str | Path,
+    field: str | None = None,
+    step: int | None = None,
+    displacement: str | None = "auto",
+    *,
+    units: str | UnitSystem | None = None,
+    surface: str | None = None,
+) -> isolate.Pending:
+    """Start :func:`read_contact` in the reading child and return at once.
+
+    ``.result()`` on the returned object gives the :class:`~fepost.field.ContactField`
+    (or raises what :func:`read_contact` raises); ``.cancel()`` abandons the read.
+    Meanwhile the caller may import, compute, or start reading a second file.
+    A missing file, an unknown suffix or an unknown unit system raise at once.
+    """
     from .contact import read_here
 
     path, size = _checked(path)
     system = unit_system(units)
-    return isolate.call(
+    return isolate.start(
         read_here, path, field, step, displacement, system, surface, what=str(path), nbytes=size
     )
 

@@ -114,10 +114,66 @@ def call(
     InputFileError
         The child crashed, ran out of memory or time, or ``func`` failed unexpectedly.
     """
+    return start(func, *args, what=what, nbytes=nbytes, timeout=timeout, **kwargs).result()
+
+
+class Pending:
+    """A call started by :func:`start`: :meth:`result` waits for it, :meth:`cancel` abandons it."""
+
+    def __init__(self, what: str, value: Any = None, error: BaseException | None = None, child=None):
+        self.what = what
+        self._value, self._error, self._child = value, error, child
+
+    def result(self) -> Any:
+        """The function's value (raises what it raised, or the child's failure)."""
+        if self._child is not None:
+            child, self._child = self._child, None
+            try:
+                self._value = _finish(*child)
+            except BaseException as exc:
+                self._error = exc
+        if self._error is not None:
+            error, self._error = self._error, None
+            raise error
+        return self._value
+
+    def cancel(self) -> None:
+        """Kill the child if it still runs (nothing is left behind)."""
+        if self._child is not None:
+            pid, reader = self._child[0], self._child[1]
+            self._child = None
+            _reap(pid, kill=True)
+            reader.close()
+
+    def __del__(self) -> None:
+        try:
+            self.cancel()
+        except Exception:  # interpreter shutdown: nothing more to do
+            pass
+
+
+def start(
+    func: Callable[..., Any],
+    *args: Any,
+    what: str,
+    nbytes: int = 0,
+    timeout: float | None = None,
+    **kwargs: Any,
+) -> Pending:
+    """Start ``func(*args, **kwargs)`` in a forked child and return at once (see :func:`call`).
+
+    The caller can go on with other work (imports, a second file) while the
+    child reads; without isolation the function runs here and now.
+    """
     if not isolation_enabled():
-        return _in_process(func, args, kwargs, what)
+        try:
+            return Pending(what, value=_in_process(func, args, kwargs, what))
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BaseException as exc:
+            return Pending(what, error=exc)
     deadline = timeout if timeout is not None else timeout_for(nbytes)
-    return _in_child(func, args, kwargs, what, nbytes, deadline)
+    return Pending(what, child=_fork(func, args, kwargs, what, nbytes, deadline))
 
 
 def _unexpected(what: str, exc: BaseException, tb: str) -> InputFileError:
@@ -300,11 +356,11 @@ def _reap(pid: int, kill: bool) -> int:
             continue
 
 
-def _in_child(func, args, kwargs, what, nbytes, timeout):
-    rfd, wfd = os.pipe()
-    if hasattr(__import__("fcntl"), "F_SETPIPE_SZ"):
-        import fcntl
+def _fork(func, args, kwargs, what, nbytes, timeout):
+    import fcntl
 
+    rfd, wfd = os.pipe()
+    if hasattr(fcntl, "F_SETPIPE_SZ"):
         try:
             fcntl.fcntl(wfd, fcntl.F_SETPIPE_SZ, _PIPE_SIZE)
         except OSError:
@@ -326,7 +382,10 @@ def _in_child(func, args, kwargs, what, nbytes, timeout):
         finally:
             os._exit(code)
     os.close(wfd)
-    reader = _Reader(rfd, time.monotonic() + timeout)
+    return pid, _Reader(rfd, time.monotonic() + timeout), what, timeout
+
+
+def _finish(pid: int, reader: _Reader, what: str, timeout: float):
     received = None
     killed = False
     try:
