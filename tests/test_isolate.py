@@ -151,3 +151,36 @@ def test_the_timeout_scales_with_the_file_and_the_environment(monkeypatch):
     assert isolate.timeout_for(10**9) == 7.5
     monkeypatch.setenv(isolate.TIMEOUT_ENV, "nonsense")
     assert isolate.timeout_for(0) == isolate.TIMEOUT_BASE
+
+
+def _children() -> set[int]:
+    """Process ids of this process's children (zombies included)."""
+    import glob
+
+    me = os.getpid()
+    kids = set()
+    for stat in glob.glob("/proc/[0-9]*/stat"):
+        try:
+            fields = open(stat).read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == me:
+            kids.add(int(stat.split("/")[2]))
+    return kids
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs /proc to list child processes")
+def test_started_reads_run_side_by_side_and_leave_no_child(analytic_mesh):
+    from fepost.reader import start_reading
+
+    before = _children()
+    a = start_reading(analytic_mesh("a.vtu", "uniform", peak=1e5, n_rings=8))
+    b = start_reading(analytic_mesh("b.vtu", "uniform", peak=2e5, n_rings=8))
+    assert float(b.result().values.max()) == pytest.approx(2e5)
+    assert float(a.result().values.max()) == pytest.approx(1e5)
+    hung = isolate.start(_hang, what="h.vtu", timeout=30)
+    assert _children() - before  # the hung child runs
+    hung.cancel()
+    assert _children() == before  # killed and reaped: no zombie left
+    with pytest.raises(FieldError, match=r"x\.vtu: no array named 'P'"):
+        isolate.start(_field_error, what="x.vtu").result()
