@@ -21,6 +21,7 @@ radius R (m). Its integrals are in :mod:`fepost.moments`.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -34,11 +35,18 @@ Rule = Literal["gauss", "trapezoid"]
 #: Default grid, chosen from the convergence study (see README, "Accuracy").
 DEFAULT_NR = 64
 DEFAULT_NPHI = 128
-#: Memory a grid node costs along the pipeline (resampling, moments), bytes; measured
-#: (peak RSS of ``fepost coefficients`` grows by ~125 B per node) with a margin.
-BYTES_PER_NODE = 200
-#: Largest grid accepted, bytes of working memory (about 10.7 million nodes).
-MAX_GRID_BYTES = 2 << 30
+#: Memory a grid node costs in one run, bytes: measured (peak of ``analyse`` and of the Table 1
+#: exact-data fit at 2-8 million nodes: 140-220 bytes per node), doubled for the report's extra
+#: maps (the command line's check, :func:`fepost.cli._validate.check_grid`, uses the same figure).
+BYTES_PER_NODE = 400
+
+
+def _memory_limit() -> int:
+    """Half the machine's physical memory (4 GB where it cannot be read), bytes."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES")) // 2
+    except (AttributeError, OSError, ValueError):
+        return 4 << 30
 
 
 def _size(n: float) -> str:
@@ -67,11 +75,12 @@ class PolarGrid:
             raise ArgumentError(f"nphi must be an integer >= 4, got {nphi!r}")
         nr, nphi = int(nr), int(nphi)
         need = float(nr) * float(nphi) * BYTES_PER_NODE
-        if need > MAX_GRID_BYTES:
+        limit = _memory_limit()
+        if need > limit:
             raise ArgumentError(
                 f"polar grid nr x nphi = {nr} x {nphi} = {float(nr) * nphi:.3g} nodes would need about "
-                f"{_size(need)} of memory (limit {_size(MAX_GRID_BYTES)}, about "
-                f"{MAX_GRID_BYTES // BYTES_PER_NODE:,} nodes); the default {DEFAULT_NR} x {DEFAULT_NPHI} "
+                f"{_size(need)} of memory (limit {_size(limit)}, half this machine's, about "
+                f"{limit // BYTES_PER_NODE:,} nodes); the default {DEFAULT_NR} x {DEFAULT_NPHI} "
                 "is accurate to ~1e-5 on smooth maps"
             )
         if rule == "gauss":

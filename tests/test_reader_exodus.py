@@ -64,6 +64,7 @@ def test_blocks_are_the_surface_and_nodes_of_two_bodies_are_never_merged(tmp_pat
     path = _two_bodies(tmp_path)
     fld = read_contact(path)
     assert "element block 2" in fld.body and "element block 1" not in fld.body
+    assert "the loaded faces lie on side set 2 'cube_bottom' (100% of them)" in fld.notes
     a = analyse(fld)
     p = a.static_patch
     assert p.N_fe == pytest.approx(P * 1.0, rel=1e-12)  # 1000 Pa on the 1 × 1 bottom of the cube

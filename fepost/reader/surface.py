@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import FieldError
-from .cells import FACE_TYPES, SPECS, Faces, boundary_faces, side_faces
+from .cells import FACE_TYPES, SPECS, Faces, _pack_key, boundary_faces, side_faces
 from .raw import RawMesh
 
 #: Share of one part's loaded nodes that must lie near the other's for "both sides of one contact".
@@ -142,7 +142,46 @@ def select_surface(
     labels = [raw.blocks[o].label for o in owners]
     surf = Surface(faces.conn, None, " + ".join(sorted(set(labels))))
     _choose_parts(raw, surf, faces, point_values, None, part, block_of_cell=block_of_cell)
+    note = _side_set_note(raw, surf, point_values)
+    if note:
+        surf.notes.append(note)
     return surf
+
+
+def _keys(conn: dict[str, np.ndarray]) -> np.ndarray:
+    """One void-typed key per face from its sorted corners (comparable across face types)."""
+    parts = [_pack_key(c[:, : (3 if t.startswith("tri") else 4)]) for t, c in conn.items() if len(c)]
+    if not parts:
+        return np.empty(0, np.dtype((np.void, 32)))
+    keys = np.concatenate(parts)
+    return keys.view(np.dtype((np.void, keys.dtype.itemsize * 4))).ravel()
+
+
+def _side_set_note(raw: RawMesh, surf: Surface, point_values: np.ndarray) -> str:
+    """Name the side set that holds the loaded faces, when one does (Exodus files have them)."""
+    if not raw.side_sets or not surf.conn:
+        return ""
+    # faces loaded at every node: the contact surface itself (the faces at its rim may be sides)
+    loaded = {t: c[np.nan_to_num(point_values[c], nan=0.0).min(axis=1) > 0] for t, c in surf.conn.items()}
+    keys = _keys(loaded)
+    if keys.size == 0:
+        return ""
+    best, best_share = None, 0.0
+    for ss in raw.side_sets:
+        conn: dict[str, list] = {}
+        for b in raw.blocks:
+            m = len(b.conn)
+            sel = (ss.elements >= b.first_cell) & (ss.elements < b.first_cell + m)
+            if sel.any() and SPECS[b.cell_type].dim >= 2:
+                rows = b.conn[ss.elements[sel] - b.first_cell]
+                for ftype, nodes, _ in side_faces(b.cell_type, rows, ss.sides[sel]):
+                    conn.setdefault(ftype, []).append(nodes)
+        share = float(np.isin(keys, _keys({t: np.concatenate(v) for t, v in conn.items()})).mean())
+        if share > best_share:
+            best, best_share = ss, share
+    if best is None or best_share < 0.9:
+        return ""
+    return f"the loaded faces lie on {best.label} ({best_share:.0%} of them)"
 
 
 def _parts(cand_blocks: list[tuple[str, np.ndarray]], n_points: int) -> np.ndarray:
