@@ -20,10 +20,11 @@ from .coefficients import Coefficients, coefficients_from_moments
 from .errors import PatchWarning, ScaleWarning
 from .field import ContactField
 from .moments import Moments, moments
-from .patch import DEFAULT_THRESHOLD, Patch, build_patch, warm_up
+from .patch import DEFAULT_THRESHOLD, Patch, build_patch
 from .polar import PolarGrid, PolarMap
 from .reader import isolate, start_reading
 from .reader.units import describe, unit_system
+from .regions import warm_up
 from .resample import resample
 
 

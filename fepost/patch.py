@@ -52,7 +52,6 @@ from ._arrays import frozen, sealed
 from .errors import ArgumentError, DimensionError, PatchError, PatchWarning, PressureError, PressureWarning
 from .facegroups import (
     STEEP_DEG,
-    FaceGroup,
     drop_edge_faces,
     exact_load,
     folded_faces,
@@ -63,46 +62,22 @@ from .facegroups import (
 )
 from .facesums import FaceSums, face_loads, face_sums, load_outside, triangle_areas
 from .field import ContactField
-from .reader.quadratic import face_surface_loads
+from .frame import Frame, _axes, _plane
 from .reader.units import check_scale
+from .regions import FRAGMENT_SHARE, _components, _separate_surfaces
+from .regions import GAP_FRACTION as GAP_FRACTION  # the patch rules' tolerances, documented here
 
 DEFAULT_THRESHOLD = 1e-6
 ASPECT_TOL = 0.10
 RMAX_TOL = 1.15
 PLANARITY_TOL = 0.02
 NEGATIVE_TOL = 0.01
-FRAGMENT_SHARE = 0.01
-GAP_FRACTION = 0.05
-RASTER_MAX = 2048
 #: Largest |load of the triangles / exact element load − 1| before the faces are cut finer.
 REFINE_TOL = 1e-4
 #: Most triangles the cut of curved faces may make (the finest level stays within it).
 REFINE_MAX_TRIANGLES = 4_000_000
 #: Loaded nodes spanning less than this fraction of their length across are on a line.
 LINE_TOL = 1e-6
-
-
-@dataclass(frozen=True)
-class Frame:
-    """Patch frame: ``origin`` (3,) in global coordinates (m); ``axes`` rows are x, y, z."""
-
-    origin: np.ndarray
-    axes: np.ndarray
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "origin", frozen(self.origin))
-        object.__setattr__(self, "axes", frozen(self.axes))
-
-    def to_local(self, points) -> np.ndarray:
-        """Global (n, 3) points → patch coordinates (n, 3), m."""
-        return (np.asarray(points, float) - self.origin) @ self.axes.T
-
-    def to_global(self, local) -> np.ndarray:
-        """Patch coordinates (n, 2 or 3) → global (n, 3), m."""
-        local = np.asarray(local, float)
-        if local.shape[-1] == 2:
-            local = np.concatenate([local, np.zeros(local.shape[:-1] + (1,))], axis=-1)
-        return local @ self.axes + self.origin
 
 
 @dataclass(frozen=True)
@@ -200,13 +175,6 @@ class Patch:
         }
 
 
-def _fmt(v) -> str:
-    """A vector as plain numbers: (1, 0, 0)."""
-    a = np.asarray(v, float).ravel()
-    a = np.where(np.abs(a) < 1e-9 * max(1.0, float(np.abs(a).max(initial=0.0))), 0.0, a) + 0.0
-    return "(" + ", ".join(f"{float(x):.3g}" for x in a) + ")"
-
-
 def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
     """The pressure values checked and, where allowed, repaired (a new array only then)."""
     v = fld.values
@@ -266,101 +234,6 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
     return (v if v is fld.values else sealed(v)), peak
 
 
-def warm_up() -> None:
-    """Import what the patch step needs beyond numpy (scipy.ndimage, ~0.3 s), e.g. while a file is read."""
-    from scipy import ndimage  # noqa: F401
-
-
-def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
-    """Separate loaded regions: (count, label per face).
-
-    Regions closer than a gap of about :data:`GAP_FRACTION` × √area (tread
-    grooves, sparse contact at the edge) belong to one patch; regions farther
-    apart (dual wheels) are separate. The nodes are binned on a raster of cell
-    h = max(GAP_FRACTION·√area, longest loaded edge), so faces that share a node
-    always fall in touching cells; one dilation closes gaps narrower than ~h.
-    """
-    from scipy import ndimage
-
-    h = max(GAP_FRACTION * np.sqrt(sums.A), sums.max_edge)
-    lo = np.array([x.min(), y.min()])
-    ext = np.array([x.max(), y.max()]) - lo
-    n = np.floor(ext / h).astype(int) + 3
-    if n.max() > RASTER_MAX:  # a very sparse region: coarsen the raster
-        h *= n.max() / RASTER_MAX
-        n = np.floor(ext / h).astype(int) + 3
-    # coordinates are >= lo, so truncation is the floor
-    i = ((x - lo[0]) * (1.0 / h)).astype(np.int32) + 1
-    j = ((y - lo[1]) * (1.0 / h)).astype(np.int32) + 1
-    occupied = np.zeros(tuple(n), bool)
-    occupied[i, j] = True
-    occupied = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), bool))
-    labels, count = ndimage.label(occupied, structure=np.ones((3, 3), bool))
-    if count == 1:
-        return 1, np.zeros(len(tri), np.int64)
-    first = tri[:, 0]
-    return int(count), labels[i[first], j[first]] - 1
-
-
-def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Weighted least-squares plane through ``points`` (n, 3): (centroid, unit normal, variances).
-
-    The second moments are accumulated column by column (one (n,) temporary)
-    about a node of the patch, so large global offsets cost no precision. The
-    variances (ascending) are those along the normal and the two in-plane axes.
-    """
-    w = weights / weights.sum()
-    ref = points[int(np.argmax(weights))]
-    c = w @ points - ref
-    m = np.empty((3, 3))
-    buf = np.empty(len(points))
-    cols = [points[:, k] for k in range(3)]
-    for a in range(3):
-        np.subtract(cols[a], ref[a], out=buf)
-        buf *= w
-        for b in range(a, 3):
-            m[a, b] = m[b, a] = buf @ cols[b] - ref[b] * buf.sum()
-    cov = m - np.outer(c, c)
-    evals, vecs = np.linalg.eigh(cov)
-    n = vecs[:, 0]
-    k = int(np.argmax(np.abs(n)))
-    if n[k] < 0:
-        n = -n
-    return c + ref, n, evals
-
-
-_AXIS_NAMES = ("x", "y", "z")
-
-
-def _axes(normal: np.ndarray, rolling_axis, source: str = "") -> tuple[np.ndarray, str]:
-    """Rows x, y, z of the patch frame, and a note when the default axis had to be replaced."""
-    note = ""
-    if rolling_axis is None:
-        ax = np.array([1.0, 0.0, 0.0])
-        if np.linalg.norm(ax - (ax @ normal) * normal) < 0.1:
-            k = int(np.argmin(np.abs(normal[1:]))) + 1  # the global axis closest to the plane (y or z)
-            ax = np.eye(3)[k]
-            note = (
-                f"rolling axis: global x is normal to the patch (normal {_fmt(normal)}); "
-                f"global {_AXIS_NAMES[k]} is used as the rolling direction x (give --rolling-axis to choose)"
-            )
-            warnings.warn(f"{source}: {note}", PatchWarning, stacklevel=4)
-    else:
-        ax = np.asarray(rolling_axis, float)
-        if ax.shape != (3,) or not np.all(np.isfinite(ax)) or np.linalg.norm(ax) == 0:
-            raise ArgumentError(f"rolling_axis must be a non-zero 3-vector, got {rolling_axis!r}")
-    ax = ax / np.linalg.norm(ax)
-    x = ax - (ax @ normal) * normal
-    if np.linalg.norm(x) < 0.1:
-        raise ArgumentError(
-            f"rolling axis {_fmt(ax)} is (nearly) normal to the patch plane "
-            f"(normal {_fmt(normal)}); give an in-plane rolling axis"
-        )
-    x /= np.linalg.norm(x)
-    y = np.cross(normal, x)
-    return np.vstack([x, y, normal]), note
-
-
 class _Geometry(NamedTuple):
     points: np.ndarray
     triangles: np.ndarray
@@ -393,45 +266,6 @@ def _geometry(source, points, tri, vals, location, thr, base: Frame) -> _Geometr
     if not sums.N > 0:
         raise PatchError(f"{source}: the contact patch carries no load")
     return _Geometry(pts, tri_local, nvals, xy, z, w, sums)
-
-
-def _separate_surfaces(fld: ContactField, groups: list[FaceGroup], hot: np.ndarray, points) -> None:
-    """Raise when the loaded faces form several patches (e.g. on parallel surfaces).
-
-    Faces are connected when they share a node loaded above the threshold, so a
-    side face touching two patches at its unloaded middle does not join them.
-    """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    rows, cols, loads = [], [], []
-    start = 0
-    for g in groups:
-        m = len(g.conn)
-        fid = np.repeat(np.arange(start, start + m), g.conn.shape[1])
-        nodes = g.conn.ravel()
-        sel = hot[nodes]
-        rows.append(fid[sel])
-        cols.append(nodes[sel])
-        vals = np.nan_to_num(fld.values if fld.location == "point" else np.asarray(g.values))
-        loads.append(face_surface_loads(g.ftype, points, g.conn, vals, fld.location))
-        start += m
-    nf = start
-    r, c = np.concatenate(rows), np.concatenate(cols)
-    g = coo_matrix((np.ones(len(r), np.int8), (r, nf + c)), shape=(nf + len(points), nf + len(points)))
-    count, labels = connected_components(g, directed=False)
-    lab = labels[:nf]
-    _, lab = np.unique(lab, return_inverse=True)
-    share = np.bincount(lab, weights=np.concatenate(loads))
-    share = share / share.sum()
-    big = np.sort(share[share > FRAGMENT_SHARE])[::-1]
-    if big.size > 1:
-        parts = ", ".join(f"{s:.0%}" for s in big)
-        raise PatchError(
-            f"{fld.source}: {big.size} separate contact patches (load shares {parts}) on different "
-            "surfaces (not one plane); fepost analyses one patch at a time: crop the mesh or choose "
-            "one surface with --surface"
-        )
 
 
 def build_patch(
@@ -576,7 +410,7 @@ def build_patch(
         tri_kept = geo.triangles[keep]
         vals_kept = geo.values if fld.location == "point" else geo.values[keep]
         if parent is not None:
-            kept_ids = np.unique(parent[_native_triangles(tri, keep)])
+            kept_ids = np.unique(parent[np.flatnonzero(keep)])  # compaction keeps the order
             groups = [g.subset(np.isin(g.ids, kept_ids)) for g in groups]
             groups = [g for g in groups if len(g.conn)]
         geo = _geometry(src, geo.points, tri_kept, vals_kept, fld.location, thr, base)
@@ -674,8 +508,3 @@ def build_patch(
         dropped_edge_faces=n_edge,
         body=fld.body,
     )
-
-
-def _native_triangles(tri: np.ndarray, keep: np.ndarray) -> np.ndarray:
-    """Indices of the kept triangles (the compaction in _geometry keeps triangle order)."""
-    return np.flatnonzero(keep)

@@ -8,6 +8,7 @@ suffix                    reader
 ========================= ===================================================
 ``.vtu .vtp .vtk .vtm``   VTK's XML / legacy readers (:mod:`.vtkfile`),
                           after the checks of :mod:`.vtkcheck`
+                          (:mod:`.xmlcheck`, :mod:`.legacycheck`)
 ``.e .exo .ex2 .exii``    the netCDF container read with netCDF4 (:mod:`.exodus`)
 ========================= ===================================================
 
