@@ -21,9 +21,10 @@ How
   first error line is quoted in the message, nothing reaches the terminal.
 * The child's address space is limited (:data:`MEMORY_BUDGET` beyond what it
   holds at the fork), so a header declaring 10¹² points fails fast.
-* The result travels back through a pipe: a pickle (protocol 5) whose large
-  numpy buffers are sent out of band and read straight into the arrays the
-  caller receives (one copy, no temporary files).
+* The result travels back as a pickle (protocol 5) whose large numpy buffers
+  go out of band into an anonymous shared memory map made before the fork
+  (the caller's arrays are views of it: one copy in the child, none in the
+  caller, no files); what does not fit goes through the pipe.
 * The parent waits with a deadline (:func:`timeout_for`); a child that misses
   it is killed.
 * Warnings the child issues are recorded and re-issued in the caller (fepost
@@ -38,6 +39,7 @@ function runs in the calling process (the validation still applies).
 from __future__ import annotations
 
 import io
+import mmap
 import os
 import pickle
 import select
@@ -63,7 +65,13 @@ TIMEOUT_PER_MB = 2.0
 MEMORY_BUDGET = 6 << 30
 #: Pipe size asked for on Linux (fewer wake-ups on large results).
 _PIPE_SIZE = 1 << 20
+#: Shared memory mapped for the results: this many times the file size, plus a floor (virtual
+#: memory: pages cost only when written).
+SHARED_FACTOR = 16
+SHARED_FLOOR = 64 << 20
+SHARED_CAP = 8 << 30
 _LEN = struct.Struct("<Q")
+_ALIGN = 64
 
 
 class ChildTraceback(Exception):
@@ -246,17 +254,31 @@ def _write_all(fd: int, data) -> None:
         view = view[n:]
 
 
-def _send(fd: int, payload: Any) -> None:
+def _send(fd: int, payload: Any, shm: mmap.mmap | None) -> None:
+    """Write the payload: header, then per buffer its place (shared-memory offset, or 2⁶⁴−1: the pipe)."""
     buffers: list[pickle.PickleBuffer] = []
     head = pickle.dumps(payload, protocol=5, buffer_callback=buffers.append)
     raws = [b.raw() for b in buffers]
-    _write_all(fd, _LEN.pack(len(head)) + _LEN.pack(len(raws)) + b"".join(_LEN.pack(r.nbytes) for r in raws))
-    _write_all(fd, head)
+    places, pos = [], 0
     for r in raws:
-        _write_all(fd, r)
+        if shm is not None and pos + r.nbytes <= len(shm):
+            shm[pos : pos + r.nbytes] = r
+            places.append(pos)
+            pos += -(-r.nbytes // _ALIGN) * _ALIGN
+        else:
+            places.append(_PIPE)
+    table = b"".join(_LEN.pack(r.nbytes) + _LEN.pack(at) for r, at in zip(raws, places, strict=True))
+    _write_all(fd, _LEN.pack(len(head)) + _LEN.pack(len(raws)) + table)
+    _write_all(fd, head)
+    for r, at in zip(raws, places, strict=True):
+        if at == _PIPE:
+            _write_all(fd, r)
 
 
-def _child_main(wfd: int, func, args, kwargs, nbytes: int) -> None:
+_PIPE = (1 << 64) - 1
+
+
+def _child_main(wfd: int, func, args, kwargs, nbytes: int, shm: mmap.mmap | None) -> None:
     import faulthandler
 
     faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
@@ -282,9 +304,10 @@ def _child_main(wfd: int, func, args, kwargs, nbytes: int) -> None:
     caught = [(w.category, str(w.message)) for w in rec if issubclass(w.category, FepostWarning)]
     text = _chatter(cap)
     try:
-        _send(wfd, (payload, caught, text))
+        _send(wfd, (payload, caught, text), shm)
     except Exception as exc:  # the result itself could not be pickled: say so
-        _send(wfd, (("other", (type(exc).__name__, _first_line(exc), traceback.format_exc())), caught, text))
+        other = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
+        _send(wfd, (other, caught, text), None)
 
 
 # ----------------------------------------------------------------------------- parent side
@@ -356,9 +379,18 @@ def _reap(pid: int, kill: bool) -> int:
             continue
 
 
+def _shared(nbytes: int) -> mmap.mmap | None:
+    size = min(SHARED_CAP, SHARED_FLOOR + SHARED_FACTOR * nbytes)
+    try:
+        return mmap.mmap(-1, size)  # anonymous and shared with the child
+    except (OSError, ValueError, OverflowError):
+        return None  # no room for the map: everything goes through the pipe
+
+
 def _fork(func, args, kwargs, what, nbytes, timeout):
     import fcntl
 
+    shm = _shared(nbytes)
     rfd, wfd = os.pipe()
     if hasattr(fcntl, "F_SETPIPE_SZ"):
         try:
@@ -376,25 +408,34 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
         code = 0
         try:
             os.close(rfd)
-            _child_main(wfd, func, args, kwargs, nbytes)
+            _child_main(wfd, func, args, kwargs, nbytes, shm)
         except BaseException:
             code = 70
         finally:
             os._exit(code)
     os.close(wfd)
-    return pid, _Reader(rfd, time.monotonic() + timeout), what, timeout
+    return pid, _Reader(rfd, time.monotonic() + timeout), what, timeout, shm
 
 
-def _finish(pid: int, reader: _Reader, what: str, timeout: float):
+def _finish(pid: int, reader: _Reader, what: str, timeout: float, shm: mmap.mmap | None):
     received = None
     killed = False
     try:
         try:
             sizes = reader.exact(16)
             nhead, nbuf = _LEN.unpack_from(sizes, 0)[0], _LEN.unpack_from(sizes, 8)[0]
-            lens = reader.exact(8 * nbuf)
+            table = reader.exact(16 * nbuf)
             head = reader.exact(nhead)
-            bufs = [reader.exact(_LEN.unpack_from(lens, 8 * i)[0]) for i in range(nbuf)]
+            bufs: list = []
+            view = memoryview(shm) if shm is not None else None
+            for i in range(nbuf):
+                n, at = _LEN.unpack_from(table, 16 * i)[0], _LEN.unpack_from(table, 16 * i + 8)[0]
+                if at == _PIPE or view is None:
+                    bufs.append(reader.exact(n))
+                elif at + n <= len(view):
+                    bufs.append(view[at : at + n])  # the arrays are views of the shared map: no copy
+                else:
+                    raise ValueError("shared-memory place out of range")
             received = pickle.loads(head, buffers=bufs)
         except _Deadline:
             killed = True
