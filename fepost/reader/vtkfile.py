@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import InputFileError
 from .cells import SPECS, VTK_TYPES, check_connectivity
-from .raw import Block, LazyArrays, RawMesh
+from .raw import Block, RawMesh
 
 VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm")
 #: VTK cell types without area that are passed over (named in the notes): they carry no contact pressure.
@@ -354,4 +354,4 @@ def _cell_data(path, ds, m: int, components) -> dict[str, np.ndarray]:
     return out
 
 
-__all__ = ["VTK_SUFFIXES", "read_vtk", "LazyArrays"]
+__all__ = ["VTK_SUFFIXES", "read_vtk"]
