@@ -88,6 +88,6 @@ def _separate_surfaces(fld: ContactField, groups: list[FaceGroup], hot: np.ndarr
         parts = ", ".join(f"{s:.0%}" for s in big)
         raise PatchError(
             f"{fld.source}: {big.size} separate contact patches (load shares {parts}) on different "
-            "surfaces (not one plane); fepost analyses one patch at a time: crop the mesh or choose "
-            "one surface with --surface"
+            "surfaces (not one plane); fepost analyses one patch at a time: crop the mesh (in an Exodus "
+            "file: choose one side set or block with --surface)"
         )
