@@ -65,3 +65,7 @@ class PatchWarning(FepostWarning):
 
 class FitWarning(FepostWarning):
     """A fit converged but its uncertainty is poorly determined."""
+
+
+class ClusterError(FepostError, RuntimeError):
+    """The Dask cluster of a sweep cannot be reached, has no workers or went away."""

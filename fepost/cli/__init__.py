@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 from ..errors import FepostError, FepostWarning
 
-_COMMANDS = ("coefficients", "table1", "report", "diagnose")
+_COMMANDS = ("coefficients", "table1", "report", "diagnose", "sweep")
 
 
 def build_parser() -> argparse.ArgumentParser:

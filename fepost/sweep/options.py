@@ -1,0 +1,92 @@
+"""What every row of a sweep is run with: the options of ``fepost coefficients``.
+
+A sweep row is one call of :func:`fepost.analysis.analyse`; :class:`RowOptions`
+holds that call's keyword arguments as plain values, so it pickles to any Dask
+worker and hashes into the row's identity (a row computed with other options is
+not reused by a later run).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from ..errors import ArgumentError
+from ..patch import DEFAULT_THRESHOLD
+from ..polar import DEFAULT_NPHI, DEFAULT_NR, PolarGrid
+
+
+@dataclass(frozen=True)
+class RowOptions:
+    """Keyword arguments of :func:`fepost.analysis.analyse` for every row.
+
+    Attributes
+    ----------
+    friction : float
+        Friction coefficient f (dimensionless).
+    field : str or None
+        Contact-pressure array name (``NAME:K`` for a component); None: by name.
+    displacement : str or None
+        ``"auto"``, an array name, or None to use the coordinates as written.
+    threshold : float
+        A face is loaded when its pressure exceeds ``threshold`` × peak.
+    nr, nphi : int
+        Polar grid nodes in r and φ.
+    rule : str
+        Radial quadrature rule, ``"gauss"`` or ``"trapezoid"``.
+    rolling_axis : tuple of 3 floats or None
+        Global rolling direction (default global x).
+    """
+
+    friction: float = 0.3
+    field: str | None = None
+    displacement: str | None = "auto"
+    threshold: float = DEFAULT_THRESHOLD
+    nr: int = DEFAULT_NR
+    nphi: int = DEFAULT_NPHI
+    rule: str = "gauss"
+    rolling_axis: tuple[float, float, float] | None = None
+
+    def __post_init__(self) -> None:
+        f = self.friction
+        if isinstance(f, bool) or not isinstance(f, int | float) or not (math.isfinite(f) and f > 0):
+            raise ArgumentError(f"friction must be a positive number, got {self.friction!r}")
+        if self.rolling_axis is not None:
+            object.__setattr__(self, "rolling_axis", tuple(float(v) for v in self.rolling_axis))
+        PolarGrid.make(self.nr, self.nphi, self.rule)  # type: ignore[arg-type]  # raises on a bad grid
+
+    @classmethod
+    def from_analysis_kwargs(cls, kwargs: dict, friction: float = 0.3) -> RowOptions:
+        """Options from the keyword arguments the single-file commands pass to ``analyse``.
+
+        ``kwargs`` is what :func:`fepost.cli._common.analysis_kwargs` returns
+        (its ``step`` is the sweep's business and is ignored here).
+        """
+        grid = kwargs.get("grid") or PolarGrid.make()
+        axis = kwargs.get("rolling_axis")
+        return cls(
+            friction=friction,
+            field=kwargs.get("field"),
+            displacement=kwargs.get("displacement", "auto"),
+            threshold=float(kwargs.get("threshold", DEFAULT_THRESHOLD)),
+            nr=int(grid.shape[0]),
+            nphi=int(grid.shape[1]),
+            rule=str(grid.rule),
+            rolling_axis=None if axis is None else tuple(axis),
+        )
+
+    def analyse_kwargs(self) -> dict:
+        """The keyword arguments of :func:`fepost.analysis.analyse` (without ``step``)."""
+        return {
+            "friction": self.friction,
+            "field": self.field,
+            "displacement": self.displacement,
+            "grid": PolarGrid.make(self.nr, self.nphi, self.rule),  # type: ignore[arg-type]
+            "threshold": self.threshold,
+            "rolling_axis": self.rolling_axis,
+        }
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["rolling_axis"] = None if self.rolling_axis is None else list(self.rolling_axis)
+        return d
