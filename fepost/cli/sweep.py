@@ -13,16 +13,6 @@ import sys
 SHOWN_ERRORS = 10
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a positive whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive whole number, got {text!r}")
-    return value
-
-
 def add_parser(sub) -> None:
     from ._common import add_friction_option, add_input_options
 
@@ -42,7 +32,7 @@ def add_parser(sub) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created; re-use it to resume)")
     p.add_argument(
         "--workers",
-        type=_positive_int,
+        type=int,
         metavar="N",
         help="worker processes of the embedded local Dask cluster (default: the CPU cores)",
     )

@@ -110,16 +110,13 @@ def run_job(job: Job) -> dict:
         warnings.simplefilter("always", FepostWarning)
         try:
             res = analyse(job.path, job.rolling, step=job.step, **job.options.analyse_kwargs())
-            doc = res.to_dict()
             step = res.static_field.step
-            row["step"] = step
-            row["time"] = res.static_field.time
-            row.update(coefficient_columns(doc))
             n_steps = job.n_steps
             if n_steps is None and step is not None:
                 listed = time_steps(job.path)  # type: ignore[arg-type]
                 n_steps = len(listed) if listed else None
-            row.update(case_metadata(job.path, step, n_steps))  # type: ignore[arg-type]
+            meta = case_metadata(job.path, step, n_steps)  # type: ignore[arg-type]
+            row.update(step=step, time=res.static_field.time, **coefficient_columns(res.to_dict()), **meta)
             row["status"], row["error"] = "ok", ""
         except FepostError as exc:
             row["status"], row["error"] = "error", one_line(str(exc))

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from ..output import write_json_atomic, write_text_atomic
 from .figures import plot_load_trends, plot_time_trends, transient_series
+from .table import normalise
 from .trends import PowerLaw, load_trends
 
 #: Most rows listed in the HTML table (the CSV and Parquet files hold them all).
@@ -126,6 +127,7 @@ def sweep_section(
     title : str
         The section's heading.
     """
+    rows = [normalise(r) for r in rows]
     fits = load_trends(rows)
     figures = draw_figures(rows, fits, Path(figure_dir))
     prefix = href.rstrip("/") + "/" if href else ""

@@ -6,8 +6,9 @@ Two ways to say it:
   name contains ``STATIC`` is the file beside it with every ``STATIC`` in the
   name replaced by ``ROLLING`` (``case_150kN_static.e`` →
   ``case_150kN_rolling.e`` with ``static=rolling``). An input without
-  ``STATIC`` in its name is a static-only row; a partner that does not exist
-  makes that row an error.
+  ``STATIC`` in its name, or whose partner does not exist, is a static-only
+  row (a load sweep often has a rolling run at one load only); a rule that
+  pairs no input at all is refused as a likely typo.
 * a **CSV file** (``*.csv``) with a header row naming the columns ``static``
   and ``rolling`` (others ignored; blank lines and ``#`` comments allowed);
   relative paths are taken from the CSV's folder. Inputs not listed are
@@ -55,11 +56,11 @@ class RollingPairs:
             name = Path(src.path).name
             if old not in name:
                 return None
+            partner = Path(src.path).with_name(name.replace(old, new))
+            if not partner.is_file():
+                return None
             given = Path(src.given)
-            return (
-                str(Path(src.path).with_name(name.replace(old, new))),
-                str(given.with_name(given.name.replace(old, new))),
-            )
+            return str(partner), str(given.with_name(given.name.replace(old, new)))
         hit = self.table.get(src.path)
         return (hit, hit) if hit is not None else None
 
@@ -127,6 +128,12 @@ def pair_sources(sources: Sequence[Source], pairs: RollingPairs | None) -> list[
         return [Pairing(s) for s in sources]
     found = [(s, pairs.partner(s)) for s in sources]
     partners = {p[0] for _, p in found if p is not None}
+    if pairs.rule is not None and not partners and any(s.path is not None for s in sources):
+        old, new = pairs.rule
+        raise ArgumentError(
+            f"--rolling-pairs {pairs.spec}: no input has a rolling partner (no file named like an "
+            f"input with {old!r} replaced by {new!r})"
+        )
     out = []
     for src, p in found:
         if src.path is not None and src.path in partners and p is None:

@@ -9,6 +9,7 @@ the rest of the sweep.
 
 from __future__ import annotations
 
+import logging
 import warnings
 from pathlib import Path
 
@@ -43,6 +44,7 @@ def time_steps(path: str | Path) -> tuple[float, ...] | None:
         raise InputFileError(f"{path}: empty file")
     import pyvista as pv
 
+    logging.disable(logging.CRITICAL)  # pyvista logs VTK's errors; the exception says enough
     with pv.vtk_verbosity("off"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
@@ -52,4 +54,6 @@ def time_steps(path: str | Path) -> tuple[float, ...] | None:
         except Exception as exc:  # VTK raises many types on a corrupt header
             first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
             raise InputFileError(f"{path}: cannot list the Exodus time steps ({first})") from None
+        finally:
+            logging.disable(logging.NOTSET)
     return times or None
