@@ -25,10 +25,10 @@ import numpy as np
 import pytest
 
 from fepost.cli import main
-from fepost.synthetic import disc_mesh, write_exodus, write_map
 from fepost.sweep import RowOptions, read_table, run_sweep
 from fepost.sweep.store import WORK
 from fepost.sweep.table import NAMES
+from fepost.synthetic import disc_mesh, write_exodus, write_map
 
 distributed = pytest.importorskip("distributed")
 
@@ -45,9 +45,16 @@ N0, R0 = 1.0e4, 0.05  # reference load (N) and Hertz radius (m)
 def cluster():
     import logging
 
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR
-    ) as lc, distributed.Client(lc) as client:
+    with (
+        distributed.LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        ) as lc,
+        distributed.Client(lc) as client,
+    ):
         client.run(importlib.import_module, "fepost.analysis")  # warm workers: rows time the analysis only
         yield client
 
@@ -142,7 +149,9 @@ def test_rolling_pairs_rule_and_csv(cluster, load_sweep, tmp_path):
     assert all(r["k_x"] is None for r in res.rows if r is not row)
     # the same pairing from a CSV (paths relative to the CSV's folder)
     pairs = tmp_path / "pairs.csv"
-    pairs.write_text(f"# static and rolling maps\nstatic,rolling\n{static},{os.path.relpath(rolling, tmp_path)}\n")
+    pairs.write_text(
+        f"# static and rolling maps\nstatic,rolling\n{static},{os.path.relpath(rolling, tmp_path)}\n"
+    )
     res2 = run_sweep([str(static)], tmp_path / "csv", rolling_pairs=str(pairs), client=cluster, trends=False)
     assert_row_equals(dict(res2.rows[0]), doc)
 
@@ -159,9 +168,22 @@ def test_bad_inputs_are_error_rows_and_exit_2(cluster, load_sweep, tmp_path, cap
     side.with_suffix(".json").write_text('{"load": "heavy"}')
     out = tmp_path / "out"
     argv = [
-        "sweep", str(good), str(trunc), str(bad / "garbage.e"), str(bad / "missing.vtu"),
-        str(bad / "nothing*.vtu"), str(side), str(files[2]), "--out", str(out),
-        "--scheduler", cluster.scheduler.address, "--steps", "all", "--no-progress", "--no-trends",
+        "sweep",
+        str(good),
+        str(trunc),
+        str(bad / "garbage.e"),
+        str(bad / "missing.vtu"),
+        str(bad / "nothing*.vtu"),
+        str(side),
+        str(files[2]),
+        "--out",
+        str(out),
+        "--scheduler",
+        cluster.scheduler.address,
+        "--steps",
+        "all",
+        "--no-progress",
+        "--no-trends",
     ]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
@@ -181,8 +203,21 @@ def test_bad_inputs_are_error_rows_and_exit_2(cluster, load_sweep, tmp_path, cap
         assert f"fepost: error: {r['error']}" in err
     assert_row_equals(rows[0], single_file(tmp_path, good))
     # the same good files alone: exit 0
-    assert main(["sweep", str(good), "--out", str(tmp_path / "ok"), "--scheduler",
-                 cluster.scheduler.address, "--no-progress", "--no-trends"]) == 0
+    assert (
+        main(
+            [
+                "sweep",
+                str(good),
+                "--out",
+                str(tmp_path / "ok"),
+                "--scheduler",
+                cluster.scheduler.address,
+                "--no-progress",
+                "--no-trends",
+            ]
+        )
+        == 0
+    )
 
 
 def test_resume_after_sigkill(cluster, tmp_path, monkeypatch):
@@ -193,8 +228,19 @@ def test_resume_after_sigkill(cluster, tmp_path, monkeypatch):
     for i, load in enumerate(loads):
         hertz(d / f"r{i:02d}.vtu", float(load), n_rings=30)  # ~3 000 nodes: rows of ~0.1 s
     out = tmp_path / "out"
-    cmd = [sys.executable, "-m", "fepost", "sweep", str(d), "--out", str(out),
-           "--scheduler", cluster.scheduler.address, "--no-progress", "--no-trends"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "fepost",
+        "sweep",
+        str(d),
+        "--out",
+        str(out),
+        "--scheduler",
+        cluster.scheduler.address,
+        "--no-progress",
+        "--no-trends",
+    ]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     rows_dir = out / WORK / "rows"
     deadline = time.monotonic() + 60
@@ -286,7 +332,10 @@ def test_cli_option_errors(cluster, tmp_path, capsys, monkeypatch):
         (["--rolling-pairs", "nonsense"], "--rolling-pairs 'nonsense': expected a naming rule"),
         (["--rolling-pairs", "a=a"], "a naming rule is STATIC=ROLLING"),
         (["--steps", "all", "--step", "2"], "--step N picks one time step of every file"),
-        (["--workers", "2", "--scheduler", cluster.scheduler.address], "--workers sizes the embedded cluster"),
+        (
+            ["--workers", "2", "--scheduler", cluster.scheduler.address],
+            "--workers sizes the embedded cluster",
+        ),
         (["--friction", "-1"], "friction must be a positive number"),
     ]
     for extra, message in cases:

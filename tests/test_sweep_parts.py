@@ -34,7 +34,13 @@ def test_expand_files_folders_globs(tmp_path, monkeypatch):
     src = expand_inputs(["x.vtk", "runs", "runs/**/*.vtu", "missing.vtu", "none*.e", "empty"])
     # the folder: its FE exports by name, not the sub-folder, not hidden or other files
     assert [s.given for s in src] == [
-        "x.vtk", "runs/a.e", "runs/b.vtu", "runs/sub/c.vtu", "missing.vtu", "none*.e", "empty",
+        "x.vtk",
+        "runs/a.e",
+        "runs/b.vtu",
+        "runs/sub/c.vtu",
+        "missing.vtu",
+        "none*.e",
+        "empty",
     ]
     assert src[0].path == str(tmp_path / "x.vtk") and src[0].error is None
     assert src[4].path == str(tmp_path / "missing.vtu") and src[4].error is None  # the reader names it
@@ -43,7 +49,10 @@ def test_expand_files_folders_globs(tmp_path, monkeypatch):
     (tmp_path / "empty").mkdir()
     assert expand_inputs(["empty"])[0].error.startswith("empty: folder holds no FE exports")
     # one file reached twice is one source, at its first place
-    assert [s.given for s in expand_inputs(["runs/b.vtu", "runs", "./runs/b.vtu"])] == ["runs/b.vtu", "runs/a.e"]
+    assert [s.given for s in expand_inputs(["runs/b.vtu", "runs", "./runs/b.vtu"])] == [
+        "runs/b.vtu",
+        "runs/a.e",
+    ]
 
 
 def test_rolling_pairs_rule(tmp_path):
@@ -83,13 +92,30 @@ def test_rolling_pairs_csv(tmp_path):
 
 def test_sidecar_metadata(tmp_path):
     f = touch(tmp_path / "case.e")
-    assert case_metadata(f, None, None) == {"case": None, "load": None, "deflection": None,
-                                            "inflation_pressure": None}
+    assert case_metadata(f, None, None) == {
+        "case": None,
+        "load": None,
+        "deflection": None,
+        "inflation_pressure": None,
+    }
     side = f.with_suffix(".json")
-    side.write_text(json.dumps({"case": 7, "reaction_z": 1.5e5, "deflection": 0.04,
-                                "inflation_pressure": [1.0e6, 1.1e6, 1.2e6], "other": "ignored"}))
-    assert case_metadata(f, 2, 3) == {"case": "7", "load": 1.5e5, "deflection": 0.04,
-                                      "inflation_pressure": 1.2e6}
+    side.write_text(
+        json.dumps(
+            {
+                "case": 7,
+                "reaction_z": 1.5e5,
+                "deflection": 0.04,
+                "inflation_pressure": [1.0e6, 1.1e6, 1.2e6],
+                "other": "ignored",
+            }
+        )
+    )
+    assert case_metadata(f, 2, 3) == {
+        "case": "7",
+        "load": 1.5e5,
+        "deflection": 0.04,
+        "inflation_pressure": 1.2e6,
+    }
     side.write_text(json.dumps({"load": 2.0e5, "reaction_z": 1.9e5}))
     assert case_metadata(f, None, None)["load"] == 2.0e5  # a prescribed load wins over the reaction
     for text, message in (
@@ -115,8 +141,13 @@ def test_time_steps_adapter(tmp_path):
     assert time_steps(touch(tmp_path / "a.vtu")) is None  # not a series
     p, c = disc_mesh(4)
     pts = np.column_stack([p, np.zeros(len(p))])
-    e = write_exodus(tmp_path / "s.e", pts, c, [{"CPRESS": np.ones(len(p)) * k} for k in range(4)],
-                     times=[0.0, 0.5, 1.25, 2.0])
+    e = write_exodus(
+        tmp_path / "s.e",
+        pts,
+        c,
+        [{"CPRESS": np.ones(len(p)) * k} for k in range(4)],
+        times=[0.0, 0.5, 1.25, 2.0],
+    )
     assert time_steps(e) == (0.0, 0.5, 1.25, 2.0)
     with pytest.raises(InputFileError, match="empty file"):
         time_steps(touch(tmp_path / "z.e", ""))
@@ -125,8 +156,16 @@ def test_time_steps_adapter(tmp_path):
 
 
 def test_table_csv_round_trip_and_types(tmp_path):
-    row = {"source": "a.vtu", "status": "ok", "N": 0.1 + 0.2, "R": 1e-300, "circular": True, "step": 3,
-           "time": math.nan, "k_x": None}
+    row = {
+        "source": "a.vtu",
+        "status": "ok",
+        "N": 0.1 + 0.2,
+        "R": 1e-300,
+        "circular": True,
+        "step": 3,
+        "time": math.nan,
+        "k_x": None,
+    }
     norm = normalise(row)
     assert list(norm) == list(NAMES)
     assert norm["time"] is None and norm["k_x"] is None and norm["error"] == "" and norm["rolling"] == ""

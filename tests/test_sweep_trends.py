@@ -24,9 +24,22 @@ def hertz_rows(loads, pressure=None, friction=0.3):
         R = 0.05 * (load / 1e4) ** (1 / 3)
         peak = 3 * load / (2 * math.pi * R**2)
         c = analytic.coefficients("hertz", R, peak, friction)
-        rows.append({"status": "ok", "source": f"{load:g}.vtu", "N": analytic.load("hertz", R, peak), "R": R,
-                     "M0": c["M0"], "aR2": c["a"] * R**2, "m_over_R2": c["m"] / R**2, "a": c["a"], "m": c["m"],
-                     "k_x": None, "inflation_pressure": pressure, "step": None})
+        rows.append(
+            {
+                "status": "ok",
+                "source": f"{load:g}.vtu",
+                "N": analytic.load("hertz", R, peak),
+                "R": R,
+                "M0": c["M0"],
+                "aR2": c["a"] * R**2,
+                "m_over_R2": c["m"] / R**2,
+                "a": c["a"],
+                "m": c["m"],
+                "k_x": None,
+                "inflation_pressure": pressure,
+                "step": None,
+            }
+        )
     return rows
 
 

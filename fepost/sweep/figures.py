@@ -53,8 +53,14 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
                     lo, hi = fit.band(grid)
                     ax.fill_between(grid, lo, hi, color=colour, alpha=0.18, lw=0)
                     lo_a, hi_a = fit.ci95  # type: ignore[misc]
-                    ax.plot(grid, fit.predict(grid), "-", color=colour, lw=1.2,
-                            label=f"N^{fit.exponent:.3f} [{lo_a:.3f}, {hi_a:.3f}]")
+                    ax.plot(
+                        grid,
+                        fit.predict(grid),
+                        "-",
+                        color=colour,
+                        lw=1.2,
+                        label=f"N^{fit.exponent:.3f} [{lo_a:.3f}, {hi_a:.3f}]",
+                    )
             finite = _values(rows, q)
             if np.all(finite[np.isfinite(finite)] > 0):
                 ax.set_yscale("log")
@@ -65,7 +71,7 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
             ax.set_title(title, fontsize=10)
             if ax.get_legend_handles_labels()[0]:
                 ax.legend(loc="best")
-        for ax in list(axes.flat)[len(quantities):]:
+        for ax in list(axes.flat)[len(quantities) :]:
             ax.set_visible(False)
         fig.tight_layout()
     return fig

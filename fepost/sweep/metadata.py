@@ -94,8 +94,7 @@ def case_metadata(path: str | Path, step: int | None, n_steps: int | None) -> di
         if isinstance(value, list):
             if n_steps is None or len(value) != n_steps or step is None:
                 raise InputFileError(
-                    f"{side}: {key!r} lists {len(value)} values but {path} has "
-                    f"{n_steps or 'no'} time steps"
+                    f"{side}: {key!r} lists {len(value)} values but {path} has {n_steps or 'no'} time steps"
                 )
             value = value[step]
         row[column] = _number(side, key, value)

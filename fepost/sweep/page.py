@@ -84,21 +84,26 @@ def draw_figures(rows: Sequence[Mapping], fits: Sequence[PowerLaw], folder: Path
     loads = {r["N"] for r in rows if r.get("status") == "ok" and r.get("N") is not None}
     if len(loads) >= 2:
         _save(plot_load_trends(rows, fits), folder, "load_trends")
-        figures.append({
-            "png": "load_trends.png",
-            "svg": "load_trends.svg",
-            "caption": "Coefficients against the normal load N (log-log), power-law fits with "
-                       "their 95 % confidence bands; exponents with 95 % intervals in the legends.",
-        })
+        figures.append(
+            {
+                "png": "load_trends.png",
+                "svg": "load_trends.svg",
+                "caption": "Coefficients against the normal load N (log-log), power-law fits with "
+                "their 95 % confidence bands; exponents with 95 % intervals in the legends.",
+            }
+        )
     series = transient_series(rows)
     if series:
         _save(plot_time_trends(series), folder, "time_trends")
-        figures.append({
-            "png": "time_trends.png",
-            "svg": "time_trends.svg",
-            "caption": "Coefficients against time for the runs with several time steps"
-                       + (f" (the first {8} of {len(series)})" if len(series) > 8 else "") + ".",
-        })
+        figures.append(
+            {
+                "png": "time_trends.png",
+                "svg": "time_trends.svg",
+                "caption": "Coefficients against time for the runs with several time steps"
+                + (f" (the first {8} of {len(series)})" if len(series) > 8 else "")
+                + ".",
+            }
+        )
     return figures
 
 
@@ -132,15 +137,19 @@ def sweep_section(
     figures = draw_figures(rows, fits, Path(figure_dir))
     prefix = href.rstrip("/") + "/" if href else ""
     listed = list(rows)[:MAX_TABLE_ROWS]
-    return _environment().get_template("section.html.j2").render(
-        title=title,
-        h=max(1, min(5, int(heading_level))),
-        figures=[{**f, "png": prefix + f["png"], "svg": prefix + f["svg"]} for f in figures],
-        fits=fits,
-        rows=listed,
-        n_rows=len(rows),
-        n_errors=sum(r.get("status") != "ok" for r in rows),
-        columns=TABLE_COLUMNS,
+    return (
+        _environment()
+        .get_template("section.html.j2")
+        .render(
+            title=title,
+            h=max(1, min(5, int(heading_level))),
+            figures=[{**f, "png": prefix + f["png"], "svg": prefix + f["svg"]} for f in figures],
+            fits=fits,
+            rows=listed,
+            n_rows=len(rows),
+            n_errors=sum(r.get("status") != "ok" for r in rows),
+            columns=TABLE_COLUMNS,
+        )
     )
 
 
@@ -166,9 +175,13 @@ def write_trends(rows: Sequence[Mapping], out: str | os.PathLike) -> Path:
         raise
     from markupsafe import Markup
 
-    page = _environment().get_template("trends.html.j2").render(
-        section=Markup(section),
-        n_rows=len(rows),
+    page = (
+        _environment()
+        .get_template("trends.html.j2")
+        .render(
+            section=Markup(section),
+            n_rows=len(rows),
+        )
     )
     write_json_atomic(out / "trends.json", {"fits": [f.to_dict() for f in load_trends(rows)]})
     return write_text_atomic(out / "trends.html", page)

@@ -191,7 +191,11 @@ def load_trends(rows: Sequence[Mapping]) -> list[PowerLaw]:
                 fit_power_law(
                     [math.nan if v is None else v for v in N],
                     [math.nan if v is None else v for v in y],
-                    quantity=q, label=label, unit=unit, group=name, hertz=hertz,
+                    quantity=q,
+                    label=label,
+                    unit=unit,
+                    group=name,
+                    hertz=hertz,
                 )
             )
     return fits
