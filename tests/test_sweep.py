@@ -50,7 +50,7 @@ def cluster():
             n_workers=2,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",
             silence_logs=logging.ERROR,
         ) as lc,
         distributed.Client(lc) as client,
@@ -364,3 +364,19 @@ def test_options_reach_every_row(cluster, tmp_path):
     # other options are other rows: nothing reused
     res2 = run_sweep([str(f)], tmp_path / "o", client=cluster, trends=False)
     assert (res2.reused, res2.computed) == (0, 1)
+
+
+def test_report_section_in_process(load_sweep, tmp_path):
+    """The report's one call: a sweep on one in-process worker thread, its section and files."""
+    from fepost.sweep import sweep_report_section
+
+    d, files, _ = load_sweep
+    html, written = sweep_report_section([str(d / "*_static.vtu")], tmp_path, heading_level=3)
+    assert html.lstrip().startswith('<section class="fepost-sweep">') and "<h3>" in html
+    assert 'src="sweep/load_trends.png"' in html
+    assert set(written) >= {"sweep/coefficients.csv", "sweep/coefficients.parquet", "sweep/load_trends.png"}
+    assert all((tmp_path / f).is_file() for f in written)
+    assert not (tmp_path / "sweep" / WORK).exists()
+    rows = read_table(tmp_path / "sweep" / "coefficients.parquet")
+    assert [r["source"] for r in rows] == [str(f) for f in sorted(d.glob("*_static.vtu"))]
+    assert all(r["status"] == "ok" for r in rows)

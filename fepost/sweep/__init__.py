@@ -23,8 +23,11 @@ Modules, one job each:
 * :mod:`.run` – :func:`run_sweep`, the steps above in order
 * :mod:`.trends`, :mod:`.figures`, :mod:`.page` – power-law fits, figures,
   the trends page and :func:`sweep_section` for embedding in a report
+* :mod:`.embed` – :func:`sweep_report_section`: run a sweep and return its
+  section, for the report
 """
 
+from .embed import sweep_report_section
 from .options import RowOptions
 from .page import sweep_section, write_trends
 from .run import SweepResult, run_sweep
@@ -40,6 +43,7 @@ __all__ = [
     "load_trends",
     "read_table",
     "run_sweep",
+    "sweep_report_section",
     "sweep_section",
     "write_trends",
 ]

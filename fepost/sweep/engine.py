@@ -41,9 +41,14 @@ class Cluster:
         Address of an existing scheduler (``tcp://HOST:PORT``); no embedded cluster.
     client : distributed.Client, optional
         A client to use as it is (not closed here).
+    processes : bool
+        Embedded cluster of worker processes (default) or of threads in this
+        process (no start-up of new interpreters; for a few small files).
     """
 
-    def __init__(self, workers: int | None = None, scheduler: str | None = None, client=None):
+    def __init__(
+        self, workers: int | None = None, scheduler: str | None = None, client=None, processes: bool = True
+    ):
         if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
             raise ArgumentError(f"--workers must be a positive whole number, got {workers!r}")
         if scheduler is not None and workers is not None:
@@ -52,6 +57,7 @@ class Cluster:
         self.scheduler = scheduler
         self._client = client
         self._own = client is None
+        self._processes = processes
         self._cluster: Any = None
 
     @property
@@ -70,8 +76,8 @@ class Cluster:
             self._cluster = LocalCluster(
                 n_workers=self.workers,
                 threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
+                processes=self._processes,
+                dashboard_address=":0",  # any free port: 8787 may be another cluster's
                 silence_logs=logging.ERROR,
             )
             return Client(self._cluster)

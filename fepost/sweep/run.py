@@ -171,6 +171,7 @@ def run_sweep(
     workers: int | None = None,
     scheduler: str | None = None,
     client=None,
+    processes: bool = True,
     progress: bool | None = None,
     fresh: bool = False,
     force: bool = False,
@@ -200,6 +201,9 @@ def run_sweep(
         Address of an existing Dask scheduler instead of the embedded cluster.
     client : distributed.Client, optional
         An open client to compute on (neither started nor closed here).
+    processes : bool
+        The embedded cluster's workers are processes (default) or threads of
+        this process (quicker to start, for a handful of small files).
     progress : bool, optional
         Progress bar on stderr; None (default): when stderr is a terminal.
     fresh : bool
@@ -221,7 +225,7 @@ def run_sweep(
     steps = _check_steps(steps)
     options = options or RowOptions()
     pairs = parse_rolling_pairs(rolling_pairs) if isinstance(rolling_pairs, str) else rolling_pairs
-    cluster = Cluster(workers, scheduler, client)
+    cluster = Cluster(workers, scheduler, client, processes=processes)
     pairings = pair_sources(expand_inputs(inputs), pairs)
     out = Path(out)
     with WorkFolder(out, force=force, fresh=fresh) as work, cluster:
