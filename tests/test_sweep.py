@@ -45,7 +45,12 @@ N0, R0 = 1.0e4, 0.05  # reference load (N) and Hertz radius (m)
 def cluster():
     import logging
 
+    import dask
+
+    from fepost.sweep.engine import ALLOWED_FAILURES
+
     with (
+        dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES}),
         distributed.LocalCluster(
             n_workers=2,
             threads_per_worker=1,
@@ -380,3 +385,32 @@ def test_report_section_in_process(load_sweep, tmp_path):
     rows = read_table(tmp_path / "sweep" / "coefficients.parquet")
     assert [r["source"] for r in rows] == [str(f) for f in sorted(d.glob("*_static.vtu"))]
     assert all(r["status"] == "ok" for r in rows)
+
+
+def _crash_on(path: str) -> None:
+    """Worker-side: make the analysis of ``path`` kill the worker process (as a reader crash would)."""
+    import fepost.analysis
+
+    real = fepost.analysis.analyse
+
+    def analyse(static, *args, **kwargs):
+        if str(static) == path:
+            os._exit(1)
+        return real(static, *args, **kwargs)
+
+    fepost.analysis.analyse = analyse
+
+
+def test_worker_crash_is_an_error_row(cluster, tmp_path):
+    """A file that kills its worker process fails its own row; the sweep itself goes on.
+
+    Runs last in this module: the two workers are restarted by their nannies.
+    """
+    f = hertz(tmp_path / "crash.vtu", 1e4)
+    cluster.run(_crash_on, str(f))
+    res = run_sweep([str(f)], tmp_path / "out", client=cluster, trends=False)
+    assert [r["status"] for r in res.rows] == ["error"]
+    assert (
+        res.rows[0]["error"] == f"{f}: the worker process died while analysing it (a crash, or out of memory)"
+    )
+    cluster.wait_for_workers(2, timeout=60)

@@ -19,6 +19,12 @@ from ..errors import ArgumentError, ClusterError
 
 #: Seconds to wait for a scheduler to answer and for its first worker.
 CONNECT_TIMEOUT = 30.0
+#: Times a task is retried after its worker died before it fails (the embedded cluster's setting).
+ALLOWED_FAILURES = 1
+
+
+class WorkerDied(RuntimeError):
+    """The worker process running a task died (a crash in a reader, or out of memory)."""
 
 
 def default_workers() -> int:
@@ -72,7 +78,7 @@ class Cluster:
         from distributed import Client, LocalCluster
 
         # a file that crashes its worker fails its row after one retry, not after killing four workers
-        with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+        with dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES}):
             self._cluster = LocalCluster(
                 n_workers=self.workers,
                 threads_per_worker=1,
@@ -125,8 +131,8 @@ class Cluster:
         """(future, result or exception) pairs as they finish.
 
         A worker that died while running a task (a crash in a reader, out of
-        memory) gives that task a :class:`RuntimeError` naming it; a cancelled
-        task (the scheduler went away) raises :class:`ClusterError`.
+        memory) gives that task a :class:`WorkerDied`; a cancelled task (the
+        scheduler went away) raises :class:`ClusterError`.
         """
         from concurrent.futures import CancelledError
 
@@ -136,7 +142,10 @@ class Cluster:
             try:
                 yield fut, fut.result()
             except KilledWorker:
-                yield fut, RuntimeError("the worker process died while analysing it (crash or out of memory)")
+                yield (
+                    fut,
+                    WorkerDied("the worker process died while analysing it (a crash, or out of memory)"),
+                )
             except CancelledError:
                 raise ClusterError(
                     "the Dask scheduler cancelled the sweep's tasks (was it shut down?)"

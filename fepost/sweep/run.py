@@ -27,7 +27,7 @@ from pathlib import Path
 from types import MappingProxyType
 
 from ..errors import ArgumentError
-from .engine import Cluster
+from .engine import Cluster, WorkerDied
 from .inputs import expand_inputs
 from .jobs import Job, run_job
 from .options import RowOptions
@@ -266,11 +266,8 @@ def _compute(cluster: Cluster, jobs, keys, todo, rows, work: WorkFolder, bar: Pr
             i = where[fut]
             if isinstance(res, BaseException):
                 job = jobs[i]
-                res = {
-                    **job.base_row(),
-                    "status": "error",
-                    "error": one_line(f"{job.path}: {type(res).__name__}: {res}"),
-                }
+                why = str(res) if isinstance(res, WorkerDied) else f"{type(res).__name__}: {res}"
+                res = {**job.base_row(), "status": "error", "error": one_line(f"{job.path}: {why}")}
             rows[i] = res
             work.save_row(keys[i], res)
             bar.update(res["status"] == "ok")
