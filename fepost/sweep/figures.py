@@ -33,6 +33,7 @@ def _values(rows: Sequence[Mapping], key: str) -> np.ndarray:
 def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
     """Panels of R, M0, aR², m/R² and k_x against N (log-log), with fits and 95 % bands."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
 
     from ..figures.theme import mpl_style
 
@@ -59,15 +60,20 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
                         "-",
                         color=colour,
                         lw=1.2,
-                        label=f"N^{fit.exponent:.3f} [{lo_a:.3f}, {hi_a:.3f}]",
+                        label=rf"$\propto N^{{{fit.exponent:.3f}}}$, 95 %: [{lo_a:.3f}, {hi_a:.3f}]",
                     )
             finite = _values(rows, q)
             if np.all(finite[np.isfinite(finite)] > 0):
                 ax.set_yscale("log")
             ax.set_xscale("log")
+            for axis in (ax.xaxis, ax.yaxis) if ax.get_yscale() == "log" else (ax.xaxis,):
+                # ticks at 1, 2, 5 × 10^k, plainly labelled: a sweep rarely spans a decade
+                axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+                axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+                axis.set_minor_locator(NullLocator())
             ax.set_xlabel("N (N)")
             ax.set_ylabel(f"{label} ({unit})")
-            title = label if hertz is None else f"{label}   (Hertz: N^{hertz:.3g})"
+            title = label if hertz is None else rf"{label}   (Hertz: $N^{{{hertz:.3g}}}$)"
             ax.set_title(title, fontsize=10)
             if ax.get_legend_handles_labels()[0]:
                 ax.legend(loc="best")
