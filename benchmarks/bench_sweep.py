@@ -5,23 +5,28 @@
 Inputs: ``--files`` copies (hard links) of one Hertz map of ~200 000 nodes
 (``--rings 166``), written as VTU into a temporary folder.
 
-Measured, each ``--repeats`` times, interleaved (so a busy neighbour slows all
-of them alike), medians printed:
+Measured ``--repeats`` times, interleaved (a busy neighbour slows all of them
+alike), medians printed, wall time and CPU time (user + system of every
+process doing the work: this one, and the worker processes):
 
 1. **in-process**: ``fepost coefficients FILE --json PATH`` through
    ``fepost.cli.main`` for every file, one after the other, in this process
-   (imports done beforehand);
-2. **sweep, 1 worker** and **sweep, 2 workers**: :func:`fepost.sweep.run_sweep`
-   of all files into a fresh folder (table and trends page) on an embedded
-   ``LocalCluster`` that is already running and has imported fepost: the
-   per-file cost. The one-off start and stop of the cluster is timed apart,
-   and so is a whole ``fepost sweep --workers 2`` including both;
+   (imports and a first call done beforehand);
+2. **sweep, 1 worker** and **sweep, 2 workers**:
+   :func:`fepost.sweep.run_sweep` of all files into a fresh folder (table and
+   trends page) on an embedded ``LocalCluster`` that is already running and
+   warm: the per-file cost. Starting and stopping a cluster is timed apart,
+   and a whole ``run_sweep(..., workers=2)`` including both is timed too;
 3. **external cluster**: ``dask scheduler`` and ``dask worker --nworkers 2
-   --nthreads 1`` started by this script as separate processes, the sweep run
-   with ``scheduler=ADDRESS``, the processes stopped at the end.
+   --nthreads 1`` started by this script as separate processes (on this
+   machine), the sweep run with ``scheduler=ADDRESS``, the processes stopped
+   at the end.
 
 Targets: sweep on 1 worker / in-process < 1.2 (per-file overhead);
-1-worker time / 2-worker time >= 1.7 (throughput on 2 local workers).
+1-worker time / 2-worker time >= 1.7 (throughput on 2 local workers). On a
+machine shared with other work, wall times swing with the neighbours' load
+while CPU times do not: the CPU ratio is the overhead the sweep adds; the wall
+ratios need a quiet machine.
 """
 
 from __future__ import annotations
@@ -29,6 +34,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import json
 import logging
 import os
 import shutil
@@ -38,6 +44,50 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+import psutil  # a dependency of dask.distributed
+
+
+def cpu_seconds(pids) -> float:
+    """User + system CPU seconds of the processes ``pids`` and their live descendants."""
+    total = 0.0
+    seen = set()
+    for pid in pids:
+        try:
+            root = psutil.Process(pid)
+            procs = [root, *root.children(recursive=True)]
+        except psutil.NoSuchProcess:
+            continue
+        for p in procs:
+            if p.pid in seen:
+                continue
+            seen.add(p.pid)
+            with contextlib.suppress(psutil.NoSuchProcess):
+                t = p.cpu_times()
+                total += t.user + t.system
+    return total
+
+
+class Timer:
+    """Wall and CPU seconds of a block; CPU of ``pids`` (default: this process alone)."""
+
+    def __init__(self, pids=None, own_only: bool = False):
+        self.pids = pids
+        self.own_only = own_only
+
+    def _cpu(self) -> float:
+        if self.own_only:
+            t = psutil.Process().cpu_times()
+            return t.user + t.system
+        return cpu_seconds(self.pids)
+
+    def __enter__(self):
+        self.cpu0, self.t0 = self._cpu(), time.perf_counter()
+        return self
+
+    def __exit__(self, *exc):
+        self.wall = time.perf_counter() - self.t0
+        self.cpu = self._cpu() - self.cpu0
 
 
 def make_inputs(folder: Path, files: int, rings: int) -> list[Path]:
@@ -52,37 +102,52 @@ def make_inputs(folder: Path, files: int, rings: int) -> list[Path]:
     return paths
 
 
-def in_process(paths: list[Path], scratch: Path) -> float:
+def in_process(paths: list[Path], scratch: Path) -> Timer:
     from fepost.cli import main
 
-    t = time.perf_counter()
-    with contextlib.redirect_stdout(io.StringIO()):
+    with Timer(own_only=True) as t, contextlib.redirect_stdout(io.StringIO()):
         for p in paths:
             assert main(["coefficients", str(p), "--json", str(scratch / "one.json")]) == 0
-    return time.perf_counter() - t
+    return t
 
 
-def sweep(paths: list[Path], out: Path, **kw) -> float:
+def sweep(paths: list[Path], out: Path, pids=None, **kw) -> Timer:
     from fepost.sweep import run_sweep
 
     shutil.rmtree(out, ignore_errors=True)
-    t = time.perf_counter()
-    res = run_sweep([str(p) for p in paths], out, progress=False, **kw)
-    elapsed = time.perf_counter() - t
+    with Timer(pids or [os.getpid()]) as t:
+        res = run_sweep([str(p) for p in paths], out, progress=False, **kw)
     assert res.ok and res.computed == len(paths), res.to_dict()
-    return elapsed
+    return t
 
 
-def local_cluster(n: int):
+def whole_command(paths: list[Path], out: Path, workers: int) -> Timer:
+    """``run_sweep(workers=N)``: cluster start, sweep, stop. CPU: this process and its waited children."""
+    from fepost.sweep import run_sweep
+
+    shutil.rmtree(out, ignore_errors=True)
+    t0, w0 = os.times(), time.perf_counter()
+    res = run_sweep([str(p) for p in paths], out, progress=False, workers=workers)
+    t1 = os.times()
+    assert res.ok and res.computed == len(paths), res.to_dict()
+    t = Timer()
+    t.wall = time.perf_counter() - w0
+    t.cpu = sum(t1[:4]) - sum(t0[:4])  # user, system, children's user and system
+    return t
+
+
+def local_cluster(n: int, warm: list[Path], scratch: Path):
     from distributed import Client, LocalCluster
 
-    t = time.perf_counter()
+    w0 = time.perf_counter()
     cluster = LocalCluster(
         n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
     )
     client = Client(cluster)
-    client.run(__import__, "fepost.analysis")
-    return cluster, client, time.perf_counter() - t
+    start = time.perf_counter() - w0
+    pids = [os.getpid(), *client.run(os.getpid).values()]
+    sweep(warm[:n], scratch, pids, client=client)  # imports and first calls in every worker
+    return cluster, client, pids, start
 
 
 @contextlib.contextmanager
@@ -91,55 +156,22 @@ def external_cluster(folder: Path, workers: int):
     dask = str(Path(sys.executable).with_name("dask"))
     sched_file = folder / "scheduler.json"
     log = open(folder / "cluster.log", "w")  # noqa: SIM115  # closed below
-    procs = [
-        subprocess.Popen(
-            [
-                dask,
-                "scheduler",
-                "--host",
-                "127.0.0.1",
-                "--port",
-                "0",
-                "--no-dashboard",
-                "--scheduler-file",
-                str(sched_file),
-            ],
-            stdout=log,
-            stderr=subprocess.STDOUT,
-        )
-    ]
+    scheduler = [dask, "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"]
+    worker = [dask, "worker", "--nworkers", str(workers), "--nthreads", "1", "--no-dashboard"]
+    procs = [subprocess.Popen([*scheduler, "--scheduler-file", str(sched_file)], stdout=log, stderr=log)]
     try:
         deadline = time.monotonic() + 60
         while not sched_file.is_file():
             if time.monotonic() > deadline or procs[0].poll() is not None:
                 raise RuntimeError(f"dask scheduler did not start; see {folder / 'cluster.log'}")
             time.sleep(0.1)
-        procs.append(
-            subprocess.Popen(
-                [
-                    dask,
-                    "worker",
-                    "--scheduler-file",
-                    str(sched_file),
-                    "--nworkers",
-                    str(workers),
-                    "--nthreads",
-                    "1",
-                    "--no-dashboard",
-                ],
-                stdout=log,
-                stderr=subprocess.STDOUT,
-            )
-        )
-        import json
-
+        procs.append(subprocess.Popen([*worker, "--scheduler-file", str(sched_file)], stdout=log, stderr=log))
         from distributed import Client
 
         address = json.loads(sched_file.read_text())["address"]
         with Client(address) as client:
             client.wait_for_workers(workers, timeout=120)
-            client.run(__import__, "fepost.analysis")
-        yield address
+        yield address, [os.getpid()] + [p.pid for p in procs]
     finally:
         for p in reversed(procs):
             p.terminate()
@@ -152,72 +184,85 @@ def external_cluster(folder: Path, workers: int):
         log.close()
 
 
+def median_row(name: str, runs: list[Timer], n: int) -> str:
+    wall = statistics.median(t.wall for t in runs)
+    cpu = statistics.median(t.cpu for t in runs)
+    each = " ".join(f"{t.wall:.1f}" for t in runs)
+    return f"{name:36s}{wall:9.2f}{wall / n:9.3f}{cpu:9.2f}{cpu / n:9.3f}   {each}"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--files", type=int, default=32)
     ap.add_argument("--rings", type=int, default=166, help="rings of the disc mesh (166: ~200 000 nodes)")
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args()
+    logging.getLogger("distributed").setLevel(logging.ERROR)  # closing clusters log at INFO
 
-    with tempfile.TemporaryDirectory(prefix="bench_sweep.") as tmp:
-        tmp = Path(tmp)
+    with tempfile.TemporaryDirectory(prefix="bench_sweep.") as tmp_name:
+        tmp = Path(tmp_name)
         inputs = tmp / "inputs"
         inputs.mkdir()
         paths = make_inputs(inputs, args.files, args.rings)
+        n = len(paths)
         from fepost.reader import read_contact
 
         nodes = read_contact(paths[0]).n_points
-        load = os.getloadavg()[0]
-        print(f"{len(paths)} files of {nodes} nodes; {os.cpu_count()} CPUs; load average {load:.1f}")
+        load0 = os.getloadavg()[0]
         in_process(paths[:1], tmp)  # imports and first-call set-up outside the timing
 
-        c1, cl1, start1 = local_cluster(1)
-        c2, cl2, start2 = local_cluster(2)
-        times: dict[str, list[float]] = {"in-process": [], "sweep, 1 worker": [], "sweep, 2 workers": []}
+        c1, cl1, pids1, start1 = local_cluster(1, paths, tmp / "warm1")
+        c2, cl2, pids2, start2 = local_cluster(2, paths, tmp / "warm2")
+        runs: dict[str, list[Timer]] = {"in-process": [], "sweep, 1 worker": [], "sweep, 2 workers": []}
         try:
             for r in range(args.repeats):
-                times["in-process"].append(in_process(paths, tmp))
-                times["sweep, 1 worker"].append(sweep(paths, tmp / f"s1-{r}", client=cl1))
-                times["sweep, 2 workers"].append(sweep(paths, tmp / f"s2-{r}", client=cl2))
+                runs["in-process"].append(in_process(paths, tmp))
+                runs["sweep, 1 worker"].append(sweep(paths, tmp / f"s1-{r}", pids1, client=cl1))
+                runs["sweep, 2 workers"].append(sweep(paths, tmp / f"s2-{r}", pids2, client=cl2))
         finally:
-            t = time.perf_counter()
+            w0 = time.perf_counter()
             cl1.close()
             c1.close()
-            stop1 = time.perf_counter() - t
+            stop1 = time.perf_counter() - w0
             cl2.close()
             c2.close()
-        whole = [sweep(paths, tmp / f"w-{r}", workers=2) for r in range(args.repeats)]
-        with external_cluster(tmp, 2) as address:
-            ext = [sweep(paths, tmp / f"x-{r}", scheduler=address) for r in range(args.repeats)]
+        runs["run_sweep(workers=2), whole"] = [
+            whole_command(paths, tmp / f"w-{r}", 2) for r in range(args.repeats)
+        ]
+        with external_cluster(tmp, 2) as (address, pids):
+            sweep(paths[:2], tmp / "xwarm", pids, scheduler=address)
+            runs["external dask cluster, 2 workers"] = [
+                sweep(paths, tmp / f"x-{r}", pids, scheduler=address) for r in range(args.repeats)
+            ]
 
-        med = {k: statistics.median(v) for k, v in times.items()}
-        n = len(paths)
-        print(f"\nmedians of {args.repeats} runs (interleaved); the machine is shared, so compare ratios")
-        print(f"{'':34s}{'total s':>10s}{'per file s':>12s}   runs")
-        for k, v in times.items():
-            print(f"{k:34s}{med[k]:10.2f}{med[k] / n:12.3f}   " + " ".join(f"{x:.2f}" for x in v))
+        med = {k: statistics.median(t.wall for t in v) for k, v in runs.items()}
+        cpu = {k: statistics.median(t.cpu for t in v) for k, v in runs.items()}
+        load1 = os.getloadavg()[0]
+        cpus = os.cpu_count()
+        print(f"{n} files of {nodes} nodes; {cpus} CPUs; load average {load0:.1f} before, {load1:.1f} after")
+        print(f"medians of {args.repeats} interleaved runs; wall times swing with the machine's other load\n")
+        print(f"{'':36s}{'wall s':>9s}{'/file':>9s}{'CPU s':>9s}{'/file':>9s}   wall of each run")
+        for k, v in runs.items():
+            print(median_row(k, v, n))
         print(
-            f"{'fepost sweep --workers 2 (whole)':34s}{statistics.median(whole):10.2f}"
-            f"{statistics.median(whole) / n:12.3f}   " + " ".join(f"{x:.2f}" for x in whole)
+            f"\nembedded cluster start: 1 worker {start1:.2f} s, 2 workers {start2:.2f} s; "
+            f"stop {stop1:.2f} s (worker imports come with the first rows)"
+        )
+        one, base = "sweep, 1 worker", "in-process"
+        print(
+            f"per-file overhead, sweep on 1 worker / in-process: wall {med[one] / med[base]:.3f}, "
+            f"CPU {cpu[one] / cpu[base]:.3f}  (target < 1.2)"
         )
         print(
-            f"{'external dask cluster, 2 workers':34s}{statistics.median(ext):10.2f}"
-            f"{statistics.median(ext) / n:12.3f}   " + " ".join(f"{x:.2f}" for x in ext)
+            f"throughput, 2 local workers / 1 worker:            wall "
+            f"{med['sweep, 1 worker'] / med['sweep, 2 workers']:.3f}  (target >= 1.7)"
         )
+        ext = "external dask cluster, 2 workers"
         print(
-            f"\nembedded cluster start (incl. worker imports): 1 worker {start1:.2f} s, "
-            f"2 workers {start2:.2f} s; stop {stop1:.2f} s"
+            f"throughput, external 2-worker cluster / 1 worker:  wall {med['sweep, 1 worker'] / med[ext]:.3f}"
         )
-        over = med["sweep, 1 worker"] / med["in-process"]
-        speed = med["sweep, 1 worker"] / med["sweep, 2 workers"]
-        ext_speed = med["sweep, 1 worker"] / statistics.median(ext)
-        print(f"per-file overhead, sweep on 1 worker / in-process: {over:.3f}  (target < 1.2)")
-        print(f"throughput, 2 local workers / 1 worker:            {speed:.3f}  (target >= 1.7)")
-        print(f"throughput, external 2-worker cluster / 1 worker:  {ext_speed:.3f}")
-        print(
-            f"whole command incl. cluster start and stop / in-process: "
-            f"{statistics.median(whole) / med['in-process']:.3f}"
-        )
+        whole = "run_sweep(workers=2), whole"
+        print(f"whole sweep incl. cluster start and stop / in-process: wall {med[whole] / med[base]:.3f}")
 
 
 if __name__ == "__main__":

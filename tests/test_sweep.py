@@ -414,3 +414,43 @@ def test_worker_crash_is_an_error_row(cluster, tmp_path):
         res.rows[0]["error"] == f"{f}: the worker process died while analysing it (a crash, or out of memory)"
     )
     cluster.wait_for_workers(2, timeout=60)
+
+
+def test_ctrl_c_stops_cleanly(tmp_path):
+    """Ctrl-C (SIGINT to the whole process group, as a terminal sends it) on the embedded cluster.
+
+    The client stops with exit status 130 and a one-line hint, the finished rows
+    stay saved, no table is written, the workers print no traceback and no
+    process is left behind.
+    """
+    d = tmp_path / "runs"
+    d.mkdir()
+    for i in range(12):
+        hertz(d / f"r{i:02d}.vtu", 1e4 * (1 + i), n_rings=30)
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "fepost", "sweep", str(d), "--out", str(out), "--workers", "1"]
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True
+    )
+    rows_dir = out / WORK / "rows"
+    deadline = time.monotonic() + 90
+    try:
+        while not (rows_dir.is_dir() and any(rows_dir.glob("*.json"))):
+            assert proc.poll() is None, proc.communicate()[1]
+            assert time.monotonic() < deadline, "no row finished within 90 s"
+            time.sleep(0.005)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=90)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 130
+    hint = f"fepost: interrupted; the rows finished so far are kept in {out}: run the same command again"
+    assert err.strip().splitlines() == [hint + " to resume"]
+    assert 1 <= len(list(rows_dir.glob("*.json"))) < 12
+    assert not (out / "coefficients.csv").exists()
+    deadline = time.monotonic() + 20  # the workers and multiprocessing's resource tracker wind down
+    while left := subprocess.run(["pgrep", "-a", "-g", str(proc.pid)], capture_output=True, text=True).stdout:
+        assert time.monotonic() < deadline, f"processes left in the group: {left}"
+        time.sleep(0.1)

@@ -85,6 +85,8 @@ class Cluster:
                 processes=self._processes,
                 dashboard_address=":0",  # any free port: 8787 may be another cluster's
                 silence_logs=logging.ERROR,
+                # workers ignore Ctrl-C: the client stops the sweep and then the workers
+                preload=["fepost.sweep.worker"] if self._processes else [],
             )
             return Client(self._cluster)
 
