@@ -244,3 +244,38 @@ def test_progress_bar_draws_only_when_asked():
     bar.update(True)
     bar.close()
     assert quiet.getvalue() == ""
+
+
+def test_row_options_follow_the_single_file_kwargs():
+    """Every keyword the single-file commands pass to ``analyse`` reaches the rows, new ones included."""
+    from fepost.polar import PolarGrid
+
+    kwargs = {
+        "field": "CPRESS:0",
+        "step": 4,  # the sweep's own business
+        "displacement": None,
+        "grid": PolarGrid.make(16, 32, "trapezoid"),
+        "threshold": 1e-4,
+        "rolling_axis": (0.0, 1.0, 0.0),
+        "units": "mm-N-MPa",  # a reading option the sweep does not know by name
+    }
+    o = RowOptions.from_analysis_kwargs(kwargs, friction=0.4)
+    got = o.analyse_kwargs()
+    assert got.pop("grid").shape == (16, 32)
+    assert got == {
+        "friction": 0.4,
+        "field": "CPRESS:0",
+        "displacement": None,
+        "threshold": 1e-4,
+        "rolling_axis": (0.0, 1.0, 0.0),
+        "units": "mm-N-MPa",
+    }
+    assert o.to_dict()["extra"] == {"units": "mm-N-MPa"}
+    assert (
+        Job("a", "/a", None, o).key()
+        != Job(
+            "a", "/a", None, RowOptions.from_analysis_kwargs({**kwargs, "units": "SI"}, friction=0.4)
+        ).key()
+    )
+    with pytest.raises(ArgumentError, match="set through its own field"):
+        RowOptions(extra=(("friction", 1.0),))

@@ -16,6 +16,7 @@ import os
 import time
 import warnings
 from dataclasses import dataclass
+from functools import partial
 
 from ..errors import FepostError, FepostWarning
 from .metadata import case_metadata, sidecar_path
@@ -91,6 +92,11 @@ class Job:
         }
 
 
+def _count_steps(path: str) -> int | None:
+    listed = time_steps(path)
+    return len(listed) if listed else None
+
+
 def run_job(job: Job) -> dict:
     """Analyse one row (on a worker); never raises for a bad input.
 
@@ -103,27 +109,25 @@ def run_job(job: Job) -> dict:
     from ..analysis import analyse
 
     row = job.base_row()
-    if job.error is not None:
-        return {**row, "status": "error", "error": one_line(job.error)}
+    if job.error is not None or job.path is None:
+        return {**row, "status": "error", "error": one_line(job.error or f"{job.source}: no file")}
+    path = job.path
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FepostWarning)
         try:
-            res = analyse(job.path, job.rolling, step=job.step, **job.options.analyse_kwargs())
+            res = analyse(path, job.rolling, step=job.step, **job.options.analyse_kwargs())
             step = res.static_field.step
-            n_steps = job.n_steps
-            if n_steps is None and step is not None:
-                listed = time_steps(job.path)  # type: ignore[arg-type]
-                n_steps = len(listed) if listed else None
-            meta = case_metadata(job.path, step, n_steps)  # type: ignore[arg-type]
+            n_steps = job.n_steps if job.n_steps is not None else partial(_count_steps, path)
+            meta = case_metadata(path, step, n_steps)
             row.update(step=step, time=res.static_field.time, **coefficient_columns(res.to_dict()), **meta)
             row["status"], row["error"] = "ok", ""
         except FepostError as exc:
             row["status"], row["error"] = "error", one_line(str(exc))
         except MemoryError:
-            row["status"], row["error"] = "error", one_line(f"{job.path}: out of memory")
+            row["status"], row["error"] = "error", one_line(f"{path}: out of memory")
         except Exception as exc:  # a bug must not stop the other rows; its type is kept
-            row["status"], row["error"] = "error", one_line(f"{job.path}: {type(exc).__name__}: {exc}")
+            row["status"], row["error"] = "error", one_line(f"{path}: {type(exc).__name__}: {exc}")
     row["warnings"] = " | ".join(
         one_line(str(w.message)) for w in caught if issubclass(w.category, FepostWarning)
     )

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 from ..errors import InputFileError
@@ -67,11 +68,11 @@ def _number(side: Path, key: str, value) -> float:
     return float(value)
 
 
-def case_metadata(path: str | Path, step: int | None, n_steps: int | None) -> dict:
+def case_metadata(path: str | Path, step: int | None, n_steps: int | None | Callable[[], int | None]) -> dict:
     """The metadata columns of one row: file ``path`` at time ``step`` of ``n_steps``.
 
     Missing keys (or no sidecar) give None. ``step`` and ``n_steps`` matter only
-    for per-step lists.
+    for per-step lists; ``n_steps`` may be a function, called only then.
 
     Raises
     ------
@@ -92,6 +93,8 @@ def case_metadata(path: str | Path, step: int | None, n_steps: int | None) -> di
             continue
         value = data[key]
         if isinstance(value, list):
+            if callable(n_steps):
+                n_steps = n_steps()
             if n_steps is None or len(value) != n_steps or step is None:
                 raise InputFileError(
                     f"{side}: {key!r} lists {len(value)} values but {path} has {n_steps or 'no'} time steps"

@@ -9,7 +9,8 @@ not reused by a later run).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
+from typing import Any
 
 from ..errors import ArgumentError
 from ..patch import DEFAULT_THRESHOLD
@@ -36,6 +37,10 @@ class RowOptions:
         Radial quadrature rule, ``"gauss"`` or ``"trapezoid"``.
     rolling_axis : tuple of 3 floats or None
         Global rolling direction (default global x).
+    extra : tuple of (name, value) pairs
+        Any other keyword argument of ``analyse`` (reading options added to
+        the single-file commands later reach every row through here). Values
+        must be plain (str, number, bool, None, or tuples of them).
     """
 
     friction: float = 0.3
@@ -46,6 +51,7 @@ class RowOptions:
     nphi: int = DEFAULT_NPHI
     rule: str = "gauss"
     rolling_axis: tuple[float, float, float] | None = None
+    extra: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self) -> None:
         f = self.friction
@@ -54,6 +60,10 @@ class RowOptions:
         if self.rolling_axis is not None:
             object.__setattr__(self, "rolling_axis", tuple(float(v) for v in self.rolling_axis))
         PolarGrid.make(self.nr, self.nphi, self.rule)  # type: ignore[arg-type]  # raises on a bad grid
+        object.__setattr__(self, "extra", tuple(sorted((str(k), v) for k, v in dict(self.extra).items())))
+        clash = [k for k, _ in self.extra if k in _NAMED or k in ("step", "grid")]
+        if clash:
+            raise ArgumentError(f"extra analysis option {clash[0]!r} is set through its own field")
 
     @classmethod
     def from_analysis_kwargs(cls, kwargs: dict, friction: float = 0.3) -> RowOptions:
@@ -64,6 +74,7 @@ class RowOptions:
         """
         grid = kwargs.get("grid") or PolarGrid.make()
         axis = kwargs.get("rolling_axis")
+        known = {"field", "displacement", "threshold", "grid", "rolling_axis", "step", "friction"}
         return cls(
             friction=friction,
             field=kwargs.get("field"),
@@ -73,6 +84,7 @@ class RowOptions:
             nphi=int(grid.shape[1]),
             rule=str(grid.rule),
             rolling_axis=None if axis is None else tuple(axis),
+            extra=tuple((k, v) for k, v in kwargs.items() if k not in known),
         )
 
     def analyse_kwargs(self) -> dict:
@@ -84,9 +96,16 @@ class RowOptions:
             "grid": PolarGrid.make(self.nr, self.nphi, self.rule),  # type: ignore[arg-type]
             "threshold": self.threshold,
             "rolling_axis": self.rolling_axis,
+            **dict(self.extra),
         }
 
     def to_dict(self) -> dict:
         d = asdict(self)
         d["rolling_axis"] = None if self.rolling_axis is None else list(self.rolling_axis)
+        d["extra"] = {
+            k: v if isinstance(v, str | int | float | bool | None) else repr(v) for k, v in self.extra
+        }
         return d
+
+
+_NAMED = tuple(f.name for f in fields(RowOptions) if f.name != "extra")
