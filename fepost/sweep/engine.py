@@ -84,7 +84,7 @@ class Cluster:
                 threads_per_worker=1,
                 processes=self._processes,
                 dashboard_address=":0",  # any free port: 8787 may be another cluster's
-                silence_logs=logging.ERROR,
+                silence_logs=logging.CRITICAL,  # a row's failure is in its row; shutdown races are noise
                 # workers ignore Ctrl-C: the client stops the sweep and then the workers
                 preload=["fepost.sweep.worker"] if self._processes else [],
             )
