@@ -186,9 +186,10 @@ def external_cluster(folder: Path, workers: int):
 
 def median_row(name: str, runs: list[Timer], n: int) -> str:
     wall = statistics.median(t.wall for t in runs)
+    best = min(t.wall for t in runs)
     cpu = statistics.median(t.cpu for t in runs)
     each = " ".join(f"{t.wall:.1f}" for t in runs)
-    return f"{name:36s}{wall:9.2f}{wall / n:9.3f}{cpu:9.2f}{cpu / n:9.3f}   {each}"
+    return f"{name:36s}{wall:9.2f}{best:9.2f}{wall / n:9.3f}{cpu:9.2f}{cpu / n:9.3f}   {each}"
 
 
 def main() -> None:
@@ -241,7 +242,7 @@ def main() -> None:
         cpus = os.cpu_count()
         print(f"{n} files of {nodes} nodes; {cpus} CPUs; load average {load0:.1f} before, {load1:.1f} after")
         print(f"medians of {args.repeats} interleaved runs; wall times swing with the machine's other load\n")
-        print(f"{'':36s}{'wall s':>9s}{'/file':>9s}{'CPU s':>9s}{'/file':>9s}   wall of each run")
+        print(f"{'':36s}{'wall s':>9s}{'best':>9s}{'/file':>9s}{'CPU s':>9s}{'/file':>9s}   wall of each run")
         for k, v in runs.items():
             print(median_row(k, v, n))
         print(
@@ -253,9 +254,11 @@ def main() -> None:
             f"per-file overhead, sweep on 1 worker / in-process: wall {med[one] / med[base]:.3f}, "
             f"CPU {cpu[one] / cpu[base]:.3f}  (target < 1.2)"
         )
+        best = {k: min(t.wall for t in v) for k, v in runs.items()}
+        two = "sweep, 2 workers"
         print(
-            f"throughput, 2 local workers / 1 worker:            wall "
-            f"{med['sweep, 1 worker'] / med['sweep, 2 workers']:.3f}  (target >= 1.7)"
+            f"throughput, 2 local workers / 1 worker:            wall {med[one] / med[two]:.3f}, "
+            f"best of each {best[one] / best[two]:.3f}  (target >= 1.7)"
         )
         ext = "external dask cluster, 2 workers"
         print(
