@@ -277,5 +277,7 @@ def test_row_options_follow_the_single_file_kwargs():
             "a", "/a", None, RowOptions.from_analysis_kwargs({**kwargs, "units": "SI"}, friction=0.4)
         ).key()
     )
+    # an option left at None (its default) keys the same row as an option not given
+    assert RowOptions(extra=(("surface", None),)).key_dict() == RowOptions().key_dict()
     with pytest.raises(ArgumentError, match="set through its own field"):
         RowOptions(extra=(("friction", 1.0),))

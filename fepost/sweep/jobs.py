@@ -75,7 +75,7 @@ class Job:
             self.path or self.source,
             self.step,
             self.rolling,
-            self.options.to_dict(),
+            self.options.key_dict(),
             _stamp(self.path),
             _stamp(self.rolling),
             _stamp(None if self.path is None else str(sidecar_path(self.path))),

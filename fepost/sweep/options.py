@@ -107,5 +107,13 @@ class RowOptions:
         }
         return d
 
+    def key_dict(self) -> dict:
+        """:meth:`to_dict` for a row's identity: an extra option left at None (the analysis
+        default) gives the same row as one not given, so a sweep started from Python and
+        resumed from the command line reuses its rows."""
+        d = self.to_dict()
+        d["extra"] = {k: v for k, v in d["extra"].items() if v is not None}
+        return d
+
 
 _NAMED = tuple(f.name for f in fields(RowOptions) if f.name != "extra")
