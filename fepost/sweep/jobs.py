@@ -92,8 +92,8 @@ class Job:
         }
 
 
-def _count_steps(path: str) -> int | None:
-    listed = time_steps(path)
+def _count_steps(path: str, units: str | None) -> int | None:
+    listed = time_steps(path, units)
     return len(listed) if listed else None
 
 
@@ -118,7 +118,9 @@ def run_job(job: Job) -> dict:
         try:
             res = analyse(path, job.rolling, step=job.step, **job.options.analyse_kwargs())
             step = res.static_field.step
-            n_steps = job.n_steps if job.n_steps is not None else partial(_count_steps, path)
+            n_steps = (
+                job.n_steps if job.n_steps is not None else partial(_count_steps, path, job.options.units)
+            )
             meta = case_metadata(path, step, n_steps)
             row.update(step=step, time=res.static_field.time, **coefficient_columns(res.to_dict()), **meta)
             row["status"], row["error"] = "ok", ""

@@ -87,6 +87,12 @@ class RowOptions:
             extra=tuple((k, v) for k, v in kwargs.items() if k not in known),
         )
 
+    @property
+    def units(self) -> str | None:
+        """The model's unit system among the reading options (it scales the time values), if set."""
+        value = dict(self.extra).get("units")
+        return None if value is None else str(value)
+
     def analyse_kwargs(self) -> dict:
         """The keyword arguments of :func:`fepost.analysis.analyse` (without ``step``)."""
         return {

@@ -23,6 +23,7 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
 from types import MappingProxyType
 
@@ -86,12 +87,12 @@ class SweepResult:
         }
 
 
-def list_steps_task(path: str) -> dict:
+def list_steps_task(path: str, units: str | None = None) -> dict:
     """Worker task: the time values of ``path`` (``{"times": ...}``) or ``{"error": message}``."""
     from ..errors import FepostError
 
     try:
-        return {"times": time_steps(path)}
+        return {"times": time_steps(path, units)}
     except FepostError as exc:
         return {"error": one_line(str(exc))}
 
@@ -104,7 +105,7 @@ def _check_steps(steps) -> str | int:
     raise ArgumentError(f"--steps must be 'last' or 'all', got {steps!r}")
 
 
-def _listed_steps(pairings: Sequence[Pairing], work: WorkFolder, cluster: Cluster) -> dict:
+def _listed_steps(pairings: Sequence[Pairing], work: WorkFolder, cluster: Cluster, units: str | None) -> dict:
     """{path: times | None | error message} for the Exodus files among ``pairings``."""
     listed: dict[str, object] = {}
     todo = []
@@ -122,7 +123,7 @@ def _listed_steps(pairings: Sequence[Pairing], work: WorkFolder, cluster: Cluste
         else:
             listed[path] = cached
     if todo:
-        futures = cluster.map(list_steps_task, todo, "steps")
+        futures = cluster.map(partial(list_steps_task, units=units), todo, "steps")
         where = dict(zip(futures, todo, strict=True))
         try:
             for fut, res in cluster.as_completed(futures):
@@ -229,7 +230,8 @@ def run_sweep(
     pairings = pair_sources(expand_inputs(inputs), pairs)
     out = Path(out)
     with WorkFolder(out, force=force, fresh=fresh) as work, cluster:
-        listed = _listed_steps(pairings, work, cluster) if steps == "all" else {}
+        units = options.units
+        listed = _listed_steps(pairings, work, cluster, units) if steps == "all" else {}
         jobs = _jobs(pairings, steps, listed, options)
         keys = [j.key() for j in jobs]
         rows: list[dict | None] = [None] * len(jobs)
