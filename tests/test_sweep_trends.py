@@ -129,6 +129,6 @@ def test_section_renders_figures_fits_and_escaped_table(tmp_path):
         assert (tmp_path / "figs" / name).stat().st_size > 1000
     assert "&lt;b&gt;odd name&lt;/b&gt;.vtu" in html and "<b>odd name" not in html
     assert "0.3333" in html  # the R exponent in the fits table
-    # one load, one row: no load figure, no fit, the section still renders
-    one = sweep_section(rows[:1], tmp_path / "one")
-    assert "load_trends" not in one and "1 row " in one
+    # one load, one row: no load figure, no fit, the section still renders; no heading on request
+    one = sweep_section(rows[:1], tmp_path / "one", title=None)
+    assert "load_trends" not in one and "1 row " in one and "<h2>" not in one and "<h3>" in one

@@ -25,7 +25,7 @@ def sweep_report_section(
     href: str = "sweep",
     rolling_pairs: str | None = None,
     heading_level: int = 2,
-    title: str = "Load sweep: coefficients against load",
+    title: str | None = "Load sweep: coefficients against load",
     workers: int = 1,
     processes: bool = False,
     client=None,

@@ -113,7 +113,7 @@ def sweep_section(
     href: str = "",
     *,
     heading_level: int = 2,
-    title: str = "Sweep: coefficients against load",
+    title: str | None = "Sweep: coefficients against load",
 ) -> str:
     """An HTML ``<section>`` with the sweep's figures, power-law fits and table.
 
@@ -129,8 +129,8 @@ def sweep_section(
         prefix, e.g. ``"sweep"``); images are linked as ``href/name.png``.
     heading_level : int
         Level of the section's heading (``2`` → ``<h2>``; sub-headings one below).
-    title : str
-        The section's heading.
+    title : str or None
+        The section's heading; None for none (the page around it gives one).
     """
     rows = [normalise(r) for r in rows]
     fits = load_trends(rows)
