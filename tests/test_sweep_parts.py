@@ -281,3 +281,29 @@ def test_row_options_follow_the_single_file_kwargs():
     assert RowOptions(extra=(("surface", None),)).key_dict() == RowOptions().key_dict()
     with pytest.raises(ArgumentError, match="set through its own field"):
         RowOptions(extra=(("friction", 1.0),))
+
+
+def test_workers_must_run_this_fepost():
+    """A cluster whose workers lack fepost, or run another version, is refused before any row."""
+    from fepost import __version__
+    from fepost.errors import ClusterError
+    from fepost.sweep.engine import Cluster
+
+    class FakeClient:
+        def __init__(self, versions):
+            self.versions = versions
+
+        def get_versions(self, packages):
+            assert packages == ["fepost"]
+            return {"workers": {addr: {"packages": {"fepost": v}} for addr, v in self.versions.items()}}
+
+    Cluster._check_workers(FakeClient({"tcp://a:1": __version__, "tcp://b:1": __version__}))
+    with pytest.raises(ClusterError, match="Dask worker tcp://b:1 cannot import fepost"):
+        Cluster._check_workers(FakeClient({"tcp://a:1": __version__, "tcp://b:1": None}))
+    with pytest.raises(
+        ClusterError, match=f"Dask worker tcp://a:1 runs fepost 0.0.1, this client {__version__}"
+    ):
+        Cluster._check_workers(FakeClient({"tcp://a:1": "0.0.1"}))
+    for bad in (0, -2, 1.5, True):
+        with pytest.raises(ArgumentError, match="--workers must be a positive whole number"):
+            Cluster(workers=bad)
