@@ -83,5 +83,9 @@ class FitWarning(FepostWarning):
     """A fit converged but its uncertainty is poorly determined."""
 
 
+class OptionWarning(FepostWarning):
+    """A command-line option is valid but implausible (e.g. ``--friction 3``)."""
+
+
 class ClusterError(FepostError, RuntimeError):
     """The Dask cluster of a sweep cannot be reached, has no workers or went away."""

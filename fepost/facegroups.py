@@ -92,24 +92,29 @@ def _normals(points: np.ndarray, g: FaceGroup) -> np.ndarray:
 
 
 def drop_edge_faces(
-    groups: list[FaceGroup], points: np.ndarray, hot: np.ndarray, normal: np.ndarray, location: str
+    groups: list[FaceGroup],
+    points: np.ndarray,
+    hot: np.ndarray,
+    normal: np.ndarray,
+    location: str,
+    flat: bool = False,
 ) -> tuple[list[FaceGroup], int]:
     """Remove steep faces that meet the contact only at nodes of flat loaded faces.
 
     ``hot`` marks the nodes loaded above the threshold. For nodal data a steep
     face is dropped when every loaded node of it is a node of a flat loaded
     face; for face data (no nodal values) when it shares two or more corners
-    with flat loaded faces. Returns the groups kept and the count dropped.
+    with flat loaded faces. ``flat``: the loaded nodes lie in the plane (to
+    round-off), so only faces with an unloaded node can be steep and the others
+    are not examined. Returns the groups kept and the count dropped.
     """
     cos_max = np.cos(np.radians(STEEP_DEG))
-    # only faces at the rim of the patch (some node not loaded) can be a side face touching it;
-    # for face data every loaded face is examined
     steep = []
     for g in groups:
         s = np.zeros(len(g.conn), bool)
-        rim = np.flatnonzero(g.partial)
-        if rim.size:
-            s[rim] = np.abs(_normals(points, g.subset(rim)) @ normal) < cos_max
+        look = np.flatnonzero(g.partial) if flat else np.arange(len(g.conn))
+        if look.size:
+            s[look] = np.abs(_normals(points, g.subset(look)) @ normal) < cos_max
         steep.append(s)
     if not any(s.any() for s in steep):
         return groups, 0
@@ -201,6 +206,20 @@ def exact_load(groups: list[FaceGroup], xy: np.ndarray, values: np.ndarray, loca
         vals = values if location == "point" else np.asarray(g.values)
         tot += quadratic.face_moments(g.ftype, xy, g.conn, vals, location).sum(axis=0)
     return tot
+
+
+def folded_faces(groups: list[FaceGroup], xy: np.ndarray) -> int:
+    """How many faces (other than linear triangles) fold over in the plane of ``xy``."""
+    return sum(int(quadratic.folded(g.ftype, xy, g.conn).sum()) for g in groups if g.ftype != "tri3")
+
+
+def next_triangles(groups: list[FaceGroup], level: int) -> int:
+    """Triangles the cut at ``level`` makes of the faces other than linear triangles."""
+    return sum(
+        len(g.conn) * quadratic.triangles_per_face(g.ftype, START_LEVEL[g.ftype] * level)
+        for g in groups
+        if g.ftype != "tri3"
+    )
 
 
 def only_triangles(groups: list[FaceGroup]) -> bool:

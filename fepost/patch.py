@@ -55,12 +55,15 @@ from .facegroups import (
     FaceGroup,
     drop_edge_faces,
     exact_load,
+    folded_faces,
     loaded_groups,
+    next_triangles,
     only_triangles,
     refine,
 )
 from .facesums import FaceSums, face_loads, face_sums, load_outside, triangle_areas
 from .field import ContactField
+from .reader.quadratic import face_surface_loads
 from .reader.units import check_scale
 
 DEFAULT_THRESHOLD = 1e-6
@@ -405,13 +408,8 @@ def _separate_surfaces(fld: ContactField, groups: list[FaceGroup], hot: np.ndarr
         sel = hot[nodes]
         rows.append(fid[sel])
         cols.append(nodes[sel])
-        p = points[g.corners()]
-        if g.corners().shape[1] == 3:
-            area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-        else:
-            area = 0.5 * np.linalg.norm(np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1]), axis=1)
-        val = fld.values[g.corners()].mean(axis=1) if fld.location == "point" else np.asarray(g.values)
-        loads.append(area * np.nan_to_num(val))
+        vals = np.nan_to_num(fld.values if fld.location == "point" else np.asarray(g.values))
+        loads.append(face_surface_loads(g.ftype, points, g.conn, vals, fld.location))
         start += m
     nf = start
     r, c = np.concatenate(rows), np.concatenate(cols)
@@ -484,6 +482,8 @@ def build_patch(
         if np.count_nonzero(w) < 3:
             raise PatchError(f"{src}: the contact patch has fewer than 3 loaded nodes")
         c, normal, var = _plane(pts_sel, w)
+        hz = np.abs(pts_sel @ normal - c @ normal)[w > 0]
+        flat = bool(hz.max() <= 1e-9 * np.sqrt(var[2]))
         if var[1] <= LINE_TOL**2 * var[2]:
             raise DimensionError(
                 f"{src}: the loaded nodes lie on one line: the contact is a line, not a patch "
@@ -495,7 +495,8 @@ def build_patch(
         base = Frame(origin=c, axes=axes)
     else:
         base = frame
-    groups, n_edge = drop_edge_faces(groups, points, hot, base.axes[2], fld.location)
+        flat = False
+    groups, n_edge = drop_edge_faces(groups, points, hot, base.axes[2], fld.location, flat=flat)
     if n_edge:
         notes.append(
             f"{n_edge} loaded face(s) steeper than {STEEP_DEG:g} deg to the patch plane, touching the "
@@ -521,17 +522,30 @@ def build_patch(
 
     level = 1
     exact = None
+    previous = np.inf
+    if not only_triangles(groups):
+        xy_native = points @ base.axes[:2].T - base.origin @ base.axes[:2].T
+        bad = folded_faces(groups, xy_native)
+        if bad:
+            raise PatchError(
+                f"{src}: {bad} loaded element face(s) fold over in the patch plane (repeated or "
+                "crossed corner nodes): corrupt or inverted elements"
+            )
     while True:
         pts, tri, vals, parent = cut(groups, level)
         geo = _geometry(src, pts, tri, vals, fld.location, thr, base)
         if parent is None:
             break
-        xy_native = points @ base.axes[:2].T - base.origin @ base.axes[:2].T
         exact = exact_load(groups, xy_native, v, fld.location)
-        err = geo.sums.N / exact[0] - 1.0
-        finer = sum(len(g.conn) for g in groups) * 4 * (2 * level) ** 2 * 16
-        if abs(err) <= REFINE_TOL or finer > REFINE_MAX_TRIANGLES:
+        err = abs(geo.sums.N / exact[0] - 1.0)
+        # finer until the triangles carry the element load, while that converges (error / 4 per level)
+        if (
+            err <= REFINE_TOL
+            or next_triangles(groups, 2 * level) > REFINE_MAX_TRIANGLES
+            or err > 0.5 * previous
+        ):
             break
+        previous = err
         level *= 2
 
     ncomp, labels = _components(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)

@@ -146,7 +146,7 @@ def test_negative_lobes_of_a_quadratic_face_are_not_a_sign_error():
     contact front inside an element): accepted, kept as the element's field, noted."""
     pts, faces = _hex20_top(n=2, h=0.5)
     x = pts[:, 0]
-    # loaded up to x = 0, zero beyond: along x the right elements' field is p0 ξ(ξ − 1)/2, < 0 on (0.25, 0.5)
+    # loaded up to x = 0, zero beyond: the right elements' field along x is p0 ξ(ξ − 1)/2, < 0 past 0.25
     p = np.where(x <= 1e-9, P0, 0.0)
     fld = ContactField("lobes", pts, np.empty((0, 3)), p, "point", "CPRESS", faces={"quad8": faces})
     patch = build_patch(fld)

@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..errors import ArgumentError
-from ..polar import DEFAULT_NPHI, DEFAULT_NR, PolarGrid
-from ..reader.units import SYSTEMS
+from ..reader.units import SYSTEMS  # a light module: no numpy
+from . import _validate as v
 
 
 def repo_meshes() -> Path:
@@ -25,7 +25,7 @@ def sample_mesh(name: str) -> Path:
 
 def add_friction_option(p: argparse.ArgumentParser, what: str = "friction coefficient f") -> None:
     """``--friction F`` (default 0.3), shared by every command that needs f."""
-    p.add_argument("--friction", type=float, default=0.3, metavar="F", help=f"{what} (default 0.3)")
+    p.add_argument("--friction", type=v.friction, default=0.3, metavar="F", help=f"{what} (default 0.3)")
 
 
 def add_input_options(p: argparse.ArgumentParser) -> None:
@@ -52,15 +52,26 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
         help="take the contact faces from this Exodus side set or element block (name or id)",
     )
     g.add_argument("--rolling-axis", metavar="X,Y,Z", help="global rolling direction (default 1,0,0)")
-    g.add_argument("--threshold", type=float, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
-    g.add_argument("--nr", type=int, default=DEFAULT_NR, help=f"radial grid nodes (default {DEFAULT_NR})")
+    g.add_argument("--threshold", type=v.fraction, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
     g.add_argument(
-        "--nphi", type=int, default=DEFAULT_NPHI, help=f"angular grid nodes (default {DEFAULT_NPHI})"
+        "--nr",
+        type=v.radial_nodes,
+        default=v.LibraryDefault("fepost.polar", "DEFAULT_NR"),
+        help="radial grid nodes (default %(default)s)",
+    )
+    g.add_argument(
+        "--nphi",
+        type=v.angular_nodes,
+        default=v.LibraryDefault("fepost.polar", "DEFAULT_NPHI"),
+        help="angular grid nodes (default %(default)s)",
     )
     g.add_argument("--rule", choices=("gauss", "trapezoid"), default="gauss", help="radial quadrature rule")
 
 
 def analysis_kwargs(args: argparse.Namespace) -> dict:
+    from ..polar import PolarGrid
+    from ..reader.units import unit_system
+
     axis = None
     if args.rolling_axis:
         try:
@@ -79,6 +90,6 @@ def analysis_kwargs(args: argparse.Namespace) -> dict:
         "grid": PolarGrid.make(args.nr, args.nphi, args.rule),
         "threshold": args.threshold,
         "rolling_axis": axis,
-        "units": args.units,
+        "units": unit_system(args.units),  # an unknown name fails here, before any file is read
         "surface": args.surface,
     }

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-from ..analysis import Analysis, analyse, reaction_candidates
-from ..output import write_json_atomic
-from ..reader.units import describe
 from ._common import add_friction_option, add_input_options, analysis_kwargs
+
+if TYPE_CHECKING:
+    from ..analysis import Analysis
 
 
 def add_parser(sub) -> None:
@@ -37,6 +38,9 @@ def format_analysis(a: Analysis) -> str:
         ("normal load N (polar)", f"{c.N:.6g} N"),
         ("normal load N_fe (FE faces)", f"{p.N_fe:.6g} N  (differs by {c.N / p.N_fe - 1:+.2e})"),
     ]
+    from ..analysis import reaction_candidates
+    from ..reader.units import describe
+
     for name, value in reaction_candidates(a.static_field, p.frame.axes[2]).items():
         rel = f"  (N_fe/|reaction| - 1 = {_pct(p.N_fe / abs(value) - 1)})" if value else ""
         rows.append((f"solver {name}", f"{value:.6g} N{rel}"))
@@ -79,6 +83,9 @@ def format_analysis(a: Analysis) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..analysis import analyse
+    from ..output import write_json_atomic
+
     result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
     print(format_analysis(result))
     if args.json:

@@ -11,10 +11,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..diagnose import diagnose
-from ..diagnose.selection import FOLDS
-from ..diagnose.writer import write_diagnosis
 from ..errors import ArgumentError, OutputError
+from . import _validate as v
 from ._common import add_friction_option, add_input_options, analysis_kwargs
 
 
@@ -47,23 +45,26 @@ def add_parser(sub) -> None:
     p.add_argument("--force", action="store_true", help="replace a non-empty output folder")
     p.add_argument(
         "--seed",
-        type=int,
+        type=v.seed,
         default=0,
         metavar="S",
         help="seed of the cross-validation folds (default 0)",
     )
     p.add_argument(
         "--folds",
-        type=int,
-        default=FOLDS,
+        type=v.integer_in(2),
+        default=v.LibraryDefault("fepost.diagnose.selection", "FOLDS"),
         metavar="K",
-        help=f"cross-validation folds (default {FOLDS})",
+        help="cross-validation folds (default %(default)s)",
     )
     add_input_options(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..diagnose import diagnose
+    from ..diagnose.writer import write_diagnosis
+
     if not args.friction > 0:
         raise ArgumentError(f"--friction must be positive, got {args.friction!r}")
     if args.folds < 2:

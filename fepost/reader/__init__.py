@@ -27,12 +27,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import InputFileError
-from ..field import ContactField
 from . import isolate
 from .names import CCX_CONTACT, DISPLACEMENT_NAMES, PRESSURE_NAMES
 from .units import SYSTEMS, UnitSystem, unit_system
+
+if TYPE_CHECKING:
+    from ..field import ContactField
 
 VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm")
 EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")

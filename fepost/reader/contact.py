@@ -32,6 +32,20 @@ EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
 SENTINELS = (-99999.0, -999999.0, -9999.0, -1.0e30, -1.0e20)
 #: Global variables read as the solver's reaction or contact force (normalised names containing these).
 REACTION_WORDS = ("react", "force")
+#: Largest magnitude accepted for a coordinate or a displacement (file units): beyond it the numbers
+#: are corrupt, whatever the units (the plausible scales are checked later, in SI).
+MAX_COORDINATE = 1e12
+#: Largest magnitude accepted for a pressure value (file units).
+MAX_PRESSURE = 1e30
+
+
+def _absurd(source: str, what: str, values: np.ndarray, limit: float) -> None:
+    finite = values[np.isfinite(values)]
+    if finite.size and np.abs(finite).max() > limit:
+        raise InputFileError(
+            f"{source}: {what} up to {np.abs(finite).max():.3g} (beyond {limit:g}, in any unit system): "
+            "corrupt file?"
+        )
 
 
 def read_raw(path: Path, step: int | None) -> RawMesh:
@@ -198,8 +212,10 @@ def _contact(
         positive = bool(finite.size and finite.max() > 0)
     if not positive:
         _no_contact(raw, path, choice)
+    _absurd(source, f"pressure values of {choice.label!r}", finite, MAX_PRESSURE)
 
     points = np.array(raw.points, float)
+    _absurd(source, "node coordinates", points, MAX_COORDINATE)
     disp = pick_displacement(source, catalogue, displacement)
     if disp is not None:
         u = np.asarray(raw.point_data[disp], float)
@@ -207,6 +223,7 @@ def _contact(
             raise FieldError(f"{source}: displacement array {disp!r} is not a vector per node")
         if not np.all(np.isfinite(u)):
             raise FieldError(f"{source}: displacement array {disp!r} holds NaN or infinite values")
+        _absurd(source, f"displacements {disp!r}", u, MAX_COORDINATE)
         points[:, : min(3, u.shape[1])] += u[:, :3]
     if units is not None and not units.is_si:
         points *= units.length

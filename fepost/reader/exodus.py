@@ -258,10 +258,10 @@ def _blocks(ds, path: Path, n_nodes: int, chosen: int | None) -> list[tuple[Bloc
         check_connectivity(conn, n_nodes, f"{path}: {label}")
         canon = exodus_type(etype, npe)
         if canon is None:
-            skipped = f"{etype or 'untyped'} ({npe} nodes)"
-            out.append((Block(label, "unknown", conn, first, k), skipped))
-            first += m
-            continue
+            raise InputFileError(
+                f"{path}: {label} has elements of type {etype or '(none)'!r} with {npe} nodes, "
+                "which fepost cannot read"
+            )
         block = Block(f"{label} ({canon.upper()}, {m} elements)", canon, conn, first, k)
         for i, name in enumerate(evar_names):
             key = f"vals_elem_var{i + 1}eb{k + 1}"

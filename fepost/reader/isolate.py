@@ -201,6 +201,9 @@ def _send(fd: int, payload: Any) -> None:
 
 
 def _child_main(wfd: int, func, args, kwargs, nbytes: int) -> None:
+    import faulthandler
+
+    faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
     signal.signal(signal.SIGINT, signal.SIG_DFL)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     cap = _capture_fd()

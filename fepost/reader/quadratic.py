@@ -189,6 +189,16 @@ def face_loads(ftype: str, xy: np.ndarray, conn: np.ndarray, values: np.ndarray,
     return np.asarray(values, float) * jac.sum(axis=1)
 
 
+def folded(ftype: str, xy: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """True for faces whose map onto the plane of ``xy`` folds over (its Jacobian changes sign)."""
+    xi, eta, _ = gauss_rule("tri" if ftype.startswith("tri") else "quad")
+    _, dxi, deta = shape(ftype, xi, eta)
+    X, Y = xy[:, 0][conn], xy[:, 1][conn]
+    det = (X @ dxi.T) * (Y @ deta.T) - (X @ deta.T) * (Y @ dxi.T)
+    scale = np.max(np.abs(det), axis=1)
+    return (det.min(axis=1) < -1e-9 * scale) & (det.max(axis=1) > 1e-9 * scale)
+
+
 def face_moments(
     ftype: str, xy: np.ndarray, conn: np.ndarray, values: np.ndarray, location: str
 ) -> np.ndarray:
@@ -201,6 +211,21 @@ def face_moments(
     sig = np.asarray(values, float)[conn] @ N.T if location == "point" else np.asarray(values, float)[:, None]
     f = sig * jac
     return np.column_stack([f.sum(1), (f * (X @ N.T)).sum(1), (f * (Y @ N.T)).sum(1)])
+
+
+def face_surface_loads(
+    ftype: str, points: np.ndarray, conn: np.ndarray, values: np.ndarray, location: str = "point"
+) -> np.ndarray:
+    """∬ σ dA of each face over its curved surface in 3-D (N): an (m,) array."""
+    xi, eta, w = gauss_rule("tri" if ftype.startswith("tri") else "quad")
+    N, dxi, deta = shape(ftype, xi, eta)
+    P = points[conn]
+    dA = (
+        np.linalg.norm(np.cross(np.einsum("qk,mkd->mqd", dxi, P), np.einsum("qk,mkd->mqd", deta, P)), axis=-1)
+        * w
+    )
+    sig = np.asarray(values, float)[conn] @ N.T if location == "point" else np.asarray(values, float)[:, None]
+    return np.sum(sig * dA, axis=1)
 
 
 def surface_integrals(

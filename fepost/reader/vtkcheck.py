@@ -275,6 +275,8 @@ class _Xml:
         a = arr.attrs
         dtype = a.get("type", "")
         if dtype == "String":
+            if a.get("format", "ascii") == "ascii":  # the bytes of the strings, each ended by a 0
+                return self.data[arr.start : arr.end].split().count(b"0")
             return None
         size = _SIZES.get(dtype)
         if size is None:

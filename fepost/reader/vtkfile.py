@@ -22,13 +22,19 @@ from .cells import SPECS, VTK_TYPES, check_connectivity
 from .raw import Block, LazyArrays, RawMesh
 
 VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm")
-#: VTK cell types that are not read (named in notes): polyhedra, polygons, strips, Lagrange cells.
-_NAMED_SKIPS = {
-    2: "poly-vertex",
-    4: "poly-line",
+#: VTK cell types without area that are passed over (named in the notes): they carry no contact pressure.
+_PASSED_OVER = {2: "poly-vertex", 4: "poly-line", 35: "cubic line", 68: "Lagrange curve", 75: "Bezier curve"}
+#: VTK cell types with area that fepost cannot read: refused by name, so no load is dropped silently.
+_UNSUPPORTED = {
     6: "triangle-strip",
     7: "polygon",
     42: "polyhedron",
+    69: "Lagrange triangle",
+    70: "Lagrange quadrilateral",
+    71: "Lagrange tetrahedron",
+    72: "Lagrange hexahedron",
+    73: "Lagrange wedge",
+    74: "Lagrange pyramid",
 }
 
 
@@ -148,6 +154,12 @@ def _as_unstructured(ds):
     return f.GetOutput()
 
 
+def _vtk_at_least(major: int, minor: int) -> bool:
+    from vtkmodules.vtkCommonCore import vtkVersion
+
+    return (vtkVersion.GetVTKMajorVersion(), vtkVersion.GetVTKMinorVersion()) >= (major, minor)
+
+
 def _np(arr) -> np.ndarray:
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
@@ -188,7 +200,9 @@ def _cells(ds) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     cells = ds.GetCells()
     if cells is None or ds.GetNumberOfCells() == 0:
         return np.empty(0, np.uint8), np.zeros(1, np.int64), np.empty(0, np.int64)
-    types = np.asarray(_np(ds.GetCellTypesArray()), np.uint8)
+    # GetCellTypes returns the array from VTK 9.6 on (GetCellTypesArray is deprecated there)
+    getter = ds.GetCellTypes if _vtk_at_least(9, 6) else ds.GetCellTypesArray
+    types = np.asarray(_np(getter()), np.uint8)
     off = np.asarray(_np(cells.GetOffsetsArray()), np.int64)
     con = np.asarray(_np(cells.GetConnectivityArray()), np.int64)
     return types, off, con
@@ -233,9 +247,14 @@ def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
             spec = VTK_TYPES.get(int(t))
             count = len(types) if isinstance(sel, slice) else len(sel)
             if spec is None:
-                name = _NAMED_SKIPS.get(int(t), f"VTK type {int(t)}")
-                skipped[name] = skipped.get(name, 0) + count
-                continue
+                if int(t) in _PASSED_OVER:
+                    skipped[_PASSED_OVER[int(t)]] = skipped.get(_PASSED_OVER[int(t)], 0) + count
+                    continue
+                what = _UNSUPPORTED.get(int(t), "an unknown type")
+                raise InputFileError(
+                    f"{path}: {count} cell(s) of VTK type {int(t)} ({what}) cannot be read: "
+                    "convert them to triangles or quadrilaterals (or the file is corrupt)"
+                )
             canon, perm = spec
             k = SPECS[canon].n_nodes
             if single and len(con) == k * count:
