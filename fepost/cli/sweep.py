@@ -14,6 +14,7 @@ SHOWN_ERRORS = 10
 
 
 def add_parser(sub) -> None:
+    from . import _validate as v
     from ._common import add_friction_option, add_input_options
 
     p = sub.add_parser(
@@ -24,15 +25,15 @@ def add_parser(sub) -> None:
             "and, with --steps all, on every Exodus time step, as tasks on a Dask cluster. Writes "
             "DIR/coefficients.parquet and DIR/coefficients.csv (one row per file and step), and "
             "DIR/trends.html (coefficients against load, power-law fits with 95 % intervals). "
-            "Re-running the same command computes only the rows not finished yet. Exit status 2 "
-            "when any row failed (the table is still complete)."
+            "Re-running the same command computes only the rows not finished yet. Exit status 1 "
+            "when some rows failed (the table is still complete and marks them)."
         ),
     )
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="FE export, folder of exports, or glob pattern")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created; re-use it to resume)")
     p.add_argument(
         "--workers",
-        type=int,
+        type=v.integer_in(1, what="a whole number of processes"),
         metavar="N",
         help="worker processes of the embedded local Dask cluster (default: the CPU cores)",
     )
@@ -66,6 +67,7 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..errors import ArgumentError
     from ..sweep import RowOptions, run_sweep
+    from . import FAILED_INPUTS, OK, Terminated
     from ._common import analysis_kwargs
 
     kwargs = analysis_kwargs(args)
@@ -86,13 +88,12 @@ def run(args: argparse.Namespace) -> int:
             force=args.force,
             trends=not args.no_trends,
         )
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, Terminated):
         print(
-            f"fepost: interrupted; the rows finished so far are kept in {args.out}: "
-            "run the same command again to resume",
+            f"fepost: the rows finished so far are kept in {args.out}: run the same command again to resume",
             file=sys.stderr,
         )
-        return 130
+        raise
     print(
         f"{len(result.rows)} rows ({result.reused} from an earlier run, {result.computed} computed), "
         f"{result.errors} failed"
@@ -106,4 +107,4 @@ def run(args: argparse.Namespace) -> int:
     if len(failed) > SHOWN_ERRORS:
         more = len(failed) - SHOWN_ERRORS
         print(f"fepost: ... and {more} more failed rows (see the table)", file=sys.stderr)
-    return 0 if result.ok else 2
+    return OK if result.ok else FAILED_INPUTS

@@ -92,7 +92,7 @@ class Job:
         }
 
 
-def _count_steps(path: str, units: str | None) -> int | None:
+def _count_steps(path: str, units) -> int | None:
     listed = time_steps(path, units)
     return len(listed) if listed else None
 

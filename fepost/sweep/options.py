@@ -88,10 +88,9 @@ class RowOptions:
         )
 
     @property
-    def units(self) -> str | None:
+    def units(self) -> Any:
         """The model's unit system among the reading options (it scales the time values), if set."""
-        value = dict(self.extra).get("units")
-        return None if value is None else str(value)
+        return dict(self.extra).get("units")
 
     def analyse_kwargs(self) -> dict:
         """The keyword arguments of :func:`fepost.analysis.analyse` (without ``step``)."""

@@ -87,7 +87,7 @@ class SweepResult:
         }
 
 
-def list_steps_task(path: str, units: str | None = None) -> dict:
+def list_steps_task(path: str, units=None) -> dict:
     """Worker task: the time values of ``path`` (``{"times": ...}``) or ``{"error": message}``."""
     from ..errors import FepostError
 
@@ -105,7 +105,7 @@ def _check_steps(steps) -> str | int:
     raise ArgumentError(f"--steps must be 'last' or 'all', got {steps!r}")
 
 
-def _listed_steps(pairings: Sequence[Pairing], work: WorkFolder, cluster: Cluster, units: str | None) -> dict:
+def _listed_steps(pairings: Sequence[Pairing], work: WorkFolder, cluster: Cluster, units) -> dict:
     """{path: times | None | error message} for the Exodus files among ``pairings``."""
     listed: dict[str, object] = {}
     todo = []

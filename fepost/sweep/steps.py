@@ -16,7 +16,7 @@ from ..reader import EXODUS_SUFFIXES
 SERIES_SUFFIXES = tuple(s.lower() for s in EXODUS_SUFFIXES)
 
 
-def time_steps(path: str | Path, units: str | None = None) -> tuple[float, ...] | None:
+def time_steps(path: str | Path, units=None) -> tuple[float, ...] | None:
     """Time values (s) of the steps in ``path``.
 
     Step ``k`` of the result is the ``step=k`` of :func:`fepost.reader.read_contact`.
