@@ -456,3 +456,37 @@ def test_ctrl_c_stops_cleanly(tmp_path):
     while left := subprocess.run(["pgrep", "-a", "-g", str(proc.pid)], capture_output=True, text=True).stdout:
         assert time.monotonic() < deadline, f"processes left in the group: {left}"
         time.sleep(0.1)
+
+
+def test_report_section_provider(tmp_path):
+    """The report's optional section: the sweep's table, fits and figures as a report Section."""
+    from types import SimpleNamespace
+
+    from fepost.report.html import environment
+    from fepost.sweep.reportsection import sweep_provider
+
+    d = tmp_path / "aircraft"
+    d.mkdir()
+    loads = [5e4, 1e5, 2e5, 3e5]
+    for load in loads:
+        hertz(d / f"static_{load / 2e3:03.0f}.vtu", load, sidecar={"load": load})
+    hertz(d / "rolling_100.vtu", 2e5, k_x=0.2)
+    inputs = [str(d / "static_*.vtu"), str(d / "rolling_*.vtu")]
+    report = tmp_path / "report"
+    report.mkdir()
+    section = sweep_provider(inputs, "static=rolling")(SimpleNamespace(friction=0.4), report)
+    assert section is not None and section.key == "sweep"
+    assert section.table[0][:3] == ("case", "load (N)", "N (N)")
+    rows = {r[0]: r for r in section.table[1:]}
+    assert list(rows) == ["static_025", "static_050", "static_100", "static_150"]  # rolling map paired
+    assert rows["static_100"][8] == pytest.approx(0.2, rel=0.05) and rows["static_025"][8] == "—"
+    assert all(r[-1] == "ok" for r in rows.values())
+    assert any(p.startswith("R ∝ N^0.333, 95 % interval") for p in section.paragraphs)
+    assert "sweep/coefficients.csv" in section.files and "sweep/load_trends.svg" in section.files
+    assert all((report / f).is_file() for f in section.files)
+    table = read_table(report / "sweep" / "coefficients.parquet")
+    assert [r["f"] for r in table] == [0.4] * 4  # the report's friction coefficient
+    html = environment().get_template("sections/generic.html.j2").render(section=section)
+    assert "data:image/png;base64," in html and "static_150" in html
+    # no sample files: no section
+    assert sweep_provider([str(tmp_path / "none" / "*.vtu")])(SimpleNamespace(friction=0.3), report) is None

@@ -24,7 +24,9 @@ Modules, one job each:
 * :mod:`.trends`, :mod:`.figures`, :mod:`.page` – power-law fits, figures,
   the trends page and :func:`sweep_section` for embedding in a report
 * :mod:`.embed` – :func:`sweep_report_section`: run a sweep and return its
-  section, for the report
+  HTML section, for any page
+* :mod:`.reportsection` – the sweep as an optional section of ``fepost report``
+  (``sample_sweep_section`` for the sample load sweep in ``meshes/aircraft/``)
 """
 
 from .embed import sweep_report_section

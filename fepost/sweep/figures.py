@@ -43,6 +43,9 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
         nrow = -(-len(quantities) // ncol)
         fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.4 * nrow), squeeze=False)
         by_group = groups(rows)
+        loads = _values([r for m in by_group.values() for r in m], "N")
+        loads = loads[np.isfinite(loads) & (loads > 0)]
+        xlim = (loads.min() / 1.1, loads.max() * 1.1) if loads.size else None
         for ax, (q, label, unit, hertz) in zip(axes.flat, quantities, strict=False):
             for k, (name, members) in enumerate(by_group.items()):
                 colour = _COLOURS[k % len(_COLOURS)]
@@ -66,6 +69,8 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
             if np.all(finite[np.isfinite(finite)] > 0):
                 ax.set_yscale("log")
             ax.set_xscale("log")
+            if xlim is not None:
+                ax.set_xlim(*xlim)  # one load axis for every panel, also for a quantity of few rows
             for axis in (ax.xaxis, ax.yaxis) if ax.get_yscale() == "log" else (ax.xaxis,):
                 # ticks at 1, 2, 5 × 10^k, plainly labelled: a sweep rarely spans a decade
                 axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
