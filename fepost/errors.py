@@ -85,3 +85,7 @@ class FitWarning(FepostWarning):
 
 class OptionWarning(FepostWarning):
     """A command-line option is valid but implausible (e.g. ``--friction 3``)."""
+
+
+class ClusterError(FepostError, RuntimeError):
+    """The Dask cluster of a sweep cannot be reached, has no workers or went away."""

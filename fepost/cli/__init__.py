@@ -37,6 +37,7 @@ COMMANDS = [
     "table1",
     "report",
     "diagnose",
+    "sweep",
 ]
 
 #: Exit statuses of ``fepost`` (the ``--help`` epilog and docs/cli-exit-codes.md).
