@@ -38,9 +38,14 @@ def frozen(a, dtype=float) -> np.ndarray:
 def sealed(a: np.ndarray) -> np.ndarray:
     """Mark an array the library has just created as read-only, without copying.
 
-    Only for arrays no caller holds: it lets :func:`frozen` share them.
+    Only for arrays no caller holds: it lets :func:`frozen` share them. The
+    arrays it views (numpy's fancy indexing may return a view of a transposed
+    temporary) are sealed too.
     """
-    a.setflags(write=False)
+    b: object = a
+    while isinstance(b, np.ndarray):
+        b.setflags(write=False)
+        b = b.base
     return a
 
 

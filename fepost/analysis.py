@@ -9,6 +9,7 @@
 
 from __future__ import annotations
 
+import re
 import warnings
 from dataclasses import dataclass
 from functools import cached_property
@@ -17,12 +18,14 @@ from pathlib import Path
 import numpy as np
 
 from .coefficients import Coefficients, coefficients_from_moments
-from .errors import PatchWarning
+from .errors import PatchWarning, ScaleWarning
 from .field import ContactField
 from .moments import Moments, moments
 from .patch import DEFAULT_THRESHOLD, Patch, build_patch
 from .polar import PolarGrid, PolarMap
-from .reader import read_contact
+from .reader import isolate, start_reading
+from .reader.units import describe, unit_system
+from .regions import warm_up
 from .resample import resample
 
 
@@ -59,12 +62,18 @@ class Analysis:
         d["R_definition"] = (
             "r_max: smallest circle about the static centre of pressure holding every loaded point"
         )
-        d["reaction_z"] = self.static_field.reaction_z
+        sf = self.static_field
+        d["reaction_z"] = sf.reaction_z
+        d["reactions"] = dict(sf.reactions)
+        d["units"] = describe(sf.units)
         d["grid"] = {"rule": self.grid.rule, "nr": self.grid.shape[0], "nphi": self.grid.shape[1]}
         d["static"] = {
-            "source": self.static_field.source,
-            "field": self.static_field.field,
-            "step": self.static_field.step,
+            "source": sf.source,
+            "field": sf.field,
+            "step": sf.step,
+            "time": sf.time,
+            "body": sf.body,
+            "format": sf.format,
         }
         if self.rolling_patch is not None and self.rolling_field is not None and self.rolling_map is not None:
             rf = self.rolling_field
@@ -83,6 +92,53 @@ class Analysis:
 
 #: Largest accepted |N/N_fe − 1| before a warning: the polar grid must carry the FE load.
 RESAMPLE_TOL = 0.01
+#: Largest accepted distance between N_fe and the solver's reaction before a warning.
+REACTION_TOL = 0.10
+_AXIS = re.compile(r"(?:^|[_\s.-])([xyz])$|([xyzXYZ])$")
+
+
+def reaction_candidates(fld: ContactField, normal: np.ndarray) -> dict[str, float]:
+    """The solver reactions of ``fld`` that act along the patch normal (N).
+
+    The sidecar's ``reaction_z``, and the file's reaction/force globals whose
+    name ends in the global axis the normal is closest to (``bot_react_y``) or
+    names no axis at all; none when the normal is oblique to every axis.
+    """
+    out: dict[str, float] = {}
+    if fld.reaction_z is not None:
+        out["reaction_z (sidecar)"] = float(fld.reaction_z)
+    k = int(np.argmax(np.abs(normal)))
+    if abs(normal[k]) < 0.9:
+        return out
+    axis = "xyz"[k]
+    for name, value in fld.reactions.items():
+        m = _AXIS.search(name)
+        named = (m.group(1) or m.group(2)).lower() if m else None
+        if named is None or named == axis:
+            out[name] = float(value)
+    return out
+
+
+def _check_reaction(fld: ContactField, patch: Patch) -> None:
+    cands = reaction_candidates(fld, patch.frame.axes[2])
+    if not cands:
+        return
+    errs = {n: abs(patch.N_fe) / abs(v) - 1.0 if v else np.inf for n, v in cands.items()}
+    best = min(errs, key=lambda n: abs(errs[n]))
+    if abs(errs[best]) <= REACTION_TOL:
+        return
+    listing = ", ".join(f"{n} = {v:.6g} N" for n, v in cands.items())
+    ratio = abs(patch.N_fe / cands[best]) if cands[best] else np.inf
+    hint = ""
+    for f in (1e-3, 1e3, 1e-6, 1e6, 1e-9, 1e9):
+        if np.isfinite(ratio) and abs(ratio / f - 1) < 0.05:
+            hint = f" (a factor {f:g}: wrong --units?)"
+    warnings.warn(
+        f"{fld.source}: N_fe = {patch.N_fe:.6g} N differs from the solver's reaction by "
+        f"{errs[best]:+.1%} ({listing}){hint}",
+        ScaleWarning,
+        stacklevel=3,
+    )
 
 
 def _check_resampling(patch: Patch, mom: Moments) -> None:
@@ -96,10 +152,13 @@ def _check_resampling(patch: Patch, mom: Moments) -> None:
         )
 
 
-def _as_field(src, field, step, displacement) -> ContactField:
+def _start(src, field, step, displacement, units, surface) -> isolate.Pending:
+    """The reading of ``src`` under way (a :class:`ContactField` is taken as it is)."""
     if isinstance(src, ContactField):
-        return src
-    return read_contact(Path(src), field=field, step=step, displacement=displacement)
+        return isolate.Pending(str(src.source), value=src)
+    return start_reading(
+        Path(src), field=field, step=step, displacement=displacement, units=units, surface=surface
+    )
 
 
 def analyse(
@@ -113,22 +172,43 @@ def analyse(
     grid: PolarGrid | None = None,
     threshold: float = DEFAULT_THRESHOLD,
     rolling_axis=None,
+    units=None,
+    surface: str | None = None,
 ) -> Analysis:
     """Run the pipeline on a static map (path or :class:`ContactField`) and an optional rolling map.
 
     The rolling map is placed in the static patch's frame; its polar grid is
     centred on the static centre of pressure with a radius large enough to
-    hold its own loaded region.
+    hold its own loaded region. ``units`` (a name of
+    :data:`fepost.reader.units.SYSTEMS`) and ``surface`` (an Exodus side set
+    or block) are passed to :func:`fepost.reader.read_contact`. N_fe is checked
+    against the solver's reaction where the export carries one (warning above
+    :data:`REACTION_TOL`).
     """
     grid = grid or PolarGrid.make()
-    sf = _as_field(static, field, step, displacement)
+    units = unit_system(units)
+    # both files are read at once in their own children; the patch step's imports run meanwhile
+    pending = [_start(static, field, step, displacement, units, surface)]
+    try:
+        if rolling is not None:
+            pending.append(_start(rolling, field, step, displacement, units, surface))
+        warm_up()
+        return _pipeline(pending, rolling is not None, friction, grid, threshold, rolling_axis)
+    finally:
+        for p in pending:
+            p.cancel()
+
+
+def _pipeline(pending, with_rolling, friction, grid, threshold, rolling_axis) -> Analysis:
+    sf = pending[0].result()
     sp = build_patch(sf, threshold=threshold, rolling_axis=rolling_axis)
+    _check_reaction(sf, sp)
     sm = resample(sp, grid, radius=sp.r_max)
     smo = moments(sm)
     _check_resampling(sp, smo)
     rf = rp = rm = rmo = None
-    if rolling is not None:
-        rf = _as_field(rolling, field, step, displacement)
+    if with_rolling:
+        rf = pending[1].result()
         rp = build_patch(rf, threshold=threshold, frame=sp.frame)
         r_roll = float(np.max(np.hypot(rp.xy[:, 0], rp.xy[:, 1])))
         rm = resample(rp, grid, radius=max(sp.r_max, r_roll))

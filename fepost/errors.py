@@ -31,6 +31,14 @@ class PatchError(FepostError, ValueError):
     """The contact patch is empty, split, non-planar or otherwise unusable."""
 
 
+class DimensionError(FepostError, ValueError):
+    """A 2-D model (plane strain/stress or axisymmetric): its contact is a line, not a patch."""
+
+
+class ScaleError(FepostError, ValueError):
+    """Lengths or pressures at an implausible scale (a model read in the wrong units?)."""
+
+
 class ArgumentError(FepostError, ValueError):
     """A function or command argument is out of its valid range."""
 
@@ -59,6 +67,14 @@ class PressureWarning(FepostWarning):
     """Small negative pressures were clipped or values were otherwise repaired."""
 
 
+class ReaderWarning(FepostWarning):
+    """A file was read, but something in it was skipped, assumed or repaired."""
+
+
+class ScaleWarning(FepostWarning):
+    """Lengths, pressures or the load look implausible, or N disagrees with the solver's reaction."""
+
+
 class PatchWarning(FepostWarning):
     """The patch is usable but departs from the method's assumptions."""
 
@@ -69,3 +85,7 @@ class FitWarning(FepostWarning):
 
 class OptionWarning(FepostWarning):
     """A command-line option is valid but implausible (e.g. ``--friction 3``)."""
+
+
+class ClusterError(FepostError, RuntimeError):
+    """The Dask cluster of a sweep cannot be reached, has no workers or went away."""

@@ -194,8 +194,8 @@ def locate(xy, triangles, points) -> Location:
         with np.errstate(divide="ignore", invalid="ignore"):
             l1 = (px * by - py * bx) / det
             l2 = (ax * py - ay * px) / det
-        l0 = 1.0 - l1 - l2
-        depth = np.minimum(np.minimum(l0, l1), l2)
+            l0 = 1.0 - l1 - l2
+            depth = np.minimum(np.minimum(l0, l1), l2)
         depth[~np.isfinite(depth) | (det == 0)] = -np.inf  # degenerate faces hold nothing
         # per query point (pq is sorted): the pair of greatest depth, the first one on ties
         has = np.flatnonzero(n)

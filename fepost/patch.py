@@ -2,17 +2,25 @@
 
 Definitions (THEORY.md §1)
 --------------------------
-* **Loaded**: a face is loaded when the FE pressure exceeds the threshold
-  somewhere on it: for nodal data when one of its nodes does, for face data
-  when its value does. The threshold is ``threshold`` × the peak pressure
-  (default :data:`DEFAULT_THRESHOLD` = 1e-6, i.e. essentially "non-zero").
+* **Loaded**: an element face is loaded when the FE pressure exceeds the
+  threshold somewhere on it: for nodal data when one of its nodes does, for
+  face data when its value does. The threshold is ``threshold`` × the peak
+  pressure (default :data:`DEFAULT_THRESHOLD` = 1e-6, i.e. essentially
+  "non-zero"). Steep faces that touch the contact only where flat loaded faces
+  do (the sides of the loaded body) are not part of the patch
+  (:func:`fepost.facegroups.drop_edge_faces`).
+* **Faces**: linear triangles as they are; bilinear and quadratic faces are cut
+  into triangles with their own shape functions, finer until the triangles
+  carry the element load to :data:`REFINE_TOL` (``N_fe`` is always the exact
+  integral over the element faces, :mod:`fepost.reader.quadratic`).
 * **Plane**: least-squares plane through the nodes with pressure above the
   threshold (SVD). Its normal is the road normal z, oriented to have a
   positive component along the global axis it is closest to (z-up and y-up
   models both come out with z pointing up).
 * **Frame**: origin = static centre of pressure (exact integral over the FE
-  faces), x = the rolling axis projected on the plane (default: global x),
-  y = z × x.
+  faces), x = the rolling axis projected on the plane (default: global x; when
+  global x is normal to the patch, the global axis closest to the plane, with a
+  warning), y = z × x.
 * **R** = ``r_max``: largest in-plane distance from the origin of a node of a
   loaded face (the support of the FE field). ``r_equiv`` = √(area/π) with the
   area of the loaded faces.
@@ -21,10 +29,13 @@ Definitions (THEORY.md §1)
   ``circular`` is true when ``aspect`` = a/b ≤ 1 + :data:`ASPECT_TOL` and
   r_max/r_equiv ≤ :data:`RMAX_TOL` (a square, aspect 1, has 1.25).
 
-Rejected (:class:`~fepost.errors.PatchError` / :class:`~fepost.errors.PressureError`):
-all-zero pressure, NaN inside the patch, negative pressures below −1 % of the
-peak, several patches each carrying more than 1 % of the load, a patch whose
-RMS distance from its plane exceeds :data:`PLANARITY_TOL` × r_equiv.
+Rejected (:class:`~fepost.errors.PatchError` / :class:`~fepost.errors.PressureError`
+/ :class:`~fepost.errors.DimensionError` / :class:`~fepost.errors.ScaleError`):
+all-zero pressure, NaN inside the patch, negative nodal pressures below −1 % of
+the peak, several patches each carrying more than 1 % of the load (side by side,
+or on parallel surfaces), a patch whose RMS distance from its plane exceeds
+:data:`PLANARITY_TOL` × r_equiv, loaded nodes on one line (a line contact), and
+implausible scales (:func:`fepost.reader.units.check_scale`).
 Repaired with a warning: NaN away from the patch and small negative values
 (set to zero), fragments under 1 % of the load (dropped).
 """
@@ -36,44 +47,37 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from scipy import ndimage
 
 from ._arrays import frozen, sealed
-from .errors import ArgumentError, PatchError, PatchWarning, PressureError, PressureWarning
+from .errors import ArgumentError, DimensionError, PatchError, PatchWarning, PressureError, PressureWarning
+from .facegroups import (
+    STEEP_DEG,
+    drop_edge_faces,
+    exact_load,
+    folded_faces,
+    loaded_groups,
+    next_triangles,
+    only_triangles,
+    refine,
+)
 from .facesums import FaceSums, face_loads, face_sums, load_outside, triangle_areas
 from .field import ContactField
+from .frame import Frame, _axes, _plane
+from .reader.units import check_scale
+from .regions import FRAGMENT_SHARE, _components, _separate_surfaces
+from .regions import GAP_FRACTION as GAP_FRACTION  # the patch rules' tolerances, documented here
 
 DEFAULT_THRESHOLD = 1e-6
 ASPECT_TOL = 0.10
 RMAX_TOL = 1.15
 PLANARITY_TOL = 0.02
 NEGATIVE_TOL = 0.01
-FRAGMENT_SHARE = 0.01
-GAP_FRACTION = 0.05
-RASTER_MAX = 2048
-
-
-@dataclass(frozen=True)
-class Frame:
-    """Patch frame: ``origin`` (3,) in global coordinates (m); ``axes`` rows are x, y, z."""
-
-    origin: np.ndarray
-    axes: np.ndarray
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "origin", frozen(self.origin))
-        object.__setattr__(self, "axes", frozen(self.axes))
-
-    def to_local(self, points) -> np.ndarray:
-        """Global (n, 3) points → patch coordinates (n, 3), m."""
-        return (np.asarray(points, float) - self.origin) @ self.axes.T
-
-    def to_global(self, local) -> np.ndarray:
-        """Patch coordinates (n, 2 or 3) → global (n, 3), m."""
-        local = np.asarray(local, float)
-        if local.shape[-1] == 2:
-            local = np.concatenate([local, np.zeros(local.shape[:-1] + (1,))], axis=-1)
-        return local @ self.axes + self.origin
+#: Largest |load of the triangles / exact element load − 1| before the faces are cut finer.
+REFINE_TOL = 1e-4
+#: Most triangles the cut of curved faces may make (the finest level stays within it).
+REFINE_MAX_TRIANGLES = 4_000_000
+#: Loaded nodes spanning less than this fraction of their length across are on a line.
+LINE_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -110,6 +114,12 @@ class Patch:
     dropped_fragments: int = 0
     max_edge: float = float("nan")  # longest edge of a loaded face (m): the mesh size
     notes: tuple[str, ...] = ()
+    n_element_faces: int = 0  # loaded element faces (before the cut into triangles)
+    face_types: tuple[str, ...] = ()
+    refine_level: int = 0  # 0: linear triangles as read
+    refine_error: float = 0.0  # load of the triangles / exact element load − 1
+    dropped_edge_faces: int = 0
+    body: str = ""
 
     def __post_init__(self) -> None:
         for name in ("xy", "height", "values"):
@@ -156,6 +166,12 @@ class Patch:
             "location": self.location,
             "source": self.source,
             "dropped_fragments": self.dropped_fragments,
+            "dropped_edge_faces": self.dropped_edge_faces,
+            "n_element_faces": self.n_element_faces,
+            "face_types": list(self.face_types),
+            "refinement": {"level": self.refine_level, "load_error": self.refine_error},
+            "body": self.body,
+            "notes": list(self.notes),
         }
 
 
@@ -172,15 +188,21 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
         )
     if not finite.all():
         bad = ~finite
+        vz = np.where(finite, v, 0.0)
         if fld.location == "point":
-            loaded_nodes = np.zeros(v.size, bool)
-            face_loaded = np.any(np.where(finite[fld.triangles], v[fld.triangles], 0.0) > 0, axis=1)
-            loaded_nodes[fld.triangles[face_loaded].ravel()] = True
-            inside = bad & loaded_nodes
+            inside = np.zeros(v.size, bool)
+            for _, conn, _ in fld.face_groups():
+                face_loaded = np.any(vz[conn] > 0, axis=1)
+                inside[conn[face_loaded].ravel()] = True
+            inside &= bad
         else:
-            tri_nodes_loaded = np.zeros(fld.n_points, bool)
-            tri_nodes_loaded[fld.triangles[finite & (np.where(finite, v, 0) > 0)].ravel()] = True
-            inside = bad & np.any(tri_nodes_loaded[fld.triangles], axis=1)
+            hot_nodes = np.zeros(fld.n_points, bool)
+            groups = list(fld.face_groups())
+            for _, conn, sl in groups:
+                hot_nodes[conn[vz[sl] > 0].ravel()] = True
+            inside = np.zeros(v.size, bool)
+            for _, conn, sl in groups:
+                inside[sl] = bad[sl] & np.any(hot_nodes[conn], axis=1)
         if inside.any():
             raise PressureError(
                 f"{fld.source}: {int(inside.sum())} NaN/inf pressure values inside the contact "
@@ -192,7 +214,7 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
             PressureWarning,
             stacklevel=3,
         )
-        v = np.where(finite, v, 0.0)
+        v = vz
     vmin = float(v.min())
     if vmin < -NEGATIVE_TOL * peak:
         n = int(np.sum(v < -NEGATIVE_TOL * peak))
@@ -212,126 +234,38 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
     return (v if v is fld.values else sealed(v)), peak
 
 
-def _loaded_faces(fld: ContactField, v: np.ndarray, thr: float) -> np.ndarray:
-    if fld.location == "point":
-        hot = (v > thr)[fld.triangles]
-        return hot[:, 0] | hot[:, 1] | hot[:, 2]
-    return v > thr
-
-
-def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
-    """Separate loaded regions: (count, label per face).
-
-    Regions closer than a gap of about :data:`GAP_FRACTION` × √area (tread
-    grooves, sparse contact at the edge) belong to one patch; regions farther
-    apart (dual wheels) are separate. The nodes are binned on a raster of cell
-    h = max(GAP_FRACTION·√area, longest loaded edge), so faces that share a node
-    always fall in touching cells; one dilation closes gaps narrower than ~h.
-    """
-    h = max(GAP_FRACTION * np.sqrt(sums.A), sums.max_edge)
-    lo = np.array([x.min(), y.min()])
-    ext = np.array([x.max(), y.max()]) - lo
-    n = np.floor(ext / h).astype(int) + 3
-    if n.max() > RASTER_MAX:  # a very sparse region: coarsen the raster
-        h *= n.max() / RASTER_MAX
-        n = np.floor(ext / h).astype(int) + 3
-    # coordinates are >= lo, so truncation is the floor
-    i = ((x - lo[0]) * (1.0 / h)).astype(np.int32) + 1
-    j = ((y - lo[1]) * (1.0 / h)).astype(np.int32) + 1
-    occupied = np.zeros(tuple(n), bool)
-    occupied[i, j] = True
-    occupied = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), bool))
-    labels, count = ndimage.label(occupied, structure=np.ones((3, 3), bool))
-    if count == 1:
-        return 1, np.zeros(len(tri), np.int64)
-    first = tri[:, 0]
-    return int(count), labels[i[first], j[first]] - 1
-
-
-def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Weighted least-squares plane through ``points`` (n, 3): (centroid, unit normal).
-
-    The second moments are accumulated column by column (one (n,) temporary)
-    about a node of the patch, so large global offsets cost no precision.
-    """
-    w = weights / weights.sum()
-    ref = points[int(np.argmax(weights))]
-    c = w @ points - ref
-    m = np.empty((3, 3))
-    buf = np.empty(len(points))
-    cols = [points[:, k] for k in range(3)]
-    for a in range(3):
-        np.subtract(cols[a], ref[a], out=buf)
-        buf *= w
-        for b in range(a, 3):
-            m[a, b] = m[b, a] = buf @ cols[b] - ref[b] * buf.sum()
-    cov = m - np.outer(c, c)
-    _, vecs = np.linalg.eigh(cov)
-    n = vecs[:, 0]
-    k = int(np.argmax(np.abs(n)))
-    if n[k] < 0:
-        n = -n
-    return c + ref, n
-
-
-def _axes(normal: np.ndarray, rolling_axis) -> np.ndarray:
-    if rolling_axis is None:
-        rolling_axis = (1.0, 0.0, 0.0)
-    ax = np.asarray(rolling_axis, float)
-    if ax.shape != (3,) or not np.all(np.isfinite(ax)) or np.linalg.norm(ax) == 0:
-        raise ArgumentError(f"rolling_axis must be a non-zero 3-vector, got {rolling_axis!r}")
-    ax = ax / np.linalg.norm(ax)
-    x = ax - (ax @ normal) * normal
-    if np.linalg.norm(x) < 0.1:
-        raise ArgumentError(
-            f"rolling_axis {tuple(np.round(ax, 3))} is (nearly) normal to the patch plane "
-            f"(normal {tuple(np.round(normal, 3))}); give an in-plane rolling axis"
-        )
-    x /= np.linalg.norm(x)
-    y = np.cross(normal, x)
-    return np.vstack([x, y, normal])
-
-
 class _Geometry(NamedTuple):
     points: np.ndarray
     triangles: np.ndarray
     values: np.ndarray
-    base: Frame
     xy: np.ndarray  # (n, 2) in-plane coordinates in the base frame (m)
     z: np.ndarray  # distance from the base plane (m)
     weights: np.ndarray  # per node: the pressure where loaded, else 0 (face data: 1)
     sums: FaceSums
 
 
-def _geometry(fld, tri, fvals, v, thr, frame, rolling_axis) -> _Geometry:
-    """Compact the loaded faces, fit the plane (unless ``frame``) and integrate."""
-    used_mask = np.zeros(fld.n_points, bool)
+def _geometry(source, points, tri, vals, location, thr, base: Frame) -> _Geometry:
+    """Compact the nodes of ``tri``, project them into ``base`` and integrate."""
+    used_mask = np.zeros(len(points), bool)
     used_mask[tri.ravel()] = True
     if used_mask.all():
-        pts, tri_local, nvals = fld.points, tri, (v if fld.location == "point" else fvals)
+        pts, tri_local, nvals = points, tri, vals
     else:
         used = np.flatnonzero(used_mask)
         remap = np.cumsum(used_mask) - 1
-        tri_local = remap[tri]
-        pts = fld.points[used]
-        nvals = v[used] if fld.location == "point" else fvals
-    w = np.where(nvals > thr, nvals, 0.0) if fld.location == "point" else np.ones(len(pts))
-    if frame is None:
-        if np.count_nonzero(w) < 3:
-            raise PatchError(f"{fld.source}: the contact patch has fewer than 3 loaded nodes")
-        c, normal = _plane(pts, w)
-        base = Frame(origin=c, axes=_axes(normal, rolling_axis))
-    else:
-        base = frame
+        tri_local = sealed(remap[tri])  # new here: the patch shares it
+        pts = points[used]
+        nvals = vals[used] if location == "point" else vals
+    w = np.where(nvals > thr, nvals, 0.0) if location == "point" else np.ones(len(pts))
     # patch coordinates: (pts − o)·e_k = pts·e_k − o·e_k
     xy = pts @ base.axes[:2].T
     xy -= base.origin @ base.axes[:2].T
     z = pts @ base.axes[2]
     z -= base.origin @ base.axes[2]
-    sums = face_sums(xy[:, 0], xy[:, 1], tri_local, nvals, fld.location)
+    sums = face_sums(xy[:, 0], xy[:, 1], tri_local, nvals, location)
     if not sums.N > 0:
-        raise PatchError(f"{fld.source}: the contact patch carries no load")
-    return _Geometry(pts, tri_local, nvals, base, xy, z, w, sums)
+        raise PatchError(f"{source}: the contact patch carries no load")
+    return _Geometry(pts, tri_local, nvals, xy, z, w, sums)
 
 
 def build_patch(
@@ -355,16 +289,104 @@ def build_patch(
     """
     if not (0.0 <= threshold < 1.0):
         raise ArgumentError(f"threshold must be a fraction of the peak pressure in [0, 1), got {threshold!r}")
+    src = fld.source
     v, peak = _validate_values(fld)
     thr = threshold * peak
-    loaded = _loaded_faces(fld, v, thr)
-    if loaded.all():
-        tri, fvals = fld.triangles, v
-    else:
-        tri = fld.triangles[loaded]
-        fvals = v[loaded] if fld.location == "cell" else v
+    groups = loaded_groups(fld, v, thr)
+    if not groups:
+        raise PatchError(f"{src}: no element face carries pressure above the threshold")
+    notes = list(fld.notes)
+    points = fld.points
+    hot = v > thr if fld.location == "point" else None
+    if hot is None:
+        hot = np.zeros(fld.n_points, bool)
+        for g in groups:
+            hot[g.conn.ravel()] = True
 
-    geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
+    # the plane of the loaded nodes (their pressure as weights)
+    if frame is None:
+        if len(groups) == 1 and len(groups[0].conn) == len(fld.triangles) and fld.location == "point":
+            sel = None  # every face loaded: weigh all nodes (zero weight off the patch)
+        else:
+            mask = np.zeros(fld.n_points, bool)
+            for g in groups:
+                mask[g.conn.ravel()] = True
+            sel = np.flatnonzero(mask)
+        pts_sel = points if sel is None else points[sel]
+        if fld.location == "point":
+            vs = v if sel is None else v[sel]
+            w = np.where(vs > thr, vs, 0.0)
+        else:
+            w = np.ones(len(pts_sel))
+        if np.count_nonzero(w) < 3:
+            raise PatchError(f"{src}: the contact patch has fewer than 3 loaded nodes")
+        c, normal, var = _plane(pts_sel, w)
+        hz = np.abs(pts_sel @ normal - c @ normal)[w > 0]
+        flat = bool(hz.max() <= 1e-9 * np.sqrt(var[2]))
+        if var[1] <= LINE_TOL**2 * var[2]:
+            raise DimensionError(
+                f"{src}: the loaded nodes lie on one line: the contact is a line, not a patch "
+                "(a 2-D plane or axisymmetric model written as 3-D?); fepost needs a contact area"
+            )
+        axes, axis_note = _axes(normal, rolling_axis, src)
+        if axis_note:
+            notes.append(axis_note)
+        base = Frame(origin=c, axes=axes)
+    else:
+        base = frame
+        flat = False
+    groups, n_edge = drop_edge_faces(groups, points, hot, base.axes[2], fld.location, flat=flat)
+    if n_edge:
+        notes.append(
+            f"{n_edge} loaded face(s) steeper than {STEEP_DEG:g} deg to the patch plane, touching the "
+            "contact only at its edge (sides of the loaded body), are not part of the patch"
+        )
+
+    def cut(groups, level):
+        if only_triangles(groups):
+            tri = groups[0].conn if len(groups) == 1 else np.concatenate([g.conn for g in groups])
+            if fld.location == "point":
+                return points, tri, v, None
+            fv = groups[0].values if len(groups) == 1 else np.concatenate([g.values for g in groups])
+            return points, tri, fv, None
+        pts, tri, vals, ids, linear = refine(groups, points, v, fld.location, level)
+        if fld.location == "point":
+            # a linear or bilinear piece with no node above the threshold carries (almost) nothing:
+            # leave it out of the loaded area, as for linear triangles
+            hot_t = (vals > thr)[tri]
+            keep = ~linear | hot_t[:, 0] | hot_t[:, 1] | hot_t[:, 2]
+            if not keep.all():
+                tri, ids = tri[keep], ids[keep]
+        return pts, tri, vals, ids
+
+    level = 1
+    exact = None
+    previous = np.inf
+    if not only_triangles(groups):
+        xy_native = points @ base.axes[:2].T - base.origin @ base.axes[:2].T
+        bad = folded_faces(groups, xy_native)
+        if bad:
+            raise PatchError(
+                f"{src}: {bad} loaded element face(s) fold over in the patch plane (repeated or "
+                "crossed corner nodes): corrupt or inverted elements"
+            )
+    while True:
+        pts, tri, vals, parent = cut(groups, level)
+        geo = _geometry(src, pts, tri, vals, fld.location, thr, base)
+        if parent is None:
+            break
+        exact = exact_load(groups, xy_native, v, fld.location)
+        err = abs(geo.sums.N / exact[0] - 1.0)
+        # finer until the triangles carry the element load, while that converges (error / 4 per level)
+        if (
+            err <= REFINE_TOL
+            or next_triangles(groups, 2 * level) > REFINE_MAX_TRIANGLES
+            or err > 0.5 * previous
+        ):
+            break
+        previous = err
+        level *= 2
+
     ncomp, labels = _components(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)
     dropped = 0
     if ncomp > 1:
@@ -374,25 +396,44 @@ def build_patch(
         if big.size > 1:
             parts = ", ".join(f"{s:.0%}" for s in sorted(share[big], reverse=True))
             raise PatchError(
-                f"{fld.source}: {big.size} separate contact patches (load shares {parts}); "
+                f"{src}: {big.size} separate contact patches (load shares {parts}); "
                 "dual wheels or a split patch? fepost analyses one patch at a time: crop the mesh"
             )
         main = int(np.argmax(share))
         keep = labels == main
         dropped = int(ncomp - 1)
         warnings.warn(
-            f"{fld.source}: dropped {dropped} small loaded fragment(s) carrying "
-            f"{1 - share[main]:.2%} of the load",
+            f"{src}: dropped {dropped} small loaded fragment(s) carrying {1 - share[main]:.2%} of the load",
             PatchWarning,
             stacklevel=2,
         )
-        tri = tri[keep]
-        if fld.location == "cell":
-            fvals = fvals[keep]
-        geo = _geometry(fld, tri, fvals, v, thr, frame, rolling_axis)
-    pts, tri_local, nvals, base, xy, height, weights, sums = geo
-    N = sums.N
-    cop = sums.centre_of_pressure
+        tri_kept = geo.triangles[keep]
+        vals_kept = geo.values if fld.location == "point" else geo.values[keep]
+        if parent is not None:
+            kept_ids = np.unique(parent[np.flatnonzero(keep)])  # compaction keeps the order
+            groups = [g.subset(np.isin(g.ids, kept_ids)) for g in groups]
+            groups = [g for g in groups if len(g.conn)]
+        geo = _geometry(src, geo.points, tri_kept, vals_kept, fld.location, thr, base)
+        if parent is not None:
+            exact = exact_load(groups, xy_native, v, fld.location)
+    _, tri_local, nvals, xy, height, weights, sums = geo
+    if exact is None:
+        N, cop = sums.N, sums.centre_of_pressure
+        refine_err = 0.0
+    else:
+        N, cop = float(exact[0]), exact[1:] / exact[0]
+        refine_err = float(sums.N / exact[0] - 1.0)
+        if abs(refine_err) > REFINE_TOL:
+            notes.append(
+                f"element faces cut into triangles carry {refine_err:+.2e} of the exact element load "
+                f"(finest cut within {REFINE_MAX_TRIANGLES:,} triangles)"
+            )
+        lobes = -float(face_loads(xy, tri_local, np.minimum(nvals, 0.0), fld.location).sum()) / N
+        if fld.location == "point" and lobes > 1e-4:
+            notes.append(
+                f"the quadratic interpolation dips below zero between nodes ({lobes:.2%} of the load): "
+                "kept, as the element's own field (not a sign error)"
+            )
     if frame is None:
         origin = base.to_global(cop[None, :])[0]  # on the plane: local z = 0
         fr = Frame(origin=origin, axes=base.axes)
@@ -419,22 +460,23 @@ def build_patch(
     r_equiv = float(np.sqrt(area / np.pi))
     rms = float(np.sqrt((weights @ (height * height)) / weights.sum()))
     if rms > PLANARITY_TOL * r_equiv:
+        _separate_surfaces(fld, groups, hot, points)
         plane = "its best-fit plane" if frame is None else "the given frame's plane (the static patch's)"
         raise PatchError(
-            f"{fld.source}: the contact patch is not planar (RMS distance from {plane} "
+            f"{src}: the contact patch is not planar (RMS distance from {plane} "
             f"{rms:.3g} m = {rms / r_equiv:.1%} of its radius, limit {PLANARITY_TOL:.0%}); "
             "are the coordinates undeformed? try --displacement NAME"
         )
+    check_scale(src, r_max, peak, fld.units)
     outside = load_outside(x, y, tri_local, nvals, fld.location, r_equiv, sums, r2=r2)
     circular = bool(aspect <= 1.0 + ASPECT_TOL and r_max / r_equiv <= RMAX_TOL)
-    notes = []
     if not circular:
         notes.append(
             f"patch is not circular (aspect {aspect:.3f}, r_max/r_equiv {r_max / r_equiv:.3f}); "
             "the paper's closed forms assume a circle"
         )
     return Patch(
-        source=fld.source,
+        source=src,
         field=fld.field,
         location=fld.location,
         frame=fr,
@@ -459,4 +501,10 @@ def build_patch(
         dropped_fragments=dropped,
         max_edge=sums.max_edge,
         notes=tuple(notes),
+        n_element_faces=sum(len(g.conn) for g in groups),
+        face_types=tuple(sorted({g.ftype for g in groups})),
+        refine_level=0 if exact is None else level,
+        refine_error=refine_err,
+        dropped_edge_faces=n_edge,
+        body=fld.body,
     )

@@ -13,7 +13,6 @@ resampled map still carries the FE load is checked by :func:`fepost.analysis.ana
 from __future__ import annotations
 
 import numpy as np
-import pyvista as pv
 
 from .errors import ArgumentError
 from .locate import interpolate
@@ -24,7 +23,9 @@ from .polar import PolarGrid, PolarMap
 METHODS = ("bins", "vtk")
 
 
-def _surface(patch: Patch) -> pv.PolyData:
+def _surface(patch: Patch):
+    import pyvista as pv
+
     pts = np.column_stack([patch.xy, np.zeros(len(patch.xy))])
     mesh = pv.PolyData.from_regular_faces(pts, patch.triangles)
     if patch.location == "point":
@@ -35,6 +36,8 @@ def _surface(patch: Patch) -> pv.PolyData:
 
 
 def _probe(patch: Patch, x: np.ndarray, y: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    import pyvista as pv
+
     probe = pv.PolyData(np.column_stack([x, y, np.zeros(x.size)]))
     # vtkCellLocator: builds faster than the static locator for one query batch
     out = probe.sample(_surface(patch), tolerance=1e-9 * radius, snap_to_closest_point=False, locator="cell")

@@ -54,3 +54,15 @@ def test_interpolation_holds_the_last_ring_up_to_the_rim():
     g = PolarGrid.make(6, 8)
     pm = PolarMap(g, 1.0, np.ones((6, 8)))
     assert pm.interpolate(0.9999, 0.0) == pytest.approx(1.0)
+
+
+def test_a_grid_beyond_memory_is_refused_with_an_estimate():
+    import re
+
+    from fepost.polar import BYTES_PER_NODE
+
+    with pytest.raises(ArgumentError) as err:
+        PolarGrid.make(100_000, 100_000)
+    msg = str(err.value)
+    assert re.match(r"polar grid nr x nphi = 100000 x 100000 = 1e\+10 nodes would need about 4 TB", msg)
+    assert 1e10 * BYTES_PER_NODE == pytest.approx(4e12)

@@ -38,6 +38,7 @@ COMMANDS = [
     "report",
     "diagnose",
     "predict",
+    "sweep",
 ]
 
 #: Exit statuses of ``fepost`` (the ``--help`` epilog and docs/cli-exit-codes.md).

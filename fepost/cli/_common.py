@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..errors import ArgumentError
+from ..reader.units import SYSTEMS  # a light module: no numpy
 from . import _validate as v
 
 
@@ -38,6 +39,18 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
         metavar="NAME",
         help="nodal displacement array added to the coordinates ('auto' default, 'none' to skip)",
     )
+    g.add_argument(
+        "--units",
+        metavar="SYSTEM",
+        help="the model's consistent unit system, converted to SI on reading: "
+        + ", ".join(s.name for s in SYSTEMS)
+        + " (aliases mm-t-s, mm-kg-ms, ...); default: SI, with implausible scales refused",
+    )
+    g.add_argument(
+        "--surface",
+        metavar="NAME",
+        help="take the contact faces from this Exodus side set or element block (name or id)",
+    )
     g.add_argument("--rolling-axis", metavar="X,Y,Z", help="global rolling direction (default 1,0,0)")
     g.add_argument("--threshold", type=v.fraction, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
     g.add_argument(
@@ -57,6 +70,7 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
 
 def analysis_kwargs(args: argparse.Namespace) -> dict:
     from ..polar import PolarGrid
+    from ..reader.units import unit_system
 
     axis = None
     if args.rolling_axis:
@@ -76,4 +90,6 @@ def analysis_kwargs(args: argparse.Namespace) -> dict:
         "grid": PolarGrid.make(args.nr, args.nphi, args.rule),
         "threshold": args.threshold,
         "rolling_axis": axis,
+        "units": unit_system(args.units),  # an unknown name fails here, before any file is read
+        "surface": args.surface,
     }

@@ -25,6 +25,11 @@ def add_parser(sub) -> None:
     p.set_defaults(func=run)
 
 
+def _pct(x: float) -> str:
+    """A signed percentage without a negative zero."""
+    return f"{(x if abs(x) >= 5e-5 else 0.0):+.2%}"
+
+
 def format_analysis(a: Analysis) -> str:
     """A readable table of the patch and the coefficients."""
     c, p = a.coefficients, a.static_patch
@@ -33,10 +38,18 @@ def format_analysis(a: Analysis) -> str:
         ("normal load N (polar)", f"{c.N:.6g} N"),
         ("normal load N_fe (FE faces)", f"{p.N_fe:.6g} N  (differs by {c.N / p.N_fe - 1:+.2e})"),
     ]
-    if p.reaction_z is not None:
-        rows.append(
-            ("solver reaction", f"{p.reaction_z:.6g} N  (N/reaction - 1 = {c.N / p.reaction_z - 1:+.2%})")
-        )
+    from ..analysis import reaction_candidates
+    from ..reader.units import describe
+
+    for name, value in reaction_candidates(a.static_field, p.frame.axes[2]).items():
+        rel = f"  (N_fe/|reaction| - 1 = {_pct(p.N_fe / abs(value) - 1)})" if value else ""
+        rows.append((f"solver {name}", f"{value:.6g} N{rel}"))
+    f = a.static_field
+    if f.step is not None:
+        rows.append(("time step", f"{f.step} of steps 0-{len(f.steps) - 1}  (t = {f.time:g} s)"))
+    if f.body:
+        rows.append(("faces from", f.body))
+    rows.append(("units", describe(f.units)))
     o = p.frame.origin
     rows += [
         ("patch centre (global)", f"({o[0]:.5g}, {o[1]:.5g}, {o[2]:.5g}) m"),

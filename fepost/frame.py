@@ -1,0 +1,106 @@
+"""The patch frame: the least-squares plane of the loaded nodes, and its axes.
+
+The plane's normal is the road normal z, oriented along the global axis it is
+closest to (z-up and y-up models both come out with z up); x is the rolling
+axis projected on the plane (default global x; when global x is normal to the
+patch, the global axis closest to the plane, with a warning); y = z × x.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._arrays import frozen
+from .errors import ArgumentError, PatchWarning
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Patch frame: ``origin`` (3,) in global coordinates (m); ``axes`` rows are x, y, z."""
+
+    origin: np.ndarray
+    axes: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "origin", frozen(self.origin))
+        object.__setattr__(self, "axes", frozen(self.axes))
+
+    def to_local(self, points) -> np.ndarray:
+        """Global (n, 3) points → patch coordinates (n, 3), m."""
+        return (np.asarray(points, float) - self.origin) @ self.axes.T
+
+    def to_global(self, local) -> np.ndarray:
+        """Patch coordinates (n, 2 or 3) → global (n, 3), m."""
+        local = np.asarray(local, float)
+        if local.shape[-1] == 2:
+            local = np.concatenate([local, np.zeros(local.shape[:-1] + (1,))], axis=-1)
+        return local @ self.axes + self.origin
+
+
+def _fmt(v) -> str:
+    """A vector as plain numbers: (1, 0, 0)."""
+    a = np.asarray(v, float).ravel()
+    a = np.where(np.abs(a) < 1e-9 * max(1.0, float(np.abs(a).max(initial=0.0))), 0.0, a) + 0.0
+    return "(" + ", ".join(f"{float(x):.3g}" for x in a) + ")"
+
+
+def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Weighted least-squares plane through ``points`` (n, 3): (centroid, unit normal, variances).
+
+    The second moments are accumulated column by column (one (n,) temporary)
+    about a node of the patch, so large global offsets cost no precision. The
+    variances (ascending) are those along the normal and the two in-plane axes.
+    """
+    w = weights / weights.sum()
+    ref = points[int(np.argmax(weights))]
+    c = w @ points - ref
+    m = np.empty((3, 3))
+    buf = np.empty(len(points))
+    cols = [points[:, k] for k in range(3)]
+    for a in range(3):
+        np.subtract(cols[a], ref[a], out=buf)
+        buf *= w
+        for b in range(a, 3):
+            m[a, b] = m[b, a] = buf @ cols[b] - ref[b] * buf.sum()
+    cov = m - np.outer(c, c)
+    evals, vecs = np.linalg.eigh(cov)
+    n = vecs[:, 0]
+    k = int(np.argmax(np.abs(n)))
+    if n[k] < 0:
+        n = -n
+    return c + ref, n, evals
+
+
+_AXIS_NAMES = ("x", "y", "z")
+
+
+def _axes(normal: np.ndarray, rolling_axis, source: str = "") -> tuple[np.ndarray, str]:
+    """Rows x, y, z of the patch frame, and a note when the default axis had to be replaced."""
+    note = ""
+    if rolling_axis is None:
+        ax = np.array([1.0, 0.0, 0.0])
+        if np.linalg.norm(ax - (ax @ normal) * normal) < 0.1:
+            k = int(np.argmin(np.abs(normal[1:]))) + 1  # the global axis closest to the plane (y or z)
+            ax = np.eye(3)[k]
+            note = (
+                f"rolling axis: global x is normal to the patch (normal {_fmt(normal)}); "
+                f"global {_AXIS_NAMES[k]} is used as the rolling direction x (give --rolling-axis to choose)"
+            )
+            warnings.warn(f"{source}: {note}", PatchWarning, stacklevel=4)
+    else:
+        ax = np.asarray(rolling_axis, float)
+        if ax.shape != (3,) or not np.all(np.isfinite(ax)) or np.linalg.norm(ax) == 0:
+            raise ArgumentError(f"rolling_axis must be a non-zero 3-vector, got {rolling_axis!r}")
+    ax = ax / np.linalg.norm(ax)
+    x = ax - (ax @ normal) * normal
+    if np.linalg.norm(x) < 0.1:
+        raise ArgumentError(
+            f"rolling axis {_fmt(ax)} is (nearly) normal to the patch plane "
+            f"(normal {_fmt(normal)}); give an in-plane rolling axis"
+        )
+    x /= np.linalg.norm(x)
+    y = np.cross(normal, x)
+    return np.vstack([x, y, normal]), note

@@ -1,0 +1,481 @@
+"""Run a reading function in a child process, so a malformed file cannot kill the caller.
+
+Why a child process
+-------------------
+VTK's readers and the netCDF/HDF5 libraries are C/C++ code: a corrupt or
+hostile file can make them dereference a wild pointer (SIGSEGV), abort
+(SIGABRT), allocate without bound or loop for ever. No amount of checking in
+Python catches that inside the process. fepost validates what it can before
+handing a file to those libraries (:mod:`fepost.reader.vtkcheck`,
+:mod:`fepost.reader.exodus`) and, in addition, reads every file in a forked
+child: a crash, a hang or an exhausted memory limit in the child becomes one
+:class:`~fepost.errors.InputFileError` in the caller.
+
+How
+---
+* ``os.fork`` (not :mod:`multiprocessing`): the child inherits the already
+  imported modules, starts in milliseconds, and works inside daemonic
+  processes (Dask workers), where ``multiprocessing`` refuses to start children.
+* The child's file descriptors 1 and 2 are redirected to an anonymous memory
+  file, so the C libraries' chatter is captured at the descriptor level; the
+  first error line is quoted in the message, nothing reaches the terminal.
+* The child's address space is limited (:data:`MEMORY_BUDGET` beyond what it
+  holds at the fork), so a header declaring 10¹² points fails fast.
+* The result travels back as a pickle (protocol 5) whose large numpy buffers
+  go out of band into an anonymous shared memory map made before the fork
+  (the caller's arrays are views of it: one copy in the child, none in the
+  caller, no files); what does not fit goes through the pipe.
+* The parent waits with a deadline (:func:`timeout_for`); a child that misses
+  it is killed.
+* Warnings the child issues are recorded and re-issued in the caller (fepost
+  warnings only); exceptions are re-raised (fepost errors as they are, anything
+  else as a one-line :class:`~fepost.errors.InputFileError` whose cause holds
+  the child's traceback, shown by ``fepost --debug``).
+
+Where ``os.fork`` does not exist, or with ``FEPOST_READ_ISOLATION=off``, the
+function runs in the calling process (the validation still applies).
+"""
+
+from __future__ import annotations
+
+import io
+import mmap
+import os
+import pickle
+import select
+import signal
+import struct
+import sys
+import time
+import traceback
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+from ..errors import FepostError, FepostWarning, InputFileError
+
+#: Environment variable: ``off`` reads in the calling process (no child).
+ISOLATION_ENV = "FEPOST_READ_ISOLATION"
+#: Environment variable: the read timeout in seconds (overrides :func:`timeout_for`).
+TIMEOUT_ENV = "FEPOST_READ_TIMEOUT"
+#: Base read timeout, s, plus :data:`TIMEOUT_PER_MB` per MB of file.
+TIMEOUT_BASE = 60.0
+TIMEOUT_PER_MB = 2.0
+#: Address space the child may add to what it holds at the fork: max of this and 64 × the file size, bytes.
+MEMORY_BUDGET = 6 << 30
+#: Pipe size asked for on Linux (fewer wake-ups on large results).
+_PIPE_SIZE = 1 << 20
+#: Shared memory mapped for the results: this many times the file size, plus a floor (virtual
+#: memory: pages cost only when written).
+SHARED_FACTOR = 16
+SHARED_FLOOR = 64 << 20
+SHARED_CAP = 8 << 30
+_LEN = struct.Struct("<Q")
+_ALIGN = 64
+
+
+class ChildTraceback(Exception):
+    """The traceback of an unexpected exception in the reading child (for ``--debug``)."""
+
+
+def isolation_enabled() -> bool:
+    """True when files are read in a forked child (the default where ``os.fork`` exists)."""
+    return hasattr(os, "fork") and os.environ.get(ISOLATION_ENV, "").strip().lower() not in ("off", "0", "no")
+
+
+def timeout_for(nbytes: int) -> float:
+    """The read deadline (s) for a file of ``nbytes``; ``FEPOST_READ_TIMEOUT`` overrides it."""
+    env = os.environ.get(TIMEOUT_ENV)
+    if env:
+        try:
+            value = float(env)
+        except ValueError:
+            value = float("nan")
+        if value > 0:
+            return value
+    return TIMEOUT_BASE + TIMEOUT_PER_MB * nbytes / 1e6
+
+
+def call(
+    func: Callable[..., Any],
+    *args: Any,
+    what: str,
+    nbytes: int = 0,
+    timeout: float | None = None,
+    **kwargs: Any,
+) -> Any:
+    """Return ``func(*args, **kwargs)``, computed in a forked child when isolation is enabled.
+
+    Parameters
+    ----------
+    what : str
+        The file being read: the prefix of every error message.
+    nbytes : int
+        Its size in bytes (sets the deadline and the memory budget).
+    timeout : float, optional
+        Deadline in s (default :func:`timeout_for`).
+
+    Raises
+    ------
+    FepostError
+        Whatever ``func`` raised on purpose.
+    InputFileError
+        The child crashed, ran out of memory or time, or ``func`` failed unexpectedly.
+    """
+    return start(func, *args, what=what, nbytes=nbytes, timeout=timeout, **kwargs).result()
+
+
+class Pending:
+    """A call started by :func:`start`: :meth:`result` waits for it, :meth:`cancel` abandons it."""
+
+    def __init__(self, what: str, value: Any = None, error: BaseException | None = None, child=None):
+        self.what = what
+        self._value, self._error, self._child = value, error, child
+
+    def result(self) -> Any:
+        """The function's value (raises what it raised, or the child's failure)."""
+        if self._child is not None:
+            child, self._child = self._child, None
+            try:
+                self._value = _finish(*child)
+            except BaseException as exc:
+                self._error = exc
+        if self._error is not None:
+            error, self._error = self._error, None
+            raise error
+        return self._value
+
+    def cancel(self) -> None:
+        """Kill the child if it still runs (nothing is left behind)."""
+        if self._child is not None:
+            pid, reader = self._child[0], self._child[1]
+            self._child = None
+            _reap(pid, kill=True)
+            reader.close()
+
+    def __del__(self) -> None:
+        try:
+            self.cancel()
+        except Exception:  # interpreter shutdown: nothing more to do
+            pass
+
+
+def start(
+    func: Callable[..., Any],
+    *args: Any,
+    what: str,
+    nbytes: int = 0,
+    timeout: float | None = None,
+    **kwargs: Any,
+) -> Pending:
+    """Start ``func(*args, **kwargs)`` in a forked child and return at once (see :func:`call`).
+
+    The caller can go on with other work (imports, a second file) while the
+    child reads; without isolation the function runs here and now.
+    """
+    if not isolation_enabled():
+        try:
+            return Pending(what, value=_in_process(func, args, kwargs, what))
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BaseException as exc:
+            return Pending(what, error=exc)
+    deadline = timeout if timeout is not None else timeout_for(nbytes)
+    return Pending(what, child=_fork(func, args, kwargs, what, nbytes, deadline))
+
+
+def _unexpected(what: str, exc: BaseException, tb: str) -> InputFileError:
+    first = _first_line(exc)
+    err = InputFileError(f"{what}: cannot read the file ({type(exc).__name__}: {first})")
+    err.__cause__ = ChildTraceback(tb)
+    return err
+
+
+def _first_line(obj: object) -> str:
+    lines = [ln.strip() for ln in str(obj).strip().splitlines() if ln.strip()]
+    text = lines[0] if lines else type(obj).__name__
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+def _in_process(func, args, kwargs, what):
+    try:
+        return func(*args, **kwargs)
+    except FepostError:
+        raise
+    except MemoryError:
+        raise InputFileError(
+            f"{what}: not enough memory to read the file (declared sizes too large?)"
+        ) from None
+    except (KeyboardInterrupt, SystemExit):
+        raise
+    except Exception as exc:  # a library error on a malformed file: one line, never a traceback
+        raise _unexpected(what, exc, traceback.format_exc()) from None
+
+
+# ----------------------------------------------------------------------------- child side
+
+
+def _limit_memory(nbytes: int) -> None:
+    try:
+        import resource
+
+        with open("/proc/self/statm", "rb") as fh:
+            vsize = int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+        budget = max(MEMORY_BUDGET, 64 * nbytes)
+        resource.setrlimit(resource.RLIMIT_AS, (vsize + budget, vsize + budget))
+    except (OSError, ValueError, ImportError, AttributeError):
+        pass  # no /proc or no limits on this platform: the deadline still applies
+
+
+def _capture_fd() -> int:
+    """An anonymous file the child's stdout and stderr are redirected to."""
+    if hasattr(os, "memfd_create"):
+        try:
+            return os.memfd_create("fepost-read-chatter")
+        except OSError:
+            pass
+    import tempfile
+
+    return os.dup(tempfile.TemporaryFile().fileno())
+
+
+def _chatter(fd: int, limit: int = 1 << 16) -> str:
+    try:
+        os.lseek(fd, 0, os.SEEK_SET)
+        return os.read(fd, limit).decode("utf-8", "replace")
+    except OSError:
+        return ""
+
+
+def _write_all(fd: int, data) -> None:
+    view = memoryview(data).cast("B")
+    while view.nbytes:
+        n = os.write(fd, view)
+        view = view[n:]
+
+
+def _send(fd: int, payload: Any, shm: mmap.mmap | None) -> None:
+    """Write the payload: header, then per buffer its place (shared-memory offset, or 2⁶⁴−1: the pipe)."""
+    buffers: list[pickle.PickleBuffer] = []
+    head = pickle.dumps(payload, protocol=5, buffer_callback=buffers.append)
+    raws = [b.raw() for b in buffers]
+    places, pos = [], 0
+    for r in raws:
+        if shm is not None and pos + r.nbytes <= len(shm):
+            shm[pos : pos + r.nbytes] = r
+            places.append(pos)
+            pos += -(-r.nbytes // _ALIGN) * _ALIGN
+        else:
+            places.append(_PIPE)
+    table = b"".join(_LEN.pack(r.nbytes) + _LEN.pack(at) for r, at in zip(raws, places, strict=True))
+    _write_all(fd, _LEN.pack(len(head)) + _LEN.pack(len(raws)) + table)
+    _write_all(fd, head)
+    for r, at in zip(raws, places, strict=True):
+        if at == _PIPE:
+            _write_all(fd, r)
+
+
+_PIPE = (1 << 64) - 1
+
+
+def _child_main(wfd: int, func, args, kwargs, nbytes: int, shm: mmap.mmap | None) -> None:
+    import faulthandler
+
+    faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    cap = _capture_fd()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.dup2(cap, 1)
+    os.dup2(cap, 2)
+    _limit_memory(nbytes)
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        try:
+            result = func(*args, **kwargs)
+            payload: tuple = ("ok", result)
+        except FepostError as exc:
+            payload = ("fepost", exc)
+        except MemoryError:
+            payload = ("memory", None)
+        except BaseException as exc:  # reported to the parent as one line
+            payload = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
+    caught = [(w.category, str(w.message)) for w in rec if issubclass(w.category, FepostWarning)]
+    text = _chatter(cap)
+    try:
+        _send(wfd, (payload, caught, text), shm)
+    except Exception as exc:  # the result itself could not be pickled: say so
+        other = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
+        _send(wfd, (other, caught, text), None)
+
+
+# ----------------------------------------------------------------------------- parent side
+
+
+class _Deadline(Exception):
+    pass
+
+
+class _Reader:
+    def __init__(self, fd: int, deadline: float):
+        self.f = io.FileIO(fd, "rb", closefd=True)
+        self.deadline = deadline
+
+    def _wait(self) -> None:
+        left = self.deadline - time.monotonic()
+        if left <= 0:
+            raise _Deadline
+        ready, _, _ = select.select([self.f], [], [], left)
+        if not ready:
+            raise _Deadline
+
+    def exact(self, n: int) -> bytearray:
+        buf = bytearray(n)
+        view = memoryview(buf)
+        pos = 0
+        while pos < n:
+            self._wait()
+            got = self.f.readinto(view[pos:])
+            if not got:
+                raise EOFError
+            pos += got
+        return buf
+
+    def close(self) -> None:
+        self.f.close()
+
+
+def _signal_name(sig: int) -> str:
+    try:
+        return signal.Signals(sig).name
+    except ValueError:
+        return f"signal {sig}"
+
+
+def _chatter_summary(text: str) -> str:
+    """The first line of the captured C-level output that says what went wrong."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    for ln in lines:
+        low = ln.lower()
+        if "error" in low and not low.startswith("error: in "):
+            return _first_line(ln)
+    return _first_line(lines[0]) if lines else ""
+
+
+def _reap(pid: int, kill: bool) -> int:
+    if kill:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    while True:
+        try:
+            _, status = os.waitpid(pid, 0)
+            return status
+        except ChildProcessError:
+            return 0
+        except InterruptedError:
+            continue
+
+
+def _shared(nbytes: int) -> mmap.mmap | None:
+    size = min(SHARED_CAP, SHARED_FLOOR + SHARED_FACTOR * nbytes)
+    try:
+        return mmap.mmap(-1, size)  # anonymous and shared with the child
+    except (OSError, ValueError, OverflowError):
+        return None  # no room for the map: everything goes through the pipe
+
+
+def _fork(func, args, kwargs, what, nbytes, timeout):
+    import fcntl
+
+    shm = _shared(nbytes)
+    rfd, wfd = os.pipe()
+    if hasattr(fcntl, "F_SETPIPE_SZ"):
+        try:
+            fcntl.fcntl(wfd, fcntl.F_SETPIPE_SZ, _PIPE_SIZE)
+        except OSError:
+            pass
+    sys.stdout.flush()
+    sys.stderr.flush()
+    with warnings.catch_warnings():
+        # Python >= 3.12 warns about forking a multi-threaded process; the child
+        # only reads a file and exits through os._exit, and a deadline guards it.
+        warnings.simplefilter("ignore", DeprecationWarning)
+        pid = os.fork()
+    if pid == 0:  # child: never returns into the caller's stack
+        code = 0
+        try:
+            os.close(rfd)
+            _child_main(wfd, func, args, kwargs, nbytes, shm)
+        except BaseException:
+            code = 70
+        finally:
+            os._exit(code)
+    os.close(wfd)
+    return pid, _Reader(rfd, time.monotonic() + timeout), what, timeout, shm
+
+
+def _finish(pid: int, reader: _Reader, what: str, timeout: float, shm: mmap.mmap | None):
+    received = None
+    killed = False
+    try:
+        try:
+            sizes = reader.exact(16)
+            nhead, nbuf = _LEN.unpack_from(sizes, 0)[0], _LEN.unpack_from(sizes, 8)[0]
+            table = reader.exact(16 * nbuf)
+            head = reader.exact(nhead)
+            bufs: list = []
+            view = memoryview(shm) if shm is not None else None
+            for i in range(nbuf):
+                n, at = _LEN.unpack_from(table, 16 * i)[0], _LEN.unpack_from(table, 16 * i + 8)[0]
+                if at == _PIPE or view is None:
+                    bufs.append(reader.exact(n))
+                elif at + n <= len(view):
+                    bufs.append(view[at : at + n])  # the arrays are views of the shared map: no copy
+                else:
+                    raise ValueError("shared-memory place out of range")
+            received = pickle.loads(head, buffers=bufs)
+        except _Deadline:
+            killed = True
+        except (EOFError, pickle.UnpicklingError, struct.error, ValueError):
+            received = None
+    except BaseException:  # KeyboardInterrupt in the parent: do not leave the child behind
+        _reap(pid, kill=True)
+        reader.close()
+        raise
+    status = _reap(pid, kill=killed or received is None)
+    reader.close()
+    if killed:
+        raise InputFileError(
+            f"{what}: reading did not finish within {timeout:.0f} s (malformed or hostile file?); "
+            f"set {TIMEOUT_ENV} to allow more time"
+        )
+    if received is None:
+        if os.WIFSIGNALED(status):
+            sig = os.WTERMSIG(status)
+            if sig == signal.SIGKILL:
+                cause = "killed (out of memory?)"
+            else:
+                cause = f"crashed ({_signal_name(sig)})"
+        else:
+            cause = f"failed (exit status {os.WEXITSTATUS(status)})"
+        raise InputFileError(f"{what}: the file reader {cause}: corrupt or malformed file")
+    (kind, value), caught, text = received
+    for category, message in caught:
+        warnings.warn(message, category, stacklevel=3)
+    if kind == "ok":
+        return value
+    if kind == "fepost":
+        raise value
+    if kind == "memory":
+        raise InputFileError(f"{what}: not enough memory to read the file (declared sizes too large?)")
+    name, first, tb = value
+    detail = _chatter_summary(text)
+    msg = f"{what}: cannot read the file ({name}: {first})"
+    if detail and detail not in msg:
+        msg = f"{msg}; reader said: {detail}"
+    err = InputFileError(msg)
+    err.__cause__ = ChildTraceback(tb)
+    raise err

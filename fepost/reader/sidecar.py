@@ -1,0 +1,59 @@
+"""The optional sidecar ``<stem>.json`` beside an FE export, read and validated.
+
+A sidecar is a JSON object whose keys describe the run (``reaction_z``: the
+solver's total normal reaction, in the model's force unit; ``inflation_pressure``;
+``deflection``; …). It is checked before use: an object at the top, at most
+:data:`MAX_BYTES`, no ``NaN``/``Infinity`` literals, and every key fepost reads
+(:data:`NUMBER_KEYS`) either absent, null or a finite number (not a boolean).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from ..errors import InputFileError
+
+#: Largest sidecar accepted, bytes.
+MAX_BYTES = 1 << 20
+#: Keys fepost reads as numbers.
+NUMBER_KEYS = ("reaction_z", "inflation_pressure", "deflection", "friction", "cpress_integral")
+
+
+def _no_constants(name: str):
+    raise ValueError(f"non-finite number {name}")
+
+
+def read_sidecar(path: Path) -> dict | None:
+    """The validated sidecar of ``path`` (``<stem>.json``), or None when there is none.
+
+    Raises
+    ------
+    InputFileError
+        Unreadable, too large, not a JSON object, or a number key that is not a finite number.
+    """
+    side = path.with_suffix(".json")
+    if side == path or not side.is_file():
+        return None
+    try:
+        size = side.stat().st_size
+        if size > MAX_BYTES:
+            raise InputFileError(f"{side}: sidecar JSON is {size} bytes (limit {MAX_BYTES})")
+        data = json.loads(side.read_bytes(), parse_constant=_no_constants)
+    except InputFileError:
+        raise
+    except (OSError, ValueError, RecursionError) as exc:
+        text = str(exc).strip().splitlines()
+        raise InputFileError(
+            f"{side}: unreadable sidecar JSON ({text[0] if text else type(exc).__name__})"
+        ) from None
+    if not isinstance(data, dict):
+        raise InputFileError(f"{side}: sidecar JSON must be an object, got {type(data).__name__}")
+    for key in NUMBER_KEYS:
+        v = data.get(key)
+        if v is None:
+            continue
+        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+            raise InputFileError(f"{side}: sidecar key {key!r} must be a finite number, got {v!r}")
+    return data

@@ -1,0 +1,80 @@
+"""Checks of VTK files before VTK reads them: declared sizes against the data, hostile XML.
+
+:func:`check_file` dispatches to :mod:`.xmlcheck` (XML) and :mod:`.legacycheck` (legacy).
+
+VTK's readers trust a file's header: a piece declaring fewer cells than its
+arrays hold is read as that many cells (a silently partial result), declared
+sizes far beyond the data make them allocate without bound, and some
+inconsistencies crash them. This module reads only the *structure* of a file
+(tags, attributes, the length headers of binary arrays, token counts of ASCII
+arrays; no array is decoded) and refuses a file whose header disagrees with
+its data, before VTK sees it:
+
+XML (``.vtu .vtp .vtm``)
+    no DOCTYPE or ENTITY declarations (entity expansion), tags nested at most
+    :data:`MAX_DEPTH` deep and balanced, the root type matching the suffix,
+    ``NumberOfPoints``/``NumberOfCells`` (``NumberOf{Verts,Lines,Strips,Polys}``)
+    non-negative and within :data:`MAX_COUNT`, every data array's length
+    (from its binary header — plain or compressed blocks, inline base64 or
+    appended raw/base64 — or its ASCII token count) equal to what the piece
+    declares, and the bytes it announces present in the file. A ``.vtm``'s
+    pieces are checked in turn (they must be VTK XML files that exist).
+Legacy (``.vtk``, ASCII or binary, ``UNSTRUCTURED_GRID`` and ``POLYDATA``)
+    every section's declared count (``POINTS``, ``CELLS``/``OFFSETS``/
+    ``CONNECTIVITY``, ``CELL_TYPES``, ``POINT_DATA``/``CELL_DATA`` arrays,
+    ``FIELD`` arrays) matches the values that follow: a section followed by
+    more numbers than declared, or by fewer, is refused.
+
+The structure is VTK's documented file format ("VTK File Formats", VTK User's
+Guide); nothing here is used to *read* data, only to decide whether VTK may.
+Corruption inside the data (a bad zlib block, wild connectivity) is left to
+VTK's own errors, to the connectivity check after reading, and to the child
+process the file is read in (:mod:`fepost.reader.isolate`).
+"""
+
+from __future__ import annotations
+
+import mmap
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputFileError
+
+#: Deepest XML nesting accepted (VTK files need about 6).
+MAX_DEPTH = 32
+#: Largest point, cell or value count accepted from a header.
+MAX_COUNT = (1 << 31) - 1
+#: Most nested .vtm files followed.
+MAX_VTM_DEPTH = 4
+
+
+@dataclass
+class Counts:
+    """What a checked file declares, for the comparison after VTK has read it."""
+
+    connectivity: list[int] = field(default_factory=list)  # values of each piece's connectivity arrays
+
+
+def _bad(path: Path, what: str) -> InputFileError:
+    """The one-line error for ``path``: refusals as they are, everything else as corrupt or truncated."""
+    if what.startswith("refused: "):
+        return InputFileError(f"{path}: refused {path.suffix} file ({what[len('refused: ') :]})")
+    return InputFileError(f"{path}: corrupt or truncated {path.suffix} file ({what})")
+
+
+def check_file(path: Path, depth: int = 0) -> Counts:
+    """Check ``path`` (suffix-chosen); raise :class:`InputFileError` on any inconsistency."""
+    suffix = path.suffix.lower()
+    try:
+        with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+            if suffix == ".vtk":
+                from .legacycheck import Legacy
+
+                return Legacy(path, data[:]).check()
+            from .xmlcheck import Xml
+
+            return Xml(path, data, depth).check()
+    except InputFileError:
+        raise
+    except (OSError, ValueError) as exc:
+        raise _bad(path, f"cannot read ({getattr(exc, 'strerror', None) or exc})") from None

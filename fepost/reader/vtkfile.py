@@ -1,0 +1,357 @@
+"""VTK files (XML ``.vtu .vtp .vtm`` and legacy ``.vtk``) read with VTK's own readers.
+
+VTK's readers are used directly (``vtkmodules``, not pyvista: the same
+readers, a third of the import time). Each file is first checked by
+:mod:`fepost.reader.vtkcheck` (declared sizes against the data, hostile XML);
+VTK's error messages are collected through a string output window and any
+error fails the read (VTK goes on after many errors and returns partial data).
+The cells are grouped by type into :class:`~fepost.reader.raw.Block` s with the
+canonical node ordering of :mod:`fepost.reader.cells`; the pieces of a
+multi-block file are kept apart (never merged: two bodies in contact share
+node positions).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputFileError
+from .cells import SPECS, VTK_TYPES, check_connectivity
+from .raw import Block, RawMesh
+
+VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm")
+#: VTK cell types without area that are passed over (named in the notes): they carry no contact pressure.
+_PASSED_OVER = {2: "poly-vertex", 4: "poly-line", 35: "cubic line", 68: "Lagrange curve", 75: "Bezier curve"}
+#: VTK cell types with area that fepost cannot read: refused by name, so no load is dropped silently.
+_UNSUPPORTED = {
+    6: "triangle-strip",
+    7: "polygon",
+    42: "polyhedron",
+    69: "Lagrange triangle",
+    70: "Lagrange quadrilateral",
+    71: "Lagrange tetrahedron",
+    72: "Lagrange hexahedron",
+    73: "Lagrange wedge",
+    74: "Lagrange pyramid",
+}
+
+
+class _ErrorWindow:
+    """Route VTK's messages into a string for the duration of a read."""
+
+    def __enter__(self):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
+
+        self._old = vtkOutputWindow.GetInstance()
+        self.window = vtkStringOutputWindow()
+        vtkOutputWindow.SetInstance(self.window)
+        return self
+
+    def __exit__(self, *exc):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow
+
+        vtkOutputWindow.SetInstance(self._old)
+        return False
+
+    def errors(self) -> list[str]:
+        text = self.window.GetOutput() or ""
+        out = []
+        lines = text.splitlines()
+        for i, ln in enumerate(lines):
+            if ln.strip().startswith("ERROR"):
+                # the message follows on the next line ("vtkXMLReader (0x..): message")
+                msg = lines[i + 1].strip() if i + 1 < len(lines) else ln.strip()
+                if "):" in msg:
+                    msg = msg.split("):", 1)[1].strip()
+                out.append(msg or ln.strip())
+        return out
+
+
+def _reader_for(suffix: str):
+    if suffix == ".vtu":
+        from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+        return vtkXMLUnstructuredGridReader()
+    if suffix == ".vtp":
+        from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+
+        return vtkXMLPolyDataReader()
+    if suffix == ".vtm":
+        from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataReader
+
+        return vtkXMLMultiBlockDataReader()
+    from vtkmodules.vtkIOLegacy import vtkDataSetReader
+
+    r = vtkDataSetReader()
+    r.ReadAllScalarsOn()
+    r.ReadAllVectorsOn()
+    r.ReadAllNormalsOn()
+    r.ReadAllTensorsOn()
+    r.ReadAllFieldsOn()
+    r.ReadAllColorScalarsOn()
+    return r
+
+
+def _leaves(obj) -> list:
+    from vtkmodules.vtkCommonDataModel import vtkMultiBlockDataSet
+
+    if obj is None:
+        return []
+    if isinstance(obj, vtkMultiBlockDataSet):
+        out = []
+        for i in range(obj.GetNumberOfBlocks()):
+            out += _leaves(obj.GetBlock(i))
+        return out
+    return [obj]
+
+
+def read_vtk(path: Path) -> RawMesh:
+    """Read a VTK file into a :class:`~fepost.reader.raw.RawMesh`."""
+    from .vtkcheck import check_file
+
+    suffix = path.suffix.lower()
+    counts = check_file(path)
+    reader = _reader_for(suffix)
+    with _ErrorWindow() as win:
+        reader.SetFileName(str(path))
+        reader.Update()
+        out = reader.GetOutputDataObject(0)
+    errors = win.errors()
+    if errors:
+        raise InputFileError(f"{path}: corrupt or truncated {suffix} file ({errors[0]})")
+    if reader.GetErrorCode():
+        from vtkmodules.vtkCommonCore import vtkErrorCode  # type: ignore[attr-defined]
+
+        raise InputFileError(
+            f"{path}: cannot read {suffix} file "
+            f"({vtkErrorCode.GetStringFromErrorCode(reader.GetErrorCode())})"
+        )
+    leaves = [leaf for leaf in _leaves(out) if leaf is not None and leaf.GetNumberOfPoints() > 0]
+    if not leaves:
+        raise InputFileError(f"{path}: the file holds no mesh (0 nodes or 0 cells)")
+    raw = _assemble(path, leaves, f"VTK {'legacy' if suffix == '.vtk' else 'XML'} ({suffix})")
+    declared = sum(counts.connectivity)
+    if declared and suffix != ".vtm" and declared != raw.connectivity_size:
+        raise InputFileError(
+            f"{path}: the header disagrees with the data: the connectivity holds {declared} values, "
+            f"the declared cells use {raw.connectivity_size}"
+        )
+    return raw
+
+
+def _as_unstructured(ds):
+    from vtkmodules.vtkCommonDataModel import vtkPolyData, vtkUnstructuredGrid
+
+    if isinstance(ds, vtkUnstructuredGrid | vtkPolyData):
+        return ds
+    from vtkmodules.vtkFiltersCore import vtkAppendFilter
+
+    f = vtkAppendFilter()
+    f.AddInputData(ds)
+    f.Update()
+    return f.GetOutput()
+
+
+def _vtk_at_least(major: int, minor: int) -> bool:
+    from vtkmodules.vtkCommonCore import vtkVersion
+
+    return (vtkVersion.GetVTKMajorVersion(), vtkVersion.GetVTKMinorVersion()) >= (major, minor)
+
+
+def _np(arr) -> np.ndarray:
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    return vtk_to_numpy(arr)
+
+
+def _cells(ds) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(types, offsets (m + 1), connectivity) of all cells of a data set."""
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+
+    if isinstance(ds, vtkPolyData):
+        parts = []
+        for getter, vtype in ((ds.GetVerts, 1), (ds.GetLines, 3), (ds.GetPolys, 7), (ds.GetStrips, 6)):
+            ca = getter()
+            if ca is None or ca.GetNumberOfCells() == 0:
+                continue
+            off = np.asarray(_np(ca.GetOffsetsArray()), np.int64)
+            con = np.asarray(_np(ca.GetConnectivityArray()), np.int64)
+            size = np.diff(off)
+            t = np.full(len(size), vtype, np.uint8)
+            if vtype == 7:
+                t[size == 3] = 5
+                t[size == 4] = 9
+            elif vtype == 3:
+                t[size != 2] = 4
+            elif vtype == 1:
+                t[size != 1] = 2
+            parts.append((t, off, con))
+        if not parts:
+            return np.empty(0, np.uint8), np.zeros(1, np.int64), np.empty(0, np.int64)
+        types = np.concatenate([p[0] for p in parts])
+        cons, offs, base = [], [np.zeros(1, np.int64)], 0
+        for _, off, con in parts:
+            offs.append(off[1:] + base)
+            cons.append(con)
+            base += len(con)
+        return types, np.concatenate(offs), np.concatenate(cons)
+    cells = ds.GetCells()
+    if cells is None or ds.GetNumberOfCells() == 0:
+        return np.empty(0, np.uint8), np.zeros(1, np.int64), np.empty(0, np.int64)
+    # GetCellTypes returns the array from VTK 9.6 on (GetCellTypesArray is deprecated there)
+    getter = ds.GetCellTypes if _vtk_at_least(9, 6) else ds.GetCellTypesArray
+    types = np.asarray(_np(getter()), np.uint8)
+    off = np.asarray(_np(cells.GetOffsetsArray()), np.int64)
+    con = np.asarray(_np(cells.GetConnectivityArray()), np.int64)
+    return types, off, con
+
+
+def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
+    pts_parts: list[np.ndarray] = []
+    blocks: list[Block] = []
+    point_pieces: list[dict[str, np.ndarray]] = []
+    sizes: list[int] = []
+    components: dict[str, tuple[str, ...]] = {}
+    skipped: dict[str, int] = {}
+    base = 0
+    first_cell = 0
+    conn_size = 0
+    for piece, leaf in enumerate(leaves):
+        ds = _as_unstructured(leaf)
+        n = int(ds.GetNumberOfPoints())
+        pts = np.asarray(_np(ds.GetPoints().GetData()), float).reshape(n, 3)
+        if not np.all(np.isfinite(pts)):
+            bad = int(np.sum(~np.isfinite(pts).all(axis=1)))
+            raise InputFileError(f"{path}: {bad} node coordinates are NaN or infinite")
+        pts_parts.append(pts)
+        point_pieces.append(_point_data(path, ds, n, components))
+        sizes.append(n)
+        types, off, con = _cells(ds)
+        conn_size += len(con)
+        if len(off) != len(types) + 1:
+            raise InputFileError(f"{path}: cell offsets and cell types disagree in length (corrupt file)")
+        if len(types):
+            if off[0] != 0 or np.any(np.diff(off) < 0) or off[-1] != len(con):
+                raise InputFileError(
+                    f"{path}: cell offsets are inconsistent with the connectivity (corrupt file)"
+                )
+            check_connectivity(con, n, str(path))
+        cdata = _cell_data(path, ds, len(types), components)
+        where = f" of piece {piece + 1}" if len(leaves) > 1 else ""
+        present = np.flatnonzero(np.bincount(types, minlength=256)) if len(types) else np.empty(0, np.int64)
+        single = len(present) == 1
+        for t in present:
+            sel: np.ndarray | slice = slice(None) if single else np.flatnonzero(types == t)
+            spec = VTK_TYPES.get(int(t))
+            count = len(types) if isinstance(sel, slice) else len(sel)
+            if spec is None:
+                if int(t) in _PASSED_OVER:
+                    skipped[_PASSED_OVER[int(t)]] = skipped.get(_PASSED_OVER[int(t)], 0) + count
+                    continue
+                what = _UNSUPPORTED.get(int(t), "an unknown type")
+                raise InputFileError(
+                    f"{path}: {count} cell(s) of VTK type {int(t)} ({what}) cannot be read: "
+                    "convert them to triangles or quadrilaterals (or the file is corrupt)"
+                )
+            canon, perm = spec
+            k = SPECS[canon].n_nodes
+            if single and len(con) == k * count:
+                # one cell type throughout: the offsets must step by k, the connectivity is a (m, k) view
+                if np.any(off != np.arange(0, k * count + 1, k)):
+                    raise InputFileError(
+                        f"{path}: cell offsets are inconsistent with {canon} cells (corrupt file)"
+                    )
+                conn = con.reshape(count, k)
+            else:
+                idx = sel if isinstance(sel, np.ndarray) else np.arange(len(types))
+                size = off[idx + 1] - off[idx]
+                if np.any(size != k):
+                    raise InputFileError(
+                        f"{path}: {canon} cells with {int(size[size != k][0])} nodes instead of {k} "
+                        "(corrupt file)"
+                    )
+                conn = con[off[idx][:, None] + np.arange(k)[None, :]]
+            if perm is not None:
+                conn = conn[:, list(perm)]
+            if base:
+                conn = conn + base
+            block = Block(f"{canon.upper()} cells{where} ({count})", canon, conn, first_cell, piece)
+            for name, arr in cdata.items():
+                block.cell_data.add(name, arr[sel])
+            blocks.append(block)
+            first_cell += count
+        base += n
+    points = pts_parts[0] if len(pts_parts) == 1 else np.concatenate(pts_parts)
+    raw = RawMesh(path=str(path), format=fmt, points=points, blocks=blocks, components=components)
+    for name, arr in _join(point_pieces, sizes).items():
+        raw.point_data.add(name, arr)
+    raw.skipped = skipped
+    raw.connectivity_size = conn_size
+    return raw
+
+
+def _numeric(arr) -> bool:
+    from vtkmodules.vtkCommonCore import vtkDataArray
+
+    return isinstance(arr, vtkDataArray)
+
+
+def _point_data(path, ds, n: int, components) -> dict[str, np.ndarray]:
+    pd = ds.GetPointData()
+    out = {}
+    for i in range(pd.GetNumberOfArrays()):
+        arr = pd.GetAbstractArray(i)
+        name = arr.GetName() if arr is not None else None
+        if not name or not _numeric(arr):
+            continue  # string and unnamed arrays carry no field values
+        a = np.asarray(_np(arr))
+        if a.shape[0] != n:
+            raise InputFileError(f"{path}: point array {name!r} has {a.shape[0]} values for {n} nodes")
+        if arr.GetNumberOfComponents() > 1:
+            names = tuple(arr.GetComponentName(k) or "" for k in range(arr.GetNumberOfComponents()))
+            if any(names):
+                components.setdefault(name, names)
+        out[name] = a
+    return out
+
+
+def _join(pieces: list[dict[str, np.ndarray]], sizes: list[int]) -> dict[str, np.ndarray]:
+    """Point arrays of several pieces end to end; a piece without an array gets zeros there."""
+    if len(pieces) == 1:
+        return pieces[0]
+    shapes: dict[str, tuple] = {}
+    for p in pieces:
+        for name, a in p.items():
+            shapes.setdefault(name, a.shape[1:])
+    out = {}
+    for name, tail in shapes.items():
+        parts: list[np.ndarray] = []
+        for p, n in zip(pieces, sizes, strict=True):
+            got = p.get(name)
+            parts.append(got if got is not None and got.shape[1:] == tail else np.zeros((n, *tail)))
+        out[name] = np.concatenate(parts)
+    return out
+
+
+def _cell_data(path, ds, m: int, components) -> dict[str, np.ndarray]:
+    cd = ds.GetCellData()
+    out = {}
+    for i in range(cd.GetNumberOfArrays()):
+        arr = cd.GetAbstractArray(i)
+        name = arr.GetName() if arr is not None else None
+        if not name or not _numeric(arr):
+            continue
+        a = np.asarray(_np(arr))
+        if a.shape[0] != m:
+            raise InputFileError(f"{path}: cell array {name!r} has {a.shape[0]} values for {m} cells")
+        if arr.GetNumberOfComponents() > 1:
+            names = tuple(arr.GetComponentName(k) or "" for k in range(arr.GetNumberOfComponents()))
+            if any(names):
+                components.setdefault(name, names)
+        out[name] = a
+    return out
+
+
+__all__ = ["VTK_SUFFIXES", "read_vtk"]

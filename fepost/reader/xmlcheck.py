@@ -1,0 +1,370 @@
+"""Checks of VTK XML files (``.vtu .vtp .vtm``) before VTK reads them (see :mod:`.vtkcheck`)."""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import mmap
+import re
+import struct
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .vtkcheck import MAX_COUNT, MAX_DEPTH, MAX_VTM_DEPTH, Counts, _bad, check_file
+
+_SIZES = {
+    "Int8": 1,
+    "UInt8": 1,
+    "Int16": 2,
+    "UInt16": 2,
+    "Int32": 4,
+    "UInt32": 4,
+    "Int64": 8,
+    "UInt64": 8,
+    "Float32": 4,
+    "Float64": 8,
+}
+_ROOT = {".vtu": "UnstructuredGrid", ".vtp": "PolyData", ".vtm": "vtkMultiBlockDataSet"}
+_TAG = re.compile(
+    rb"<!--.*?-->|<\?.*?\?>|<!\[CDATA\[.*?\]\]>|<(/?)([A-Za-z_][\w:.-]*)((?:[^>\"']|\"[^\"]*\"|'[^']*')*)>",
+    re.S,
+)
+_ATTR = re.compile(rb"([A-Za-z_][\w:.-]*)\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
+
+
+def _int(path: Path, attrs: dict[str, str], key: str, default: int | None = None) -> int:
+    if key not in attrs:
+        if default is None:
+            raise _bad(path, f"missing {key}")
+        return default
+    text = attrs[key].strip()
+    if not re.fullmatch(r"[+-]?\d{1,20}", text):
+        raise _bad(path, f"{key}={attrs[key]!r} is not an integer")
+    value = int(text)
+    if value < 0 or value > MAX_COUNT:
+        raise _bad(path, f"{key}={value} is out of range")
+    return value
+
+
+@dataclass
+class _Array:
+    attrs: dict[str, str]
+    section: str
+    start: int  # inline content (ascii numbers or base64): data[start:end]
+    end: int
+
+
+@dataclass
+class _Piece:
+    attrs: dict[str, str]
+    arrays: list[_Array] = field(default_factory=list)
+
+
+class Xml:
+    def __init__(self, path: Path, data: bytes | mmap.mmap, depth: int):
+        self.path, self.data, self.depth = path, data, depth
+
+    def check(self) -> Counts:
+        path, data = self.path, self.data
+        suffix = path.suffix.lower()
+        cut = data.find(b"<AppendedData")
+        limit = len(data) if cut < 0 else cut
+        first = data.find(b"<VTKFile", 0, limit)
+        prologue = data[: first if first >= 0 else min(limit, 1 << 16)]
+        if re.search(rb"<!(DOCTYPE|ENTITY)", prologue, re.I):
+            raise _bad(
+                path, "refused: XML with DOCTYPE/ENTITY declarations (not a VTK file; entity expansion)"
+            )
+        root, pieces, refs = self._scan(limit)
+        want = _ROOT.get(suffix)
+        if root.get("type") != want:
+            raise _bad(path, f"not a VTK XML {want} file: VTKFile type={root.get('type')!r}")
+        self.header_size = 8 if root.get("header_type", "UInt32") == "UInt64" else 4
+        if root.get("header_type", "UInt32") not in ("UInt32", "UInt64"):
+            raise _bad(path, f"header_type={root.get('header_type')!r}")
+        self.endian = ">" if root.get("byte_order", "LittleEndian") == "BigEndian" else "<"
+        self.compressed = bool(root.get("compressor"))
+        self.appended = self._appended(cut)
+        counts = Counts()
+        if suffix == ".vtm":
+            self._check_refs(refs)
+            return counts
+        for piece in pieces:
+            counts.connectivity.append(self._piece(piece, suffix))
+        return counts
+
+    def _tags(self, limit: int):
+        """The tags before ``limit``, found with bytes.find (array contents hold no '<')."""
+        data, pos = self.data, 0
+        while True:
+            pos = data.find(b"<", pos, limit)
+            if pos < 0:
+                return
+            m = _TAG.match(data, pos, limit)
+            if m is None:
+                raise _bad(self.path, "a '<' that opens no XML tag")
+            yield m
+            pos = m.end()
+
+    def _scan(self, limit: int):
+        data = self.data
+        stack: list[bytes] = []
+        root: dict[str, str] | None = None
+        pieces: list[_Piece] = []
+        refs: list[str] = []
+        section = ""
+        for m in self._tags(limit):
+            closing, name, rest = m.group(1), m.group(2), m.group(3)
+            if name is None:
+                continue  # comment, processing instruction, CDATA
+            selfclose = rest.rstrip().endswith(b"/")
+            if closing:
+                if not stack or stack[-1] != name:
+                    raise _bad(self.path, f"unexpected XML tag </{name.decode('latin-1')}>")
+                stack.pop()
+                if name in (
+                    b"Points",
+                    b"Cells",
+                    b"Verts",
+                    b"Lines",
+                    b"Strips",
+                    b"Polys",
+                    b"PointData",
+                    b"CellData",
+                ):
+                    section = ""
+                continue
+            attrs = {
+                k.decode("latin-1"): (a if a is not None else b or b"").decode("latin-1")
+                for k, a, b in _ATTR.findall(rest)
+            }
+            if root is None:
+                if name != b"VTKFile":
+                    raise _bad(self.path, "no VTKFile element: not a VTK XML file")
+                root = attrs
+            if name == b"Piece":
+                pieces.append(_Piece(attrs))
+            elif name in (
+                b"Points",
+                b"Cells",
+                b"Verts",
+                b"Lines",
+                b"Strips",
+                b"Polys",
+                b"PointData",
+                b"CellData",
+                b"FieldData",
+            ):
+                section = name.decode()
+            elif name == b"DataArray" and pieces:
+                end = data.find(b"<", m.end(), limit)
+                end = m.end() if selfclose else (end if end >= 0 else limit)
+                pieces[-1].arrays.append(_Array(attrs, section, m.end(), end))
+            elif name == b"DataSet" and "file" in attrs:
+                refs.append(attrs["file"])
+            if not selfclose:
+                stack.append(name)
+                if len(stack) > MAX_DEPTH:
+                    raise _bad(self.path, f"refused: XML nested more than {MAX_DEPTH} levels deep")
+        if root is None:
+            raise _bad(self.path, "no VTKFile element: not a VTK XML file")
+        if stack and self.data.find(b"<AppendedData") < 0:
+            raise _bad(self.path, f"XML element <{stack[-1].decode('latin-1')}> is not closed")
+        return root, pieces, refs
+
+    def _appended(self, cut: int) -> tuple[int, bool] | None:
+        if cut < 0:
+            return None
+        close = self.data.find(b">", cut)
+        if close < 0:
+            raise _bad(self.path, "AppendedData element is not closed")
+        attrs = dict(
+            (k.decode("latin-1"), (a or b).decode("latin-1"))
+            for k, a, b in _ATTR.findall(self.data[cut:close])
+        )
+        mark = self.data.find(b"_", close)
+        if mark < 0:
+            raise _bad(self.path, "AppendedData without its '_' marker")
+        return mark + 1, attrs.get("encoding", "raw") == "base64"
+
+    def _check_refs(self, refs: list[str]) -> None:
+        if self.depth >= MAX_VTM_DEPTH:
+            raise _bad(self.path, f"refused: multi-block files nested more than {MAX_VTM_DEPTH} deep")
+        for ref in refs:
+            sub = (self.path.parent / ref).resolve()
+            if sub.suffix.lower() not in (".vtu", ".vtp", ".vtm"):
+                raise _bad(self.path, f"multi-block piece {ref!r} is not a VTK XML file")
+            if not sub.is_file():
+                raise _bad(self.path, f"multi-block piece {ref!r} not found")
+            if sub == self.path.resolve():
+                raise _bad(self.path, "multi-block file refers to itself")
+            check_file(sub, self.depth + 1)
+
+    # -- array lengths --
+
+    def _values(self, arr: _Array) -> int | None:
+        """Number of values the array holds (None: a string array, not counted)."""
+        a = arr.attrs
+        dtype = a.get("type", "")
+        if dtype == "String":
+            if a.get("format", "ascii") == "ascii":  # the bytes of the strings, each ended by a 0
+                return self.data[arr.start : arr.end].split().count(b"0")
+            return None
+        size = _SIZES.get(dtype)
+        if size is None:
+            raise _bad(self.path, f"unknown data type {dtype!r} of array {a.get('Name', '?')!r}")
+        fmt = a.get("format", "ascii")
+        name = a.get("Name", "?")
+        if fmt == "ascii":
+            return len(self.data[arr.start : arr.end].split())
+        if fmt == "binary":
+            nbytes, have = self._binary_size(arr.start, arr.end, name)
+        elif fmt == "appended":
+            if self.appended is None:
+                raise _bad(self.path, f"array {name!r} is appended but the file has no AppendedData")
+            off = _int(self.path, a, "offset")
+            base, b64 = self.appended
+            if b64:
+                end = self.data.find(b"<", base)
+                nbytes, have = self._binary_size(base + off, end if end >= 0 else len(self.data), name)
+            else:
+                nbytes, have = self._raw_size(base + off, name)
+        else:
+            raise _bad(self.path, f"format={fmt!r} of array {name!r}")
+        if nbytes % size:
+            raise _bad(self.path, f"array {name!r}: {nbytes} bytes is not a whole number of {dtype} values")
+        return nbytes // size
+
+    def _words(self, raw: bytes, n: int) -> tuple[int, ...]:
+        fmt = self.endian + ("Q" if self.header_size == 8 else "I") * n
+        return struct.unpack(fmt, raw[: self.header_size * n])
+
+    def _decoded(self, start: int, end: int, nbytes: int, name: str) -> bytes:
+        """The first ``nbytes`` of the base64 text data[start:end] (whitespace skipped)."""
+        chars = -(-nbytes // 3) * 4
+        head = b""
+        pos = start
+        while len(head) < chars and pos < end:
+            chunk = self.data[pos : min(end, pos + max(4 * chars, 256))]
+            head += re.sub(rb"\s+", b"", chunk)
+            pos += len(chunk)
+        head = head[:chars]
+        try:
+            return base64.b64decode(head + b"=" * (-len(head) % 4))
+        except (binascii.Error, ValueError):
+            raise _bad(self.path, f"array {name!r}: invalid base64 data") from None
+
+    def _binary_size(self, start: int, end: int, name: str) -> tuple[int, int]:
+        """(uncompressed bytes, bytes present at most) of a base64 array in data[start:end]."""
+        h = self.header_size
+        text_len = end - start  # whitespace included: an upper bound of the base64 characters
+        if self.compressed:
+            head = self._decoded(start, end, 3 * h, name)
+            if len(head) < 3 * h:
+                raise _bad(self.path, f"array {name!r}: truncated block header")
+            nblocks, block, last = self._words(head, 3)
+            if nblocks > MAX_COUNT // max(block, 1):
+                raise _bad(self.path, f"array {name!r}: block header out of range")
+            head = self._decoded(start, end, (3 + nblocks) * h, name)
+            if len(head) < (3 + nblocks) * h:
+                raise _bad(self.path, f"array {name!r}: truncated block header")
+            csizes = self._words(head, 3 + nblocks)[3:]
+            total = 0 if nblocks == 0 else (nblocks - 1) * block + (last or block)
+            present = text_len * 3 // 4 - (3 + nblocks) * h
+            if sum(csizes) > present + 3:
+                raise _bad(
+                    self.path, f"array {name!r}: compressed data shorter than its header says (truncated?)"
+                )
+            return total, present
+        head = self._decoded(start, end, h, name)
+        if len(head) < h:
+            raise _bad(self.path, f"array {name!r}: truncated length header")
+        (nbytes,) = self._words(head, 1)
+        present = text_len * 3 // 4 - h
+        if nbytes > present + 3:
+            raise _bad(
+                self.path, f"array {name!r}: {nbytes} bytes announced, {max(present, 0)} present (truncated?)"
+            )
+        return nbytes, present
+
+    def _raw_size(self, pos: int, name: str) -> tuple[int, int]:
+        h = self.header_size
+        data = self.data
+        if self.compressed:
+            head = data[pos : pos + 3 * h]
+            if len(head) < 3 * h:
+                raise _bad(self.path, f"array {name!r}: truncated block header")
+            nblocks, block, last = self._words(head, 3)
+            if nblocks > MAX_COUNT // max(block, 1) or pos + (3 + nblocks) * h > len(data):
+                raise _bad(self.path, f"array {name!r}: block header out of range (truncated?)")
+            csizes = self._words(data[pos : pos + (3 + nblocks) * h], 3 + nblocks)[3:]
+            present = len(data) - pos - (3 + nblocks) * h
+            if sum(csizes) > present:
+                raise _bad(
+                    self.path, f"array {name!r}: compressed data shorter than its header says (truncated?)"
+                )
+            total = 0 if nblocks == 0 else (nblocks - 1) * block + (last or block)
+            return total, present
+        head = data[pos : pos + h]
+        if len(head) < h:
+            raise _bad(self.path, f"array {name!r}: truncated length header")
+        (nbytes,) = self._words(head, 1)
+        present = len(data) - pos - h
+        if nbytes > present:
+            raise _bad(self.path, f"array {name!r}: {nbytes} bytes announced, {present} present (truncated?)")
+        return nbytes, present
+
+    def _piece(self, piece: _Piece, suffix: str) -> int:
+        path = self.path
+        npts = _int(path, piece.attrs, "NumberOfPoints", 0)
+        if suffix == ".vtu":
+            sections = {"Cells": _int(path, piece.attrs, "NumberOfCells", 0)}
+        else:
+            sections = {
+                s: _int(path, piece.attrs, f"NumberOf{s}", 0) for s in ("Verts", "Lines", "Strips", "Polys")
+            }
+        ncells = sum(sections.values())
+        conn_total = 0
+        seen_points = False
+        for arr in piece.arrays:
+            n = self._values(arr)
+            if n is None:
+                continue
+            name = arr.attrs.get("Name", "?")
+            ncomp = _int(path, arr.attrs, "NumberOfComponents", 1)
+            if ncomp == 0:
+                raise _bad(path, f"array {name!r} declares 0 components")
+            if "NumberOfTuples" in arr.attrs and arr.section != "FieldData":
+                if _int(path, arr.attrs, "NumberOfTuples") * ncomp != n:
+                    raise _bad(path, f"array {name!r}: NumberOfTuples disagrees with its data")
+            if arr.section == "Points":
+                seen_points = True
+                self._expect(n, 3 * npts, f"{npts} points", "the Points array", ncomp=3)
+            elif arr.section in sections:
+                count = sections[arr.section]
+                if name in ("offsets", "types"):
+                    if name == "types" and suffix != ".vtu":
+                        continue
+                    self._expect(
+                        n,
+                        count,
+                        f"{count} {'cells' if suffix == '.vtu' else arr.section.lower()}",
+                        f"its {name} array",
+                    )
+                elif name == "connectivity":
+                    conn_total += n
+            elif arr.section == "PointData":
+                self._expect(n, npts * ncomp, f"{npts} points", f"point array {name!r}", ncomp=ncomp)
+            elif arr.section == "CellData":
+                self._expect(n, ncells * ncomp, f"{ncells} cells", f"cell array {name!r}", ncomp=ncomp)
+        if npts and not seen_points:
+            raise _bad(path, f"a piece of {npts} points has no Points array")
+        return conn_total
+
+    def _expect(self, have: int, want: int, declared: str, what: str, ncomp: int = 1) -> None:
+        if have != want:
+            held = f"{have} values" if ncomp == 1 else f"{have} values ({have / ncomp:g} tuples of {ncomp})"
+            raise _bad(
+                self.path,
+                f"the header disagrees with the data: the piece declares {declared} but {what} holds {held}",
+            )

@@ -1,0 +1,51 @@
+"""Sweeps: many FE exports and time steps in one table, computed on Dask.
+
+::
+
+    from fepost.sweep import run_sweep
+    res = run_sweep(["runs/*.e"], "sweep_out", steps="all", workers=2)
+    res.rows[0]["M0"], res.ok, res.parquet
+
+Every row is one :func:`fepost.analysis.analyse` call (the call behind
+``fepost coefficients``), run as a task on a ``dask.distributed`` cluster.
+Modules, one job each:
+
+* :mod:`.inputs` – files, folders and globs → sources
+* :mod:`.pairs` – ``--rolling-pairs``: naming rule or CSV of static/rolling pairs
+* :mod:`.steps` – which time steps an export holds
+* :mod:`.metadata` – case metadata from a sidecar ``<case>.json``
+* :mod:`.options` – the analysis options of every row
+* :mod:`.jobs` – one row: its identity and the function a worker runs
+* :mod:`.store` – the work folder that makes a sweep resumable
+* :mod:`.engine` – the Dask client (embedded local cluster or an existing one)
+* :mod:`.progress` – the progress bar
+* :mod:`.table` – columns, units, Parquet and CSV
+* :mod:`.run` – :func:`run_sweep`, the steps above in order
+* :mod:`.trends`, :mod:`.figures`, :mod:`.page` – power-law fits, figures,
+  the trends page and :func:`sweep_section` for embedding in a report
+* :mod:`.embed` – :func:`sweep_report_section`: run a sweep and return its
+  HTML section, for any page
+* :mod:`.reportsection` – the sweep as an optional section of ``fepost report``
+  (``sample_sweep_section`` for the sample load sweep in ``meshes/aircraft/``)
+"""
+
+from .embed import sweep_report_section
+from .options import RowOptions
+from .page import sweep_section, write_trends
+from .run import SweepResult, run_sweep
+from .table import COLUMNS, read_table
+from .trends import PowerLaw, fit_power_law, load_trends
+
+__all__ = [
+    "COLUMNS",
+    "PowerLaw",
+    "RowOptions",
+    "SweepResult",
+    "fit_power_law",
+    "load_trends",
+    "read_table",
+    "run_sweep",
+    "sweep_report_section",
+    "sweep_section",
+    "write_trends",
+]

@@ -1,0 +1,137 @@
+"""One row of the sweep: a job description and the function a worker runs for it.
+
+:func:`run_job` is exactly one single-file run: it calls
+:func:`fepost.analysis.analyse` with the options ``fepost coefficients`` would
+use and copies the numbers from :meth:`~fepost.analysis.Analysis.to_dict` (the
+``--json`` document). Errors fepost raises on purpose become an error row with
+their one-line message; anything else is reported with its exception type,
+so a bug in one file's analysis shows in its row instead of stopping the sweep.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+import warnings
+from dataclasses import dataclass
+from functools import partial
+
+from ..errors import FepostError, FepostWarning
+from .metadata import case_metadata, sidecar_path
+from .options import RowOptions
+from .steps import time_steps
+from .table import coefficient_columns, one_line
+
+
+def _stamp(path: str | None) -> list | None:
+    """(size, mtime in ns) of a file, None when it is absent: a changed file is a new row."""
+    if path is None:
+        return None
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return [st.st_size, st.st_mtime_ns]
+
+
+@dataclass(frozen=True)
+class Job:
+    """What one row is computed from.
+
+    Attributes
+    ----------
+    source, rolling_given : str, str or None
+        Paths as given (the table's ``source`` and ``rolling`` columns).
+    path, rolling : str or None
+        Absolute paths the worker reads (None: nothing to read, see ``error``).
+    step : int or None
+        Time step to read; None: the file's last step (or a file without steps).
+    n_steps : int or None
+        Number of time steps of the file when listed (for per-step sidecar lists).
+    time : float or None
+        Time value of ``step`` when listed.
+    options : RowOptions
+        Keyword arguments of the analysis.
+    error : str or None
+        Set when the row fails before any analysis (input names no file, its
+        time steps cannot be listed): the row is this error.
+    """
+
+    source: str
+    path: str | None
+    step: int | None
+    options: RowOptions
+    rolling: str | None = None
+    rolling_given: str | None = None
+    n_steps: int | None = None
+    time: float | None = None
+    error: str | None = None
+
+    def key(self) -> str:
+        """Identity of the row: inputs, their size and modification time, step and options."""
+        ident = [
+            self.path or self.source,
+            self.step,
+            self.rolling,
+            self.options.key_dict(),
+            _stamp(self.path),
+            _stamp(self.rolling),
+            _stamp(None if self.path is None else str(sidecar_path(self.path))),
+            self.error,
+        ]
+        return hashlib.sha1(json.dumps(ident, sort_keys=True).encode()).hexdigest()
+
+    def base_row(self) -> dict:
+        return {
+            "source": self.source,
+            "rolling": self.rolling_given or "",
+            "step": self.step,
+            "time": self.time,
+        }
+
+
+def _count_steps(path: str, units) -> int | None:
+    listed = time_steps(path, units)
+    return len(listed) if listed else None
+
+
+def run_job(job: Job) -> dict:
+    """Analyse one row (on a worker); never raises for a bad input.
+
+    Returns
+    -------
+    dict
+        The row: the job's identity columns, ``status`` and ``error``, the
+        coefficient columns, the sidecar metadata, ``warnings`` and ``seconds``.
+    """
+    from ..analysis import analyse
+
+    row = job.base_row()
+    if job.error is not None or job.path is None:
+        return {**row, "status": "error", "error": one_line(job.error or f"{job.source}: no file")}
+    path = job.path
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FepostWarning)
+        try:
+            res = analyse(path, job.rolling, step=job.step, **job.options.analyse_kwargs())
+            step = res.static_field.step
+            n_steps = (
+                job.n_steps if job.n_steps is not None else partial(_count_steps, path, job.options.units)
+            )
+            meta = case_metadata(path, step, n_steps)
+            row.update(step=step, time=res.static_field.time, **coefficient_columns(res.to_dict()), **meta)
+            row["status"], row["error"] = "ok", ""
+        except FepostError as exc:
+            row["status"], row["error"] = "error", one_line(str(exc))
+        except MemoryError:
+            row["status"], row["error"] = "error", one_line(f"{path}: out of memory")
+        except Exception as exc:  # a bug must not stop the other rows; its type is kept
+            row["status"], row["error"] = "error", one_line(f"{path}: {type(exc).__name__}: {exc}")
+    row["warnings"] = " | ".join(
+        one_line(str(w.message)) for w in caught if issubclass(w.category, FepostWarning)
+    )
+    row["seconds"] = time.perf_counter() - t0
+    return row

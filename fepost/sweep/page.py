@@ -1,0 +1,187 @@
+"""The trends page of a sweep (``DIR/trends.html``) and its embeddable section.
+
+HTML comes from Jinja2 templates kept as files in ``fepost/sweep/templates/``:
+``section.html.j2`` (figures, power-law fits, the table) is what
+:func:`sweep_section` returns for embedding in another page (the report);
+``trends.html.j2`` wraps it into a standalone page.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+from ..output import write_json_atomic, write_text_atomic
+from .figures import plot_load_trends, plot_time_trends, transient_series
+from .table import normalise
+from .trends import PowerLaw, load_trends
+
+#: Most rows listed in the HTML table (the CSV and Parquet files hold them all).
+MAX_TABLE_ROWS = 200
+#: Columns of the HTML table: column, heading.
+TABLE_COLUMNS = (
+    ("source", "source"),
+    ("step", "step"),
+    ("status", "status"),
+    ("load", "load (N)"),
+    ("N", "N (N)"),
+    ("R", "R (m)"),
+    ("M0", "M0 (N m)"),
+    ("a", "a"),
+    ("m", "m"),
+    ("aspect", "aspect"),
+    ("circular", "circular"),
+    ("k_x", "k_x"),
+    ("error", "error"),
+)
+
+
+def _environment():
+    import jinja2
+
+    env = jinja2.Environment(
+        loader=jinja2.PackageLoader("fepost.sweep", "templates"),
+        autoescape=jinja2.select_autoescape(["html", "j2"]),
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
+    env.filters["num"] = _num
+    return env
+
+
+def _num(v, digits: int = 4) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return ""
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return f"{v:.{digits}g}"
+    return str(v)
+
+
+def _save(fig, folder: Path, stem: str) -> list[str]:
+    import matplotlib.pyplot as plt
+
+    names = []
+    for ext in ("png", "svg"):
+        fig.savefig(folder / f"{stem}.{ext}")
+        names.append(f"{stem}.{ext}")
+    plt.close(fig)
+    return names
+
+
+def draw_figures(rows: Sequence[Mapping], fits: Sequence[PowerLaw], folder: Path) -> list[dict]:
+    """Draw the sweep's figures into ``folder`` (PNG and SVG); return name and caption of each."""
+    folder.mkdir(parents=True, exist_ok=True)
+    figures = []
+    loads = {r["N"] for r in rows if r.get("status") == "ok" and r.get("N") is not None}
+    if len(loads) >= 2:
+        _save(plot_load_trends(rows, fits), folder, "load_trends")
+        figures.append(
+            {
+                "png": "load_trends.png",
+                "svg": "load_trends.svg",
+                "caption": "Coefficients against the normal load N (log-log), power-law fits with "
+                "their 95 % confidence bands; exponents with 95 % intervals in the legends.",
+            }
+        )
+    series = transient_series(rows)
+    if series:
+        _save(plot_time_trends(series), folder, "time_trends")
+        figures.append(
+            {
+                "png": "time_trends.png",
+                "svg": "time_trends.svg",
+                "caption": "Coefficients against time for the runs with several time steps"
+                + (f" (the first {8} of {len(series)})" if len(series) > 8 else "")
+                + ".",
+            }
+        )
+    return figures
+
+
+def sweep_section(
+    rows: Sequence[Mapping],
+    figure_dir: str | os.PathLike,
+    href: str = "",
+    *,
+    heading_level: int = 2,
+    title: str | None = "Sweep: coefficients against load",
+) -> str:
+    """An HTML ``<section>`` with the sweep's figures, power-law fits and table.
+
+    Parameters
+    ----------
+    rows : sequence of mappings
+        The sweep table (:attr:`SweepResult.rows` or
+        :func:`fepost.sweep.table.read_table` of ``coefficients.parquet``).
+    figure_dir : path
+        Folder the figures are drawn into (created).
+    href : str
+        How the page holding the section reaches ``figure_dir`` (relative URL
+        prefix, e.g. ``"sweep"``); images are linked as ``href/name.png``.
+    heading_level : int
+        Level of the section's heading (``2`` → ``<h2>``; sub-headings one below).
+    title : str or None
+        The section's heading; None for none (the page around it gives one).
+    """
+    rows = [normalise(r) for r in rows]
+    fits = load_trends(rows)
+    figures = draw_figures(rows, fits, Path(figure_dir))
+    prefix = href.rstrip("/") + "/" if href else ""
+    listed = list(rows)[:MAX_TABLE_ROWS]
+    return (
+        _environment()
+        .get_template("section.html.j2")
+        .render(
+            title=title,
+            h=max(1, min(5, int(heading_level))),
+            figures=[{**f, "png": prefix + f["png"], "svg": prefix + f["svg"]} for f in figures],
+            fits=fits,
+            rows=listed,
+            n_rows=len(rows),
+            n_errors=sum(r.get("status") != "ok" for r in rows),
+            columns=TABLE_COLUMNS,
+        )
+    )
+
+
+def write_trends(rows: Sequence[Mapping], out: str | os.PathLike) -> Path:
+    """Write ``trends.html``, ``trends.json`` and the figures in ``trends/`` into ``out``.
+
+    The figures are drawn into a temporary folder and moved into place whole.
+    """
+    out = Path(out)
+    tmp = Path(tempfile.mkdtemp(prefix=".trends.", suffix=".tmp", dir=out))
+    try:
+        section = sweep_section(rows, tmp, "trends")
+        final = out / "trends"
+        if final.is_dir():
+            old = out / f".trends.old-{os.getpid()}"
+            os.replace(final, old)
+            os.replace(tmp, final)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, final)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    from markupsafe import Markup
+
+    page = (
+        _environment()
+        .get_template("trends.html.j2")
+        .render(
+            section=Markup(section),
+            n_rows=len(rows),
+        )
+    )
+    write_json_atomic(out / "trends.json", {"fits": [f.to_dict() for f in load_trends(rows)]})
+    return write_text_atomic(out / "trends.html", page)

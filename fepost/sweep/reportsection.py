@@ -1,0 +1,152 @@
+"""A sweep as an optional section of ``fepost report`` (a report section provider).
+
+:func:`sample_sweep_section` is the provider for the sample load sweep shipped
+in ``meshes/aircraft/`` (``static_*.vtu``, ``rolling_*.vtu`` paired by
+``static=rolling``): when those files exist it runs the sweep, draws the load
+trends and returns a :class:`fepost.report.Section`; otherwise it returns None
+and the report has no trace of it. :func:`sweep_provider` makes a provider for
+any other inputs. A provider is listed in
+:data:`fepost.report.sections.DEFAULT_SECTIONS` to appear in ``fepost report``.
+
+The sweep runs on one worker thread of an in-process Dask cluster (it starts
+in well under a second; the sample is a handful of files), with the report's
+friction coefficient, and writes into ``sweep/`` beside ``report.html``:
+``coefficients.csv``, ``coefficients.parquet`` and the figures (PNG, SVG).
+"""
+
+from __future__ import annotations
+
+import glob
+import math
+import shutil
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..report.sections import ReportData, Section
+
+#: Sub-folder of the report that holds the sweep's files.
+FOLDER = "sweep"
+#: The sample sweep, relative to the repository's ``meshes/`` folder, and its pairing rule.
+SAMPLE_INPUTS = ("aircraft/static_*.vtu", "aircraft/rolling_*.vtu")
+SAMPLE_PAIRS = "static=rolling"
+#: Columns of the section's table: column, heading.
+TABLE = (
+    ("case", "case"),
+    ("load", "load (N)"),
+    ("N", "N (N)"),
+    ("R", "R (m)"),
+    ("M0", "M0 (N·m)"),
+    ("aR2", "a·R² (m²)"),
+    ("m_over_R2", "m/R² (1/m²)"),
+    ("aspect", "aspect"),
+    ("k_x", "k_x"),
+    ("status", "status"),
+)
+
+
+def _cell(row, key: str):
+    v = row.get(key)
+    if key == "case" and not v:
+        return Path(str(row.get("source", ""))).stem
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "—"
+    return v
+
+
+def _exponent_text(fit) -> str:
+    if not fit.fitted:
+        return f"{fit.label}: no power law ({fit.note})."
+    lo, hi = fit.ci95
+    hertz = "" if fit.hertz is None else f"; Hertz contact: {fit.hertz:.3g}"
+    group = "" if fit.group == "all" else f" ({fit.group})"
+    return (
+        f"{fit.label} ∝ N^{fit.exponent:.3f}{group}, 95 % interval [{lo:.3f}, {hi:.3f}], "
+        f"from {fit.n} loads{hertz}."
+    )
+
+
+def sweep_provider(
+    inputs: Sequence[str],
+    rolling_pairs: str | None = None,
+    *,
+    key: str = "sweep",
+    title: str = "Load sweep",
+) -> Callable[[ReportData, Path], Section | None]:
+    """A report section provider sweeping ``inputs`` (paths or glob patterns).
+
+    The provider returns None when no input exists, so a report built where the
+    sweep's files are missing shows no empty section.
+    """
+
+    def provider(data: ReportData, folder: Path) -> Section | None:
+        present = [i for i in inputs if glob.glob(str(i), recursive=True)]
+        if not present:
+            return None
+        from ..errors import ArgumentError
+        from ..report.figures import Figure, png_data_uri
+        from ..report.sections import Section
+        from .inputs import expand_inputs
+        from .options import RowOptions
+        from .page import draw_figures
+        from .pairs import pair_sources, parse_rolling_pairs
+        from .run import run_sweep
+        from .store import WORK
+        from .trends import load_trends
+
+        pairs = None if rolling_pairs is None else parse_rolling_pairs(rolling_pairs)
+        if pairs is not None:
+            try:
+                pair_sources(expand_inputs(present), pairs)
+            except ArgumentError:  # no rolling map among the files: a static-only sweep
+                pairs = None
+        out = Path(folder) / FOLDER
+        result = run_sweep(
+            present,
+            out,
+            rolling_pairs=pairs,
+            options=RowOptions(friction=float(data.friction)),
+            workers=1,
+            processes=False,
+            progress=False,
+            trends=False,
+            force=True,
+        )
+        shutil.rmtree(out / WORK, ignore_errors=True)
+        rows = list(result.rows)
+        fits = load_trends(rows)
+        figures, captions = [], {}
+        for fig in draw_figures(rows, fits, out):
+            stem = fig["png"].rsplit(".", 1)[0]
+            fkey = f"{key}-{stem.replace('_', '-')}"
+            files = (f"{FOLDER}/{fig['png']}", f"{FOLDER}/{fig['svg']}")
+            figures.append(Figure(fkey, files, fig["caption"], png_data_uri(out / fig["png"])))
+            captions[fkey] = fig["caption"]
+        ok = sum(r["status"] == "ok" for r in rows)
+        intro = (
+            f"The same analysis on each of {len(rows)} FE exports of a load sweep "
+            f"({ok} analysed{'' if ok == len(rows) else f', {len(rows) - ok} failed'}), run by "
+            "fepost sweep. Power laws y = c·N^α are fitted by least squares of log y on log N; "
+            "the intervals use Student's t with n − 2 degrees of freedom."
+        )
+        table = (tuple(h for _, h in TABLE), *(tuple(_cell(r, k) for k, _ in TABLE) for r in rows))
+        return Section(
+            key=key,
+            title=title,
+            paragraphs=(intro, *(_exponent_text(f) for f in fits)),
+            table=table,
+            figures=tuple(figures),
+            captions=captions,
+            files=(f"{FOLDER}/coefficients.csv", f"{FOLDER}/coefficients.parquet"),
+        )
+
+    return provider
+
+
+def sample_sweep_section(data: ReportData, folder: Path) -> Section | None:
+    """The section of the sample load sweep in ``meshes/aircraft/``, or None when it is not there."""
+    from ..report.samples import meshes_folder
+
+    inputs = [str(meshes_folder() / p) for p in SAMPLE_INPUTS]
+    return sweep_provider(inputs, SAMPLE_PAIRS)(data, folder)

@@ -1,0 +1,186 @@
+"""Reading in a forked child: crashes, hangs, memory, chatter, warnings and daemonic processes."""
+
+import multiprocessing as mp
+import os
+import signal
+import time
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+
+from fepost.errors import FieldError, InputFileError, ReaderWarning
+from fepost.reader import isolate, read_contact
+
+
+def _segfault():
+    os.kill(os.getpid(), signal.SIGSEGV)
+
+
+def _abort():
+    os.abort()
+
+
+def _hang():
+    time.sleep(60)
+
+
+def _huge():
+    return np.ones(1 << 40)  # 8 TB: beyond the child's address-space budget
+
+
+def _chatty():
+    os.write(
+        2,
+        b"HDF5-DIAG: Error detected in HDF5 (1.14.0) thread 0:\n"
+        b"  #000: H5F.c line 620 in H5Fopen(): unable\n",
+    )
+    os.write(1, b"some stdout chatter\n")
+    raise ValueError("the library gave up")
+
+
+def _warns():
+    warnings.warn("something was assumed", ReaderWarning, stacklevel=1)
+    warnings.warn("a numpy detail", RuntimeWarning, stacklevel=1)  # not a fepost warning: not passed on
+    return 42
+
+
+def _field_error():
+    raise FieldError("x.vtu: no array named 'P'")
+
+
+def _array():
+    return {"a": np.arange(3_000_000, dtype=float), "b": np.eye(3)}
+
+
+@pytest.mark.parametrize(
+    "func,pattern",
+    [
+        (_segfault, r"f\.vtu: the file reader crashed \(SIGSEGV\): corrupt or malformed file"),
+        (_abort, r"f\.vtu: the file reader crashed \(SIGABRT\): corrupt or malformed file"),
+        (_huge, r"f\.vtu: not enough memory to read the file \(declared sizes too large\?\)"),
+    ],
+)
+def test_a_crash_in_the_reader_is_one_line_error(func, pattern):
+    with pytest.raises(InputFileError, match=pattern):
+        isolate.call(func, what="f.vtu")
+
+
+def test_a_hang_is_killed_at_the_deadline():
+    t = time.monotonic()
+    with pytest.raises(
+        InputFileError, match=r"f\.vtu: reading did not finish within 1 s .*FEPOST_READ_TIMEOUT"
+    ):
+        isolate.call(_hang, what="f.vtu", timeout=1.0)
+    assert time.monotonic() - t < 10
+
+
+def test_c_level_chatter_is_captured_and_summarised(capfd):
+    with pytest.raises(InputFileError) as err:
+        isolate.call(_chatty, what="f.e")
+    msg = str(err.value)
+    assert msg.startswith(
+        "f.e: cannot read the file (ValueError: the library gave up); reader said: HDF5-DIAG: Error"
+    )
+    assert "\n" not in msg
+    out, errout = capfd.readouterr()
+    assert "HDF5" not in errout + out and "chatter" not in errout + out
+
+
+def test_errors_warnings_and_results_cross_the_process_boundary():
+    with pytest.raises(FieldError, match=r"x\.vtu: no array named 'P'"):
+        isolate.call(_field_error, what="x.vtu")
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        assert isolate.call(_warns, what="w.vtu") == 42
+    assert [(w.category, str(w.message)) for w in rec] == [(ReaderWarning, "something was assumed")]
+    got = isolate.call(_array, what="big")
+    np.testing.assert_array_equal(got["a"], np.arange(3_000_000, dtype=float))
+    np.testing.assert_array_equal(got["b"], np.eye(3))
+
+
+def _read_in_daemon(path, queue):
+    try:
+        fld = read_contact(path)
+        queue.put(("ok", float(fld.values.max())))
+    except Exception as exc:  # reported to the test
+        queue.put(("error", repr(exc)))
+
+
+def test_reading_inside_a_daemonic_process(analytic_mesh):
+    """Dask workers are daemonic processes, where multiprocessing refuses to start children."""
+    path = analytic_mesh("d.vtu", "hertz", radius=0.1, peak=1e6, n_rings=10)
+    ctx = mp.get_context("fork")
+    q = ctx.Queue()
+    proc = ctx.Process(target=_read_in_daemon, args=(str(path), q), daemon=True)
+    proc.start()
+    kind, value = q.get(timeout=60)
+    proc.join(timeout=30)
+    assert kind == "ok", value
+    assert value == pytest.approx(1e6, rel=1e-6)
+
+
+def test_reading_from_many_threads_at_once(analytic_mesh):
+    paths = [
+        analytic_mesh(f"t{i}.vtu", "uniform", radius=0.1, peak=(i + 1) * 1e5, n_rings=8) for i in range(4)
+    ]
+    with ThreadPoolExecutor(4) as pool:
+        peaks = list(pool.map(lambda p: float(read_contact(p).values.max()), paths * 2))
+    assert peaks == pytest.approx([(i + 1) * 1e5 for i in range(4)] * 2)
+
+
+def test_isolation_can_be_switched_off(analytic_mesh, monkeypatch):
+    path = analytic_mesh("o.vtu", "hertz", n_rings=8)
+    forked = read_contact(path)
+    monkeypatch.setenv(isolate.ISOLATION_ENV, "off")
+    assert not isolate.isolation_enabled()
+    here = read_contact(path)
+    np.testing.assert_array_equal(forked.values, here.values)
+    np.testing.assert_array_equal(forked.points, here.points)
+    with pytest.raises(
+        InputFileError, match=r"f\.vtu: cannot read the file \(ValueError: the library gave up\)"
+    ):
+        isolate.call(_chatty, what="f.vtu")
+
+
+def test_the_timeout_scales_with_the_file_and_the_environment(monkeypatch):
+    assert isolate.timeout_for(0) == isolate.TIMEOUT_BASE
+    assert isolate.timeout_for(100_000_000) == isolate.TIMEOUT_BASE + 100 * isolate.TIMEOUT_PER_MB
+    monkeypatch.setenv(isolate.TIMEOUT_ENV, "7.5")
+    assert isolate.timeout_for(10**9) == 7.5
+    monkeypatch.setenv(isolate.TIMEOUT_ENV, "nonsense")
+    assert isolate.timeout_for(0) == isolate.TIMEOUT_BASE
+
+
+def _children() -> set[int]:
+    """Process ids of this process's children (zombies included)."""
+    import glob
+
+    me = os.getpid()
+    kids = set()
+    for stat in glob.glob("/proc/[0-9]*/stat"):
+        try:
+            fields = open(stat).read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == me:
+            kids.add(int(stat.split("/")[2]))
+    return kids
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs /proc to list child processes")
+def test_started_reads_run_side_by_side_and_leave_no_child(analytic_mesh):
+    from fepost.reader import start_reading
+
+    before = _children()
+    a = start_reading(analytic_mesh("a.vtu", "uniform", peak=1e5, n_rings=8))
+    b = start_reading(analytic_mesh("b.vtu", "uniform", peak=2e5, n_rings=8))
+    assert float(b.result().values.max()) == pytest.approx(2e5)
+    assert float(a.result().values.max()) == pytest.approx(1e5)
+    hung = isolate.start(_hang, what="h.vtu", timeout=30)
+    assert _children() - before  # the hung child runs
+    hung.cancel()
+    assert _children() == before  # killed and reaped: no zombie left
+    with pytest.raises(FieldError, match=r"x\.vtu: no array named 'P'"):
+        isolate.start(_field_error, what="x.vtu").result()

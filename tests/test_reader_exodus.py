@@ -1,0 +1,261 @@
+"""Exodus II as solvers write it: blocks, bodies, side sets, node sets, steps, globals, 2-D models.
+
+The files are written with netCDF4 alone (tests/exodus_files.py), in MOOSE's
+layout; the expected loads are closed forms of the fields written.
+"""
+
+import json
+import re
+
+import numpy as np
+import pytest
+from exodus_files import hex_grid, write
+
+from fepost import analyse
+from fepost.cli import main
+from fepost.errors import DimensionError, FieldError, PressureError, ScaleWarning
+from fepost.reader import read_contact, time_steps
+
+P = 1000.0
+
+
+def _two_bodies(tmp_path, name="pair.e", both_sides=False, scale=1.0, **kw):
+    """A 1 × 1 × 1 cube (block 2, 3 × 3 × 3 HEX8) resting on a 2 × 2 × 1 slab (block 1, 4 × 4 × 2):
+    the cube's bottom nodes carry P; the slab's top nodes sit at the same positions (not merged)."""
+    slab_pts, slab = hex_grid(4, 4, 2, size=(2.0, 2.0, 1.0), origin=(-1.0, -1.0, -1.0))
+    cube_pts, cube = hex_grid(3, 3, 3, size=(1.0, 1.0, 1.0), origin=(-0.5, -0.5, 0.0))
+    pts = np.vstack([slab_pts, cube_pts]) * scale
+    n0 = len(slab_pts)
+    p = np.zeros(len(pts))
+    p[n0:][np.isclose(cube_pts[:, 2], 0.0)] = P
+    if both_sides:
+        top = (
+            np.isclose(slab_pts[:, 2], 0.0)
+            & (np.abs(slab_pts[:, 0]) <= 0.5)
+            & (np.abs(slab_pts[:, 1]) <= 0.5)
+        )
+        p[:n0][top] = 0.8 * P  # the slab side carries a little less (a penalty's asymmetry)
+    # side sets on every face of both bodies (as MOOSE meshes have), and node sets
+    ss = [
+        (np.arange(len(slab)), np.full(len(slab), 5)),  # every slab element's top side (some interior)
+        (len(slab) + np.arange(len(cube)), np.full(len(cube), 4)),  # every cube element's bottom side
+    ]
+    ns = [np.arange(n0), n0 + np.arange(len(cube_pts))]
+    disp = np.zeros(len(pts))
+    return write(
+        tmp_path / name,
+        pts,
+        [("HEX8", slab), ("HEX8", cube + n0)],
+        nodal={
+            "contact_pressure": np.vstack([0 * p, p]),
+            "disp_x": np.vstack([disp, disp]),
+            "disp_y": np.vstack([disp, disp]),
+            "disp_z": np.vstack([disp, disp]),
+        },
+        times=(0.0, 1.0),
+        side_sets=ss,
+        side_set_names=["slab_top", "cube_bottom"],
+        node_sets=ns,
+        **kw,
+    )
+
+
+def test_blocks_are_the_surface_and_nodes_of_two_bodies_are_never_merged(tmp_path):
+    path = _two_bodies(tmp_path)
+    fld = read_contact(path)
+    assert "element block 2" in fld.body and "element block 1" not in fld.body
+    assert "the loaded faces lie on side set 2 'cube_bottom' (100% of them)" in fld.notes
+    a = analyse(fld)
+    p = a.static_patch
+    assert p.N_fe == pytest.approx(P * 1.0, rel=1e-12)  # 1000 Pa on the 1 × 1 bottom of the cube
+    assert p.area == pytest.approx(1.0, rel=1e-12)
+    assert p.R == pytest.approx(np.sqrt(0.5), rel=1e-12)
+    assert not p.circular and p.dropped_edge_faces == 12  # the cube's side faces along the bottom edge
+    # M0 = f ∬σ r dA, for a uniform square of side 1: f P (√2 + asinh 1)/6. The polar grid meets a
+    # pressure that jumps along a square's edges: ~0.5 % on the default grid, converging when refined
+    m0 = 0.3 * P * (np.sqrt(2) + np.arcsinh(1.0)) / 6
+    assert a.coefficients.N == pytest.approx(P, rel=1e-2)
+    assert a.coefficients.M0 == pytest.approx(m0, rel=1e-2)
+    from fepost.polar import PolarGrid
+
+    fine = analyse(fld, grid=PolarGrid.make(256, 512)).coefficients
+    assert fine.N == pytest.approx(P, rel=5e-4) and fine.M0 == pytest.approx(m0, rel=5e-4)
+
+
+def test_both_sides_of_a_contact_loaded_one_is_taken(tmp_path):
+    fld = read_contact(_two_bodies(tmp_path, both_sides=True))
+    assert "element block 2" in fld.body
+    assert any(
+        re.search(r"both sides of the contact carry pressure: loaded faces taken from element block 2", n)
+        for n in fld.notes
+    )
+    assert analyse(fld).static_patch.N_fe == pytest.approx(P, rel=1e-12)
+
+
+def test_surface_option_picks_a_side_set_or_a_block(tmp_path):
+    path = _two_bodies(tmp_path, both_sides=True)
+    slab = analyse(path, surface="slab_top").static_patch
+    # 0.8 P on the slab's nodes within the cube's footprint, ramping to zero over one 0.5 element:
+    # ∬ = 0.8 P (1 + 2 · 0.5/2)²
+    assert slab.N_fe == pytest.approx(0.8 * P * 1.5**2, rel=1e-12)
+    assert analyse(path, surface="2").static_patch.N_fe == pytest.approx(P, rel=1e-12)  # side set id 2
+    with pytest.raises(
+        FieldError,
+        match=r"pair\.e: no side set or element block 'road'; side sets: 1 'slab_top', "
+        r"2 'cube_bottom'; blocks: element block 1",
+    ):
+        read_contact(path, surface="road")
+
+
+def test_time_steps_and_a_step_without_contact(tmp_path):
+    path = _two_bodies(tmp_path)
+    steps = time_steps(path)
+    assert [(s.index, s.time) for s in steps] == [(0, 0.0), (1, 1.0)]
+    with pytest.raises(
+        PressureError,
+        match=r"pair\.e: pressure array 'contact_pressure' is zero or negative "
+        r"everywhere at step 0 \(t = 0\) \(no contact\); contact pressure is "
+        r"positive at step\(s\) 1 \(t = 1\): choose one with --step",
+    ):
+        read_contact(path, step=0)
+    assert time_steps(path, units="mm-kg-ms")[1].time == pytest.approx(1e-3)
+
+
+def test_reaction_globals_are_shown_and_checked(tmp_path, capsys):
+    path = _two_bodies(tmp_path, globals_={"bot_react_z": [0.0, P], "top_react_z": [0.0, -P], "dt": [0, 1]})
+    fld = read_contact(path)
+    assert dict(fld.reactions) == {"bot_react_z": P, "top_react_z": -P}
+    out = tmp_path / "c.json"
+    assert main(["coefficients", str(path), "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert re.search(r"solver bot_react_z\s+1000 N\s+\(N_fe/\|reaction\| - 1 = \+0\.00%\)", text)
+    assert json.loads(out.read_text())["reactions"] == {"bot_react_z": P, "top_react_z": -P}
+    wrong = _two_bodies(tmp_path, "wrong.e", globals_={"react_z": [0.0, 1e3 * P]})
+    with pytest.warns(
+        ScaleWarning,
+        match=r"wrong\.e: N_fe = 1000 N differs from the solver's reaction by "
+        r"-99\.9% \(react_z = 1e\+06 N\) \(a factor 0\.001: wrong --units\?\)",
+    ):
+        analyse(wrong)
+
+
+def test_two_dimensional_models_are_refused(tmp_path):
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    path = write(
+        tmp_path / "plane.e",
+        pts,
+        [("QUAD4", np.array([[0, 1, 2, 3]]))],
+        nodal={"contact_pressure": np.array([[0.0, 0.0, 5.0, 5.0]])},
+    )
+    with pytest.raises(
+        DimensionError,
+        match=r"plane\.e: 2-D model \(num_dim = 2: plane strain, plane stress or "
+        r"axisymmetric\): the contact is a line, not a patch",
+    ):
+        read_contact(path)
+
+
+def test_a_line_of_loaded_nodes_in_3d_is_a_line_contact(tmp_path):
+    pts, conn = hex_grid(4, 4, 1)
+    p = np.where(np.isclose(pts[:, 2], 1.0) & np.isclose(pts[:, 1], 0.5), P, 0.0)
+    path = write(tmp_path / "line.e", pts, [("HEX8", conn)], nodal={"contact_pressure": p[None]})
+    with pytest.raises(
+        DimensionError, match=r"line\.e: the loaded nodes lie on one line: the contact is a line"
+    ):
+        analyse(path)
+
+
+def test_element_variable_pressure(tmp_path):
+    """Pressure as an element variable: every boundary face of an element carries its value; for a
+    slab of HEX8 that is its top and its bottom, two parallel loaded surfaces, refused as such."""
+    pts, conn = hex_grid(2, 2, 1, size=(2.0, 2.0, 0.2))
+    p = np.array([1.0, 2.0, 3.0, 4.0]) * P
+    path = write(tmp_path / "cells.e", pts, [("HEX8", conn)], elemental={"pressure": [p[None]]})
+    fld = read_contact(path, field="pressure")
+    assert fld.location == "cell" and fld.n_faces == 4 + 4 + 8
+    assert sorted(fld.values) == sorted(np.repeat(p, 4))  # each element's top, bottom and two sides
+    from fepost.errors import PatchError
+
+    with pytest.raises(
+        PatchError,
+        match=r"cells\.e: 2 separate contact patches \(load shares 50%, 50%\) on "
+        r"different surfaces",
+    ):
+        analyse(fld)
+
+
+@pytest.mark.parametrize(
+    "etype,order",
+    [
+        ("HEX8", "hex8"),
+        ("HEX20", "hex20"),
+        ("HEX27", "hex27"),
+        ("TETRA", "tet4"),
+        ("TETRA10", "tet10"),
+        ("WEDGE", "wedge6"),
+        ("WEDGE15", "wedge15"),
+        ("PYRAMID", "pyramid5"),
+        ("PYRAMID13", "pyramid13"),
+        ("SHELL4", "quad4"),
+        ("SHELL8", "quad8"),
+        ("SHELL9", "quad9"),
+        ("TRISHELL3", "tri3"),
+        ("TRI6", "tri6"),
+        ("TRISHELL7", "tri7"),
+    ],
+)
+def test_element_faces_carry_their_element_load(tmp_path, etype, order):
+    """One element of each type, its nodes placed on the unit cube, tetrahedron, wedge, pyramid,
+    square or triangle; a field p0 (1 + x − y²/2) on the nodes of z = 0: N_fe equals the closed
+    form of the face's own interpolant (exact for quadratic faces, which hold y²)."""
+    from fepost.reader.cells import SPECS
+
+    square = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    triangle = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+    ref = {
+        "hex": square + [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+        "tet": triangle + [[0, 0, 1]],
+        "wedge": triangle + [[0, 0, 1], [1, 0, 1], [0, 1, 1]],
+        "pyramid": square + [[0.5, 0.5, 1]],
+        "quad": square,
+        "tri": triangle,
+    }
+    spec = SPECS[order]
+    fam = order.rstrip("0123456789")
+    corners = np.array(ref[fam], float)
+    nodes = list(corners)
+    for a, b in spec.edges if spec.quadratic else ():
+        nodes.append(0.5 * (corners[a] + corners[b]))
+    extra = [None] * (spec.n_nodes - len(nodes))  # volume centre and face centres
+    if extra:
+        first = len(nodes)
+        for k, face in enumerate(spec.faces):
+            extra[spec.face_centres[k] - first] = corners[list(face)].mean(axis=0)
+        if order == "hex27":
+            extra[20 - first] = corners.mean(axis=0)
+        nodes += extra
+    pts = np.array(nodes)
+    p = P * (1 + pts[:, 0] - 0.5 * pts[:, 1] ** 2) * np.isclose(pts[:, 2], 0.0)
+    path = write(
+        tmp_path / f"{order}.e",
+        pts,
+        [(etype, np.arange(len(pts))[None])],
+        nodal={"contact_pressure": p[None]},
+    )
+    patch = analyse(path).static_patch
+    on_square = fam in ("hex", "pyramid", "quad")
+    face = {
+        "hex": "quad",
+        "pyramid": "quad",
+        "quad": "quad",
+        "tet": "tri",
+        "wedge": "tri",
+        "tri": "tri",
+    }[fam]
+    if spec.quadratic:  # ∬ (1 + x − y²/2) over the unit square, over the unit right triangle
+        exact = P * ((1 + 0.5 - 1 / 6) if on_square else (0.5 + 1 / 6 - 1 / 24))
+    elif face == "quad":  # the bilinear interpolant of the corner values: their mean
+        exact = P * (1 + 2 + 1.5 + 0.5) / 4
+    else:  # the linear interpolant over the triangle: area × mean of the corners
+        exact = P * 0.5 * (1 + 2 + 0.5) / 3
+    assert patch.N_fe == pytest.approx(exact, rel=1e-12)
