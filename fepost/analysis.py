@@ -54,8 +54,11 @@ class Analysis:
 
         return summarise(self)
 
-    def to_dict(self) -> dict:
-        """The coefficients JSON of INTERFACE.md (SI units), with provenance."""
+    def to_dict(self, model: bool = True) -> dict:
+        """The coefficients JSON of INTERFACE.md (SI units), with provenance.
+
+        ``model``: include the generalised friction model (key ``model``; building
+        it takes about a second: a table of many analyses may leave it out)."""
         d = self.coefficients.to_dict()
         d["N_fe"] = self.static_patch.N_fe
         d["patch"] = self.static_patch.to_dict()
@@ -86,7 +89,8 @@ class Analysis:
                 "centre_of_pressure": list(self.rolling_patch.centre_of_pressure),
                 "grid_radius": self.rolling_map.radius,
             }
-        d["model"] = self.model_summary.to_dict()  # generalised model (fepost.friction.summary)
+        if model:  # generalised friction model (fepost.friction.summary)
+            d["model"] = self.model_summary.to_dict()
         return d
 
 

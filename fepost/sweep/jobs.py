@@ -122,7 +122,8 @@ def run_job(job: Job) -> dict:
                 job.n_steps if job.n_steps is not None else partial(_count_steps, path, job.options.units)
             )
             meta = case_metadata(path, step, n_steps)
-            row.update(step=step, time=res.static_field.time, **coefficient_columns(res.to_dict()), **meta)
+            columns = coefficient_columns(res.to_dict(model=False))  # the table has no model block
+            row.update(step=step, time=res.static_field.time, **columns, **meta)
             row["status"], row["error"] = "ok", ""
         except FepostError as exc:
             row["status"], row["error"] = "error", one_line(str(exc))
