@@ -303,9 +303,11 @@ def _value_options(command: str):
 
 
 @pytest.mark.parametrize("command", COMMANDS)
-def test_hostile_option_values(capsys, data, command):
+def test_hostile_option_values(capsys, data, command, monkeypatch):
     """Every value-taking option x hostile values: a one-line refusal naming the option or the file."""
     folder, _, _ = data
+    # a hostile --out value is a relative folder (``--out=abc``): keep what it writes in the scratch folder
+    monkeypatch.chdir(folder)
     if command not in ("coefficients", "table1", "report", "diagnose", "predict", "sweep"):
         pytest.fail(f"new command {command!r}: add its required arguments to _required()")
     base = _required(command, folder)
