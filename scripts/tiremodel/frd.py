@@ -105,3 +105,39 @@ def read_dat_totals(path) -> list[tuple[str, float, np.ndarray]]:
     for m in _TOTAL.finditer(text):
         out.append((m.group(1), float(m.group(2)), np.array([float(m.group(i)) for i in (3, 4, 5)])))
     return out
+
+
+_BLOCK = re.compile(r"^ ([a-z ]+) \(([a-z,]+)\) for set (\S+) and time\s+(\S+)\s*$")
+
+
+def read_dat_blocks(path) -> list[tuple[str, str, float, np.ndarray]]:
+    """All printed blocks of a .dat file, in file order.
+
+    Each is (kind, set name, time, rows): ``kind`` is the block title
+    ('total force', 'displacements', 'forces', ...); ``rows`` holds the numbers
+    of each printed line (a node number first, except for totals).
+    """
+    out: list[tuple[str, str, float, np.ndarray]] = []
+    cur: tuple[str, str, float] | None = None
+    rows: list[list[float]] = []
+
+    def flush():
+        if cur is not None:
+            out.append((*cur, np.array(rows, dtype=float)))
+
+    with open(path, encoding="latin-1") as fh:
+        for line in fh:
+            m = _BLOCK.match(line.rstrip("\n"))
+            if m:
+                flush()
+                cur, rows = (m.group(1).strip(), m.group(3), float(m.group(4))), []
+                continue
+            f = line.split()
+            if cur is not None and f:
+                try:
+                    rows.append([float(v) for v in f])
+                except ValueError:
+                    flush()
+                    cur, rows = None, []
+    flush()
+    return out

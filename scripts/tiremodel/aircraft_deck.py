@@ -1,0 +1,225 @@
+"""CalculiX deck for the aircraft tire (half model) on a rigid flat road.
+
+Materials (SI units; where the numbers come from is in meshes/README.md):
+
+- tread and sidewall rubber: nearly incompressible Neo-Hooke solids
+  (``*HYPERELASTIC, NEO HOOKE``, bulk modulus K = 100 G);
+- carcass (and, under the crown, the belt package): one orthotropic cord-rubber
+  layer, ``*ELASTIC, TYPE=ENGINEERING CONSTANTS`` in per-element
+  ``*ORIENTATION`` frames: local 1 = meridional (along the section profile,
+  the direction of the radial carcass cords), 2 = circumferential (the belts),
+  3 = normal to the wall.
+
+The rim is a rigid body (``*RIGID BODY`` on the bead nodes) whose reference
+node carries the vertical rim travel and, for the rolling stand-in, the
+longitudinal travel; its rotation node is held. Node-to-surface penalty
+contact with Coulomb friction between the tread/shoulder nodes and the top of
+a fixed road block, as for the small sample tire.
+
+Node numbers: tire nodes 1..n_tire, then the road block's nodes, then the rim
+reference and rotation nodes. Elements: tire 1..e_tire, then the road's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .aircraft_geometry import AircraftMesh
+from .deck import _lines, build_road
+from .geometry import face_lookup
+
+PRESSURE = 1.38e6  # Pa, rated inflation (200 psi)
+RATED_LOAD = 200.0e3  # N, rated load of the modelled tire (45,000 lbf)
+FRICTION = 0.3
+CONTACT_SLOPE = 5.0e9  # Pa/m, pressure per overclosure
+CONTACT_TENSION = 1.0  # Pa
+STICK_SLOPE = 5.0e8  # Pa/m
+
+# rubber: Neo-Hooke C10 = G/2, D1 = 2/K with K = 100 G (initial Poisson ratio 0.495)
+RUBBER = {
+    "TREAD": {"shear_modulus": 1.5e6, "bulk_modulus": 150.0e6},
+    "SIDEWALL": {"shear_modulus": 1.0e6, "bulk_modulus": 100.0e6},
+}
+# carcass layers: E1 meridional, E2 circumferential, E3 normal; nu12, nu13, nu23; G12, G13, G23
+CARCASS = {
+    # radial nylon carcass plies + circumferential (aramid/nylon) belt package under the crown
+    "BELTED": (0.6e9, 2.0e9, 30.0e6, 0.10, 0.45, 0.45, 20.0e6, 10.0e6, 10.0e6),
+    # radial nylon carcass plies only (shoulder, sidewall)
+    "CARCASS": (1.0e9, 30.0e6, 30.0e6, 0.45, 0.45, 0.45, 10.0e6, 10.0e6, 10.0e6),
+}
+
+
+def orthotropic_ok(c) -> bool:
+    """Positive definite compliance (Lempriere's conditions) for engineering constants."""
+    e1, e2, e3, n12, n13, n23, g12, g13, g23 = c
+    s = np.array(
+        [
+            [1 / e1, -n12 / e1, -n13 / e1],
+            [-n12 / e1, 1 / e2, -n23 / e2],
+            [-n13 / e1, -n23 / e2, 1 / e3],
+        ]
+    )
+    return bool(np.all(np.linalg.eigvalsh(s) > 0) and min(g12, g13, g23) > 0)
+
+
+@dataclass(frozen=True)
+class Step:
+    """One analysis step after inflation: the rim reference node's target travel."""
+
+    name: str
+    travel_z: float  # m, total downward rim travel (>= 0)
+    travel_x: float = 0.0  # m, longitudinal rim travel (+x)
+    initial: float = 0.1  # initial increment as a fraction of the step
+    max_inc: float = 0.25
+
+
+@dataclass
+class DeckInfo:
+    tire_nodes: int
+    tire_elements: int
+    road_nodes: int
+    road_elements: int
+    ref_node: int
+    rot_node: int
+    step_names: list = field(default_factory=list)
+
+
+def write_aircraft_deck(path, mesh: AircraftMesh, steps: list[Step]) -> DeckInfo:
+    """Write the deck: inflation (step 1), then one step per entry of ``steps``."""
+    for name, c in CARCASS.items():
+        if not orthotropic_ok(c):
+            raise ValueError(f"carcass constants {name} are not positive definite")
+    road = _half_road()
+    nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
+    ref, rot = nt + road.nodes.shape[0] + 1, nt + road.nodes.shape[0] + 2
+    p = mesh.params
+    out: list[str] = []
+    w = out.append
+    w("*HEADING")
+    w("fepost aircraft tire (46x17R20 class), half model y >= 0")
+    w("*NODE, NSET=NALL")
+    for i, (x, y, z) in enumerate(mesh.nodes):
+        w(f"{i + 1}, {x:.9e}, {y:.9e}, {z:.9e}")
+    for i, (x, y, z) in enumerate(road.nodes):
+        w(f"{nt + i + 1}, {x:.9e}, {y:.9e}, {z:.9e}")
+    w(f"{ref}, 0.0, 0.0, {p.axle_z:.9e}")
+    w(f"{rot}, 0.0, 0.0, {p.axle_z:.9e}")
+    # tire elements, grouped by material
+    w("*ELEMENT, TYPE=C3D8I, ELSET=TIRE")
+    for e, h in enumerate(mesh.hexes):
+        w(f"{e + 1}, " + ", ".join(str(int(n) + 1) for n in h))
+    w("*ELEMENT, TYPE=C3D8, ELSET=ROAD")
+    for e, h in enumerate(road.hexes):
+        w(f"{et + e + 1}, " + ", ".join(str(int(n) + nt + 1) for n in h))
+    rubber = mesh.layer == 0
+    tread = rubber & (mesh.region == 0)
+    for name, sel in (("ETREAD", tread), ("ESIDEWALL", rubber & ~tread)):
+        w(f"*ELSET, ELSET={name}")
+        w(_lines(int(e) + 1 for e in np.flatnonzero(sel)))
+    w("*NSET, NSET=BEAD")
+    w(_lines(int(n) + 1 for n in mesh.bead_nodes))
+    w("*NSET, NSET=SYMN")
+    w(_lines(int(n) + 1 for n in mesh.symmetry_nodes))
+    w("*NSET, NSET=ROADN")
+    w(_lines(range(nt + 1, nt + road.nodes.shape[0] + 1)))
+    w("*NSET, NSET=TIREN")
+    w(_lines(range(1, nt + 1)))
+    w("*NSET, NSET=REFN")
+    w(str(ref))
+    table = face_lookup(mesh.hexes)
+
+    def faces(quads):
+        return [table[frozenset(int(i) for i in q)] for q in quads]
+
+    w("*SURFACE, NAME=STIRE, TYPE=ELEMENT")
+    for e, k in faces(mesh.contact_quads):
+        w(f"{e + 1}, S{k}")
+    w("*SURFACE, NAME=SROAD, TYPE=ELEMENT")
+    for e, k in road.top_faces:
+        w(f"{et + e + 1}, S{k}")
+    # materials
+    for name, r in RUBBER.items():
+        w(f"*MATERIAL, NAME={name}")
+        w("*HYPERELASTIC, NEO HOOKE")
+        w(f"{r['shear_modulus'] / 2:.6e}, {2.0 / r['bulk_modulus']:.6e}")
+    for name, c in CARCASS.items():
+        w(f"*MATERIAL, NAME={name}")
+        w("*ELASTIC, TYPE=ENGINEERING CONSTANTS")
+        w(", ".join(f"{v:.6e}" for v in c[:8]))
+        w(f"{c[8]:.6e}")
+    w("*MATERIAL, NAME=ROADMAT")
+    w("*ELASTIC")
+    w("2.1e11, 0.3")
+    w("*SOLID SECTION, ELSET=ETREAD, MATERIAL=TREAD")
+    w("*SOLID SECTION, ELSET=ESIDEWALL, MATERIAL=SIDEWALL")
+    w("*SOLID SECTION, ELSET=ROAD, MATERIAL=ROADMAT")
+    # carcass: one orientation per element (local 1 meridional, 2 circumferential)
+    for e in np.flatnonzero(mesh.layer == 1):
+        a, b = mesh.meridian[e], mesh.circumferential[e]
+        mat = "BELTED" if mesh.region[e] == 0 else "CARCASS"
+        w(f"*ORIENTATION, NAME=OR{e + 1}")
+        w(", ".join(f"{v:.8f}" for v in (*a, *b)))
+        w(f"*ELSET, ELSET=EC{e + 1}")
+        w(str(e + 1))
+        w(f"*SOLID SECTION, ELSET=EC{e + 1}, MATERIAL={mat}, ORIENTATION=OR{e + 1}")
+    w(f"*RIGID BODY, NSET=BEAD, REF NODE={ref}, ROT NODE={rot}")
+    w("*SURFACE INTERACTION, NAME=SI")
+    w("*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR")
+    w(f"{CONTACT_SLOPE:.6e}, {CONTACT_TENSION:.6e}")
+    w("*FRICTION")
+    w(f"{FRICTION}, {STICK_SLOPE:.6e}")
+    w("*CONTACT PAIR, INTERACTION=SI, TYPE=NODE TO SURFACE")
+    w("STIRE, SROAD")
+    w("*BOUNDARY")
+    w("ROADN, 1, 3")
+    w("SYMN, 2, 2")
+    w(f"{rot}, 1, 3")
+    w(f"{ref}, 1, 3")
+
+    def outputs():
+        w("*NODE FILE, NSET=TIREN")
+        w("U")
+        w("*CONTACT FILE")
+        w("CDIS, CSTR")
+        w("*NODE PRINT, NSET=ROADN, TOTALS=ONLY")
+        w("RF")
+        w("*NODE PRINT, NSET=REFN")
+        w("U, RF")
+
+    w("*STEP, NLGEOM, INC=1000")
+    w("*STATIC")
+    w("0.25, 1.0, 1e-5, 0.5")
+    w("*DLOAD")
+    for e, k in faces(mesh.inner_quads):
+        w(f"{e + 1}, P{k}, {PRESSURE:.6e}")
+    outputs()
+    w("*END STEP")
+    for s in steps:
+        w("*STEP, NLGEOM, INC=1000")
+        w("*STATIC")
+        w(f"{s.initial}, 1.0, 1e-7, {s.max_inc}")
+        w("*BOUNDARY")
+        w(f"{ref}, 1, 1, {s.travel_x:.9e}")
+        w(f"{ref}, 3, 3, {-s.travel_z:.9e}")
+        outputs()
+        w("*END STEP")
+    with open(path, "w") as fh:
+        fh.write("\n".join(out) + "\n")
+    return DeckInfo(
+        tire_nodes=nt,
+        tire_elements=et,
+        road_nodes=int(road.nodes.shape[0]),
+        road_elements=int(road.hexes.shape[0]),
+        ref_node=ref,
+        rot_node=rot,
+        step_names=["inflation", *[s.name for s in steps]],
+    )
+
+
+def _half_road():
+    """Road block on x in [-0.6, 0.6], y in [0, 0.3], top face z = 0, 25 mm faces."""
+    road = build_road(half_x=0.60, half_y=0.15, thick=0.02, size=0.025)
+    road.nodes[:, 1] += 0.15
+    return road
