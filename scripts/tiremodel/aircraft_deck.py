@@ -10,14 +10,13 @@ Materials (SI units; where the numbers come from is in meshes/README.md):
   the direction of the radial carcass cords), 2 = circumferential (the belts),
   3 = normal to the wall.
 
-The rim is a rigid body (``*RIGID BODY`` on the bead nodes) whose reference
-node carries the vertical rim travel and, for the rolling stand-in, the
-longitudinal travel; its rotation node is held. Node-to-surface penalty
+The rim is rigid and held (bead nodes fixed); the road block moves instead (up by the rim travel, and for the rolling stand-in
+along -x), and results are expressed in the road's frame, where the rim moves
+down and along +x. Node-to-surface penalty
 contact with Coulomb friction between the tread/shoulder nodes and the top of
 a fixed road block, as for the small sample tire.
 
-Node numbers: tire nodes 1..n_tire, then the road block's nodes, then the rim
-reference and rotation nodes. Elements: tire 1..e_tire, then the road's.
+Node numbers: tire nodes 1..n_tire, then the road block's nodes. Elements: tire 1..e_tire, then the road's.
 """
 
 from __future__ import annotations
@@ -36,6 +35,7 @@ FRICTION = 0.3
 CONTACT_SLOPE = 5.0e9  # Pa/m, pressure per overclosure
 CONTACT_TENSION = 1.0  # Pa
 STICK_SLOPE = 5.0e8  # Pa/m
+INFLATION_TIME = 0.2  # analysis time of the inflation ramp (each road stage takes 1.0)
 
 # rubber: Neo-Hooke C10 = G/2, D1 = 2/K with K = 100 G (initial Poisson ratio 0.495)
 RUBBER = {
@@ -65,14 +65,19 @@ def orthotropic_ok(c) -> bool:
 
 
 @dataclass(frozen=True)
-class Step:
-    """One analysis step after inflation: the rim reference node's target travel."""
+class Stage:
+    """One unit of analysis time after inflation: the road moves linearly to this travel.
 
-    name: str
-    travel_z: float  # m, total downward rim travel (>= 0)
-    travel_x: float = 0.0  # m, longitudinal rim travel (+x)
-    initial: float = 0.1  # initial increment as a fraction of the step
-    max_inc: float = 0.25
+    ``travel_z`` is the total upward road travel (= downward rim travel relative
+    to the road, m); ``travel_x`` the total road travel along -x (= rim travel
+    along +x relative to the road, m). ``outputs`` maps a case name to the
+    fraction of the stage (0 < f <= 1) at which its results are written.
+    """
+
+    travel_z: float
+    travel_x: float = 0.0
+    outputs: tuple[tuple[str, float], ...] = ()
+    max_inc: float = 0.1  # largest increment, in units of stage time
 
 
 @dataclass
@@ -81,20 +86,24 @@ class DeckInfo:
     tire_elements: int
     road_nodes: int
     road_elements: int
-    ref_node: int
-    rot_node: int
+    output_times: dict = field(default_factory=dict)  # case name -> analysis time
     step_names: list = field(default_factory=list)
 
 
-def write_aircraft_deck(path, mesh: AircraftMesh, steps: list[Step]) -> DeckInfo:
-    """Write the deck: inflation (step 1), then one step per entry of ``steps``."""
+def write_aircraft_deck(path, mesh: AircraftMesh, stages: list[Stage]) -> DeckInfo:
+    """Write the deck: one static step, inflation over [0, INFLATION_TIME], then the stages.
+
+    Everything happens in a single CalculiX step driven by amplitudes (pressure,
+    road travel z and x), with results written at the requested times only
+    (``*TIME POINTS``): CalculiX 2.20 did not converge the first increment of a
+    new step whose prescribed displacements change after a pressure step, while
+    the same path inside one step converges without cut-backs.
+    """
     for name, c in CARCASS.items():
         if not orthotropic_ok(c):
             raise ValueError(f"carcass constants {name} are not positive definite")
     road = _half_road()
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
-    ref, rot = nt + road.nodes.shape[0] + 1, nt + road.nodes.shape[0] + 2
-    p = mesh.params
     out: list[str] = []
     w = out.append
     w("*HEADING")
@@ -104,12 +113,13 @@ def write_aircraft_deck(path, mesh: AircraftMesh, steps: list[Step]) -> DeckInfo
         w(f"{i + 1}, {x:.9e}, {y:.9e}, {z:.9e}")
     for i, (x, y, z) in enumerate(road.nodes):
         w(f"{nt + i + 1}, {x:.9e}, {y:.9e}, {z:.9e}")
-    w(f"{ref}, 0.0, 0.0, {p.axle_z:.9e}")
-    w(f"{rot}, 0.0, 0.0, {p.axle_z:.9e}")
     # tire elements, grouped by material
-    w("*ELEMENT, TYPE=C3D8I, ELSET=TIRE")
-    for e, h in enumerate(mesh.hexes):
-        w(f"{e + 1}, " + ", ".join(str(int(n) + 1) for n in h))
+    # incompatible-mode hexahedra (good in bending) in the refined region around the
+    # patch; plain C3D8 in the coarse upper part, which only carries the inflation
+    for etype, sel in (("C3D8I", mesh.fine), ("C3D8", ~mesh.fine)):
+        w(f"*ELEMENT, TYPE={etype}, ELSET=TIRE")
+        for e in np.flatnonzero(sel):
+            w(f"{e + 1}, " + ", ".join(str(int(n) + 1) for n in mesh.hexes[e]))
     w("*ELEMENT, TYPE=C3D8, ELSET=ROAD")
     for e, h in enumerate(road.hexes):
         w(f"{et + e + 1}, " + ", ".join(str(int(n) + nt + 1) for n in h))
@@ -126,8 +136,8 @@ def write_aircraft_deck(path, mesh: AircraftMesh, steps: list[Step]) -> DeckInfo
     w(_lines(range(nt + 1, nt + road.nodes.shape[0] + 1)))
     w("*NSET, NSET=TIREN")
     w(_lines(range(1, nt + 1)))
-    w("*NSET, NSET=REFN")
-    w(str(ref))
+    w("*NSET, NSET=ROADREF")
+    w(str(nt + 1))
     table = face_lookup(mesh.hexes)
 
     def faces(quads):
@@ -164,7 +174,6 @@ def write_aircraft_deck(path, mesh: AircraftMesh, steps: list[Step]) -> DeckInfo
         w(f"*ELSET, ELSET=EC{e + 1}")
         w(str(e + 1))
         w(f"*SOLID SECTION, ELSET=EC{e + 1}, MATERIAL={mat}, ORIENTATION=OR{e + 1}")
-    w(f"*RIGID BODY, NSET=BEAD, REF NODE={ref}, ROT NODE={rot}")
     w("*SURFACE INTERACTION, NAME=SI")
     w("*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR")
     w(f"{CONTACT_SLOPE:.6e}, {CONTACT_TENSION:.6e}")
@@ -172,39 +181,54 @@ def write_aircraft_deck(path, mesh: AircraftMesh, steps: list[Step]) -> DeckInfo
     w(f"{FRICTION}, {STICK_SLOPE:.6e}")
     w("*CONTACT PAIR, INTERACTION=SI, TYPE=NODE TO SURFACE")
     w("STIRE, SROAD")
+    # time schedule: inflation over [0, t0], then stage k over [t0 + k - 1, t0 + k]
+    t0 = INFLATION_TIME
+    times, zs, xs = [0.0, t0], [0.0, 0.0], [0.0, 0.0]
+    output_times: dict[str, float] = {"inflation": t0}
+    for k, st in enumerate(stages, start=1):
+        for name, frac in st.outputs:
+            if not 0.0 < frac <= 1.0:
+                raise ValueError(f"output {name}: stage fraction {frac} outside (0, 1]")
+            output_times[name] = t0 + k - 1 + frac
+        times.append(t0 + k)
+        zs.append(st.travel_z)
+        xs.append(st.travel_x)
+    total = times[-1]
+    w("*AMPLITUDE, NAME=APRESS")
+    w(f"0.0, 0.0, {t0:.6f}, 1.0, {total:.6f}, 1.0")
+    for name, vals in (("AROADZ", zs), ("AROADX", xs)):
+        w(f"*AMPLITUDE, NAME={name}")
+        w(_lines((f"{t:.6f}, {v:.9e}" for t, v in zip(times, vals, strict=True)), per=4))
+    w("*TIME POINTS, NAME=TOUT")
+    w(_lines(f"{t:.9f}" for t in sorted(set(output_times.values()))))
     w("*BOUNDARY")
-    w("ROADN, 1, 3")
     w("SYMN, 2, 2")
-    w(f"{rot}, 1, 3")
-    w(f"{ref}, 1, 3")
-
-    def outputs():
-        w("*NODE FILE, NSET=TIREN")
-        w("U")
-        w("*CONTACT FILE")
-        w("CDIS, CSTR")
-        w("*NODE PRINT, NSET=ROADN, TOTALS=ONLY")
-        w("RF")
-        w("*NODE PRINT, NSET=REFN")
-        w("U, RF")
-
-    w("*STEP, NLGEOM, INC=1000")
+    w("BEAD, 1, 3")
+    w("ROADN, 2, 2")
+    w("*STEP, NLGEOM, INC=5000")
     w("*STATIC")
-    w("0.25, 1.0, 1e-5, 0.5")
-    w("*DLOAD")
+    max_inc = min([t0, *[st.max_inc for st in stages]])
+    w(f"{max_inc}, {total:.6f}, 1e-8, {max_inc}")
+    # the road block moves (all nodes prescribed) and the rim stays; the export
+    # expresses everything in the road's frame, where the rim moves
+    w("*BOUNDARY, AMPLITUDE=AROADZ")
+    w("ROADN, 3, 3, 1.0")
+    w("*BOUNDARY, AMPLITUDE=AROADX")
+    w("ROADN, 1, 1, -1.0")
+    w("*DLOAD, AMPLITUDE=APRESS")
     for e, k in faces(mesh.inner_quads):
         w(f"{e + 1}, P{k}, {PRESSURE:.6e}")
-    outputs()
+    w("*NODE FILE, NSET=TIREN, TIME POINTS=TOUT")
+    w("U")
+    w("*CONTACT FILE, TIME POINTS=TOUT")
+    w("CDIS, CSTR")
+    w("*NODE PRINT, NSET=ROADN, TOTALS=ONLY")
+    w("RF")
+    w("*NODE PRINT, NSET=ROADREF")
+    w("U")
+    w("*NODE PRINT, NSET=BEAD, TOTALS=ONLY")
+    w("RF")
     w("*END STEP")
-    for s in steps:
-        w("*STEP, NLGEOM, INC=1000")
-        w("*STATIC")
-        w(f"{s.initial}, 1.0, 1e-7, {s.max_inc}")
-        w("*BOUNDARY")
-        w(f"{ref}, 1, 1, {s.travel_x:.9e}")
-        w(f"{ref}, 3, 3, {-s.travel_z:.9e}")
-        outputs()
-        w("*END STEP")
     with open(path, "w") as fh:
         fh.write("\n".join(out) + "\n")
     return DeckInfo(
@@ -212,9 +236,8 @@ def write_aircraft_deck(path, mesh: AircraftMesh, steps: list[Step]) -> DeckInfo
         tire_elements=et,
         road_nodes=int(road.nodes.shape[0]),
         road_elements=int(road.hexes.shape[0]),
-        ref_node=ref,
-        rot_node=rot,
-        step_names=["inflation", *[s.name for s in steps]],
+        output_times=output_times,
+        step_names=list(output_times),
     )
 
 

@@ -51,16 +51,16 @@ class AircraftParams:
     rubber_thickness: tuple = ((0.020, 0.020), (0.020, 0.006), (0.006, 0.006))
     gap0: float = 0.030  # clearance between the uninflated crown and the road
     # mesh: elements along crown / shoulder / sidewall arcs (half section)
-    n_crown: int = 9
-    n_shoulder: int = 5
-    n_side: int = 7
+    n_crown: int = 7
+    n_shoulder: int = 4
+    n_side: int = 5
     # circumferential layers, per side of the bottom: the first layer spans
     # ``first_deg`` and each next one is ``growth`` times longer up to ``fine_deg``;
     # beyond it ``n_coarse`` layers of geometrically growing size up to 180 deg
-    first_deg: float = 0.45
-    growth: float = 1.025
-    fine_deg: float = 50.0
-    n_coarse: int = 24
+    first_deg: float = 0.6
+    growth: float = 1.02
+    fine_deg: float = 45.0
+    n_coarse: int = 18
 
     @property
     def axle_z(self) -> float:
@@ -129,6 +129,7 @@ class AircraftMesh:
     hexes: np.ndarray  # (e, 8) int, 0-based, C3D8 ordering, positive volume
     region: np.ndarray  # (e,) int: 0 crown, 1 shoulder, 2 side
     layer: np.ndarray  # (e,) int: 0 rubber, 1 carcass
+    fine: np.ndarray  # (e,) bool: element in the refined region around the bottom
     meridian: np.ndarray  # (e, 3) unit meridional direction at the element centroid
     circumferential: np.ndarray  # (e, 3) unit circumferential direction
     outer_quads: np.ndarray  # (f, 4) outer surface, outward normals
@@ -217,7 +218,7 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
         coarse = p.coarse_layers()
         base = [(2, s) for s, _, _ in surfaces]
         groups: dict[str, list[int]] = {"outer": [], "contact": [], "inner": [], "bead": [], "sym": []}
-        vol_kind: dict[int, tuple[int, int]] = {}
+        vol_kind: dict[int, tuple[int, int, bool]] = {}
 
         def heights(sizes):
             c = np.cumsum(sizes)
@@ -244,7 +245,7 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
                     blk = out[6 * j : 6 * j + 6]
                     top, vol, lat = blk[0], blk[1], blk[2:]
                     new_tops.append(top)
-                    vol_kind[vol[1]] = (k, layer)
+                    vol_kind[vol[1]] = (k, layer, part == "fine")
                     if layer == 0:
                         groups["outer"].append(lat[0][1])
                         if part == "fine" and k in (0, 1):
@@ -261,8 +262,8 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
 
         tags, coords, _ = gmsh.model.mesh.getNodes()
         coords = coords.reshape(-1, 3)
-        hex_list, reg_list, lay_list = [], [], []
-        for vtag, (k, layer) in vol_kind.items():
+        hex_list, reg_list, lay_list, fine_list = [], [], [], []
+        for vtag, (k, layer, is_fine) in vol_kind.items():
             et, _, en = gmsh.model.mesh.getElements(3, vtag)
             for t, nn in zip(et, en, strict=True):
                 if t != 5:
@@ -271,6 +272,7 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
                 hex_list.append(h)
                 reg_list.append(np.full(h.shape[0], k))
                 lay_list.append(np.full(h.shape[0], layer))
+                fine_list.append(np.full(h.shape[0], is_fine))
         hexes_t = np.vstack(hex_list)
 
         def quads_of(surfs: list[int]) -> np.ndarray:
@@ -321,6 +323,7 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
         hexes=hexes,
         region=region,
         layer=layer,
+        fine=np.concatenate(fine_list),
         meridian=meridian,
         circumferential=circ,
         outer_quads=_orient_outward(hexes, table, remap(q["outer"])),

@@ -79,7 +79,7 @@ def _run(exe: str, inp: Path, timeout: float) -> float:
 
 def run_decks(
     mesh: AircraftMesh,
-    plans: dict[str, list[ad.Step]],
+    plans: dict[str, list[ad.Stage]],
     workdir: Path,
     jobs: int = 2,
     timeout: float = 3 * 3600.0,
@@ -99,46 +99,53 @@ def run_decks(
     }
 
 
+def _at_time(records, t: float, what: str, job: str) -> np.ndarray:
+    for time_, value in records:
+        if abs(time_ - t) < 1e-6:
+            return value
+    raise ModelError(f"{job}: no {what} printed at analysis time {t:g}")
+
+
 def _collect(mesh: AircraftMesh, inp: Path, name: str, info: ad.DeckInfo, runtime: float, solver: str):
     nt = mesh.nodes.shape[0]
-    res = read_frd(inp.with_suffix(".frd"))
+    res = read_frd(inp.with_suffix(".frd"), every=True)
     if res.node_ids[:nt].tolist() != list(range(1, nt + 1)):
         raise ModelError("unexpected node numbering in the .frd file")
     blocks = read_dat_blocks(inp.with_suffix(".dat"))
-    road = [b[3][0] for b in blocks if b[0] == "total force" and b[1] == "ROADN"]
-    ref = [b[3][0, 1:4] for b in blocks if b[0] == "displacements" and b[1] == "REFN"]
-    if len(road) != len(res.steps) or len(ref) != len(res.steps):
-        raise ModelError(f"{inp.stem}: {len(road)} printed increments but {len(res.steps)} stored ones")
-    last_index = {}
-    for i, (step, _) in enumerate(res.steps):
-        last_index[step] = i
+    road = [(b[2], b[3][0]) for b in blocks if b[0] == "total force" and b[1] == "ROADN"]
+    # rim displacement relative to the road = -(road block displacement)
+    rim = [(b[2], -b[3][0, 1:4]) for b in blocks if b[0] == "displacements" and b[1] == "ROADREF"]
+    if not road or len(road) != len(rim):
+        raise ModelError(f"{inp.stem}: road force and road displacement records do not match")
     states = []
-    for k, step_name in enumerate(info.step_names, start=1):
-        if k not in res.last:
-            raise ModelError(f"{inp.stem}: step {k} ({step_name}) has no results")
-        _, u = res.field(k, "U")
-        if k == 1:
+    for case, t in info.output_times.items():
+        store = next((blk for time_, blk in res.every if abs(time_ - t) < 1e-6), None)
+        if store is None or "U" not in store:
+            raise ModelError(f"{inp.stem}: no results at analysis time {t:g} ({case})")
+        u = store["U"][1][:nt]
+        rim_u = np.asarray(_at_time(rim, t, "road displacement", inp.stem), dtype=float)
+        if case == "inflation" or "CONTACT" not in store:
             cp = np.zeros(nt)
         else:
-            comps, c = res.field(k, "CONTACT")
+            comps, c = store["CONTACT"]
             cp = np.clip(c[:nt, comps.index("CPRESS")], 0.0, None)
-        i = last_index[k]
         states.append(
             StepState(
-                name=step_name,
-                displacement=u[:nt].copy(),
+                name=case,
+                # in the road's frame the road is at rest and the rim moves by rim_u
+                displacement=u + rim_u[None, :],
                 cpress=cp,
-                road_force=np.asarray(road[i], dtype=float),
-                rim_displacement=np.asarray(ref[i], dtype=float),
+                road_force=np.asarray(_at_time(road, t, "road force", inp.stem), dtype=float),
+                rim_displacement=rim_u,
             )
         )
-    ref_arr = np.array(ref)
+    rim_arr = np.array([v for _, v in rim])
     return RunResult(
         name=name,
         steps=tuple(states),
-        curve_travel=-ref_arr[:, 2],
-        curve_force=np.array([f[2] for f in road]),
-        curve_travel_x=ref_arr[:, 0],
+        curve_travel=-rim_arr[:, 2],
+        curve_force=np.array([f[2] for _, f in road]),
+        curve_travel_x=rim_arr[:, 0],
         runtime_s=runtime,
         solver=solver,
         deck=info,
