@@ -48,7 +48,12 @@ def _parser() -> argparse.ArgumentParser:
         "--out", type=Path, default=REPO / "meshes" / "aircraft", help="output folder (default: meshes/aircraft/)"
     )
     a.add_argument("--jobs", type=int, default=2, help="CalculiX runs at a time (one thread each)")
-    a.add_argument("--keep", type=Path, default=None, help="also copy the CalculiX work files here")
+    a.add_argument(
+        "--work",
+        type=Path,
+        default=None,
+        help="keep the CalculiX files here; runs already completed there with the same deck are reused",
+    )
     a.add_argument("--debug", action="store_true", help="show tracebacks")
     c = sub.add_parser("check-elements", help="cantilever check of the rubber elements against Timoshenko")
     c.add_argument("--debug", action="store_true", help="show tracebacks")
@@ -104,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "aircraft":
             from .aircraft_build import build_aircraft
 
-            build_aircraft(args.out, coarse=args.coarse, jobs=args.jobs, keep=args.keep)
+            build_aircraft(args.out, coarse=args.coarse, jobs=args.jobs, work=args.work)
         else:
             cases = list(dk.CASES) if args.case == "all" else [args.case]
             build(cases, args.coarse, args.out, args.keep, args.threads)

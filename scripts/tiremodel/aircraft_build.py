@@ -35,8 +35,9 @@ LOAD_FRACTIONS = (0.25, 0.50, 0.75, 1.00, 1.25, 1.50)
 TOLERANCE = 0.03  # relative load error accepted without a secant correction
 ROLL_TOLERANCE = 0.05  # the same for the rolling run's vertical load
 BRACKET = (-0.025, 0.0, 0.025)  # relative rim-travel offsets written around each estimate
-PROBE_TRAVEL = 0.20  # m, rim travel of the coarse pre-estimate (past 150 % of rated load)
-ROLL_DX = 0.04  # m, rim travel along +x of the rolling stand-in
+PROBE_TRAVEL = 0.165  # m, rim travel of the coarse pre-estimate (past 150 % of rated load)
+ROLL_DX = 0.03  # m, rim travel along +x of the rolling stand-in
+RESIDUAL_TOLERANCE = 0.02  # CalculiX R_n of the fine runs (see aircraft_deck.write_aircraft_deck)
 
 
 def static_name(fraction: float) -> str:
@@ -57,10 +58,10 @@ def _plans(travels: np.ndarray, rated_travel: float) -> dict[str, list[ad.Stage]
         for j, b in enumerate(BRACKET)
     )
     return {
-        "sweep": [ad.Stage(tmax, 0.0, outputs, max_inc=0.05)],
+        "sweep": [ad.Stage(tmax, 0.0, outputs, max_inc=0.05, samples=20)],
         "rolling": [
-            ad.Stage(rated_travel, 0.0, (("rolling_vertical", 1.0),), max_inc=0.1),
-            ad.Stage(rated_travel, ROLL_DX, (("rolling_100", 1.0),), max_inc=0.1),
+            ad.Stage(rated_travel, 0.0, (("rolling_vertical", 1.0),), max_inc=0.05),
+            ad.Stage(rated_travel, ROLL_DX, (("rolling_100", 1.0),), max_inc=0.05, samples=10),
         ],
     }
 
@@ -69,60 +70,67 @@ def _log(msg: str) -> None:
     print(f"tiremodel: {msg}", file=sys.stderr, flush=True)
 
 
-def build_aircraft(out: Path, coarse: bool = False, jobs: int = 2, keep: Path | None = None) -> list[dict]:
-    """Solve and export every case into ``out`` (replaced only when all succeeded)."""
+def build_aircraft(out: Path, coarse: bool = False, jobs: int = 2, work: Path | None = None) -> list[dict]:
+    """Solve and export every case into ``out`` (replaced only when all succeeded).
+
+    ``work``: a folder for the CalculiX files that is kept; runs already
+    completed there with the same deck are reused (resume after a failure).
+    Without it a temporary folder is used and removed.
+    """
     find_ccx()
     t_start = time.perf_counter()
     targets = np.array(LOAD_FRACTIONS) * ad.RATED_LOAD
     with tempfile.TemporaryDirectory(prefix="tiremodel-aircraft-") as tmp_name:
-        tmp = Path(tmp_name)
-        try:
-            probe_mesh = build_aircraft_mesh(coarse_aircraft_params())
-            _log(f"pre-estimate on the coarse mesh ({probe_mesh.info['nodes']} nodes) ...")
-            probe_curve = _probe(probe_mesh, tmp / "probe")
-            travels = travel_for_loads(probe_curve[0], probe_curve[1], targets)
-            _log(
-                "pre-estimated rim travels (mm): "
-                + ", ".join(f"{1e3 * t:.1f}" for t in travels)
-                + f" ({probe_curve[3]:.0f} s)"
+        tmp = Path(tmp_name) if work is None else work
+        probe_mesh = build_aircraft_mesh(coarse_aircraft_params())
+        _log(f"pre-estimate on the coarse mesh ({probe_mesh.info['nodes']} nodes) ...")
+        probe_curve = _probe(probe_mesh, tmp / "probe")
+        travels = travel_for_loads(probe_curve[0], probe_curve[1], targets)
+        _log(
+            "pre-estimated rim travels (mm): "
+            + ", ".join(f"{1e3 * t:.1f}" for t in travels)
+            + f" ({probe_curve[3]:.0f} s)"
+        )
+        mesh = probe_mesh if coarse else build_aircraft_mesh(AircraftParams())
+        rated_travel = float(travels[LOAD_FRACTIONS.index(1.0)])
+        for attempt in (1, 2):
+            label = "coarse" if coarse else "fine"
+            _log(f"{label} mesh ({mesh.info['nodes']} nodes), pass {attempt} ...")
+            runs = run_decks(
+                mesh,
+                _plans(travels, rated_travel),
+                tmp / f"pass{attempt}",
+                jobs=jobs,
+                tolerances={"sweep": RESIDUAL_TOLERANCE, "rolling": RESIDUAL_TOLERANCE},
             )
-            mesh = probe_mesh if coarse else build_aircraft_mesh(AircraftParams())
-            rated_travel = float(travels[LOAD_FRACTIONS.index(1.0)])
-            for attempt in (1, 2):
-                label = "coarse" if coarse else "fine"
-                _log(f"{label} mesh ({mesh.info['nodes']} nodes), pass {attempt} ...")
-                runs = run_decks(mesh, _plans(travels, rated_travel), tmp / f"pass{attempt}", jobs=jobs)
-                sweep, rolling = runs["sweep"], runs["rolling"]
-                chosen = []
-                for f, target in zip(LOAD_FRACTIONS, targets, strict=True):
-                    names = [_candidate(f, j) for j in range(len(BRACKET))]
-                    errs = [abs(2.0 * sweep.step(n).road_force[2] / target - 1.0) for n in names]
-                    chosen.append(names[int(np.argmin(errs))])
-                loads = np.array([2.0 * sweep.step(n).road_force[2] for n in chosen])
-                roll_load = 2.0 * rolling.step("rolling_vertical").road_force[2]
-                err = loads / targets - 1.0
-                roll_err = roll_load / ad.RATED_LOAD - 1.0
-                _log(
-                    "loads / target - 1: "
-                    + ", ".join(f"{100 * e:+.1f} %" for e in err)
-                    + f"; rolling {100 * roll_err:+.1f} % "
-                    + f"(sweep {sweep.runtime_s:.0f} s, rolling {rolling.runtime_s:.0f} s)"
+            sweep, rolling = runs["sweep"], runs["rolling"]
+            chosen = []
+            for f, target in zip(LOAD_FRACTIONS, targets, strict=True):
+                names = [_candidate(f, j) for j in range(len(BRACKET))]
+                errs = [abs(2.0 * sweep.step(n).road_force[2] / target - 1.0) for n in names]
+                chosen.append(names[int(np.argmin(errs))])
+            loads = np.array([2.0 * sweep.step(n).road_force[2] for n in chosen])
+            roll_load = 2.0 * rolling.step("rolling_vertical").road_force[2]
+            err = loads / targets - 1.0
+            roll_err = roll_load / ad.RATED_LOAD - 1.0
+            _log(
+                "loads / target - 1: "
+                + ", ".join(f"{100 * e:+.1f} %" for e in err)
+                + f"; rolling {100 * roll_err:+.1f} % "
+                + f"(sweep {sweep.runtime_s:.0f} s, rolling {rolling.runtime_s:.0f} s)"
+            )
+            if np.all(np.abs(err) <= TOLERANCE) and abs(roll_err) <= ROLL_TOLERANCE:
+                break
+            if attempt == 2:
+                raise ModelError(
+                    "target loads not reached within "
+                    f"{100 * TOLERANCE:.0f} % after a secant correction: {np.round(100 * err, 1)} %"
                 )
-                if np.all(np.abs(err) <= TOLERANCE) and abs(roll_err) <= ROLL_TOLERANCE:
-                    break
-                if attempt == 2:
-                    raise ModelError(
-                        "target loads not reached within "
-                        f"{100 * TOLERANCE:.0f} % after a secant correction: {np.round(100 * err, 1)} %"
-                    )
-                # secant step on the fine run's own load-deflection curve
-                travels = travel_for_loads(sweep.curve_travel, 2.0 * sweep.curve_force, targets)
-                rated_travel = float(travels[LOAD_FRACTIONS.index(1.0)])
-            stage = tmp / "export"
-            sides = _export(mesh, sweep, rolling, stage, probe_curve, chosen)
-        finally:
-            if keep is not None:
-                shutil.copytree(tmp, keep, dirs_exist_ok=True, ignore=shutil.ignore_patterns("*.frd"))
+            # secant step on the fine run's own load-deflection curve
+            travels = travel_for_loads(sweep.curve_travel, 2.0 * sweep.curve_force, targets)
+            rated_travel = float(travels[LOAD_FRACTIONS.index(1.0)])
+        stage = tmp / "export"
+        sides = _export(mesh, sweep, rolling, stage, probe_curve, chosen)
         out.mkdir(parents=True, exist_ok=True)
         for f in sorted(stage.iterdir()):
             part = out / (f.name + ".part")
@@ -140,7 +148,7 @@ def _probe(mesh, workdir: Path) -> tuple[np.ndarray, np.ndarray, float, float]:
     passes the largest target load.
     """
     try:
-        plan = {"probe": [ad.Stage(PROBE_TRAVEL, 0.0, (("probe_end", 1.0),), max_inc=0.04)]}
+        plan = {"probe": [ad.Stage(PROBE_TRAVEL, 0.0, (("probe_end", 1.0),), max_inc=0.04, samples=33)]}
         run = run_decks(mesh, plan, workdir, jobs=1)["probe"]
         return (
             run.curve_travel,
@@ -155,10 +163,11 @@ def _probe(mesh, workdir: Path) -> tuple[np.ndarray, np.ndarray, float, float]:
         blocks = read_dat_blocks(dat)
         force = np.array([2.0 * b[3][0][2] for b in blocks if b[0] == "total force" and b[1] == "ROADN"])
         travel = np.array([b[3][0][3] for b in blocks if b[0] == "displacements" and b[1] == "ROADREF"])
+        clear = float(np.interp(1e-3, force, travel)) if force.size else float("nan")
         if force.size == 0 or force.max() < max(LOAD_FRACTIONS) * ad.RATED_LOAD:
             raise
         _log(f"pre-estimate stopped early ({exc}); its converged part covers the targets")
-        return travel[: force.size], force, float("nan"), float("nan")
+        return travel[: force.size], force, clear, float("nan")
 
 
 def _export(mesh, sweep, rolling, stage: Path, probe_curve, chosen: list[str]) -> list[dict]:

@@ -59,8 +59,8 @@ class AircraftParams:
     # beyond it ``n_coarse`` layers of geometrically growing size up to 180 deg
     first_deg: float = 0.6
     growth: float = 1.02
-    fine_deg: float = 45.0
-    n_coarse: int = 18
+    fine_deg: float = 55.0
+    n_coarse: int = 22
 
     @property
     def axle_z(self) -> float:

@@ -77,26 +77,60 @@ def _run(exe: str, inp: Path, timeout: float) -> float:
     return dt
 
 
+def _finished(workdir: Path, name: str, deck: str) -> float | None:
+    """Run time of an earlier, completed run of exactly this deck in ``workdir``, else None."""
+    inp, stamp = workdir / f"{name}.inp", workdir / f"{name}.runtime"
+    try:
+        same = inp.read_text() == deck
+        done = "Job finished" in (workdir / f"{name}.log").read_text(errors="replace")
+        seconds = float(stamp.read_text())
+    except (OSError, ValueError):
+        return None
+    if same and done and (workdir / f"{name}.frd").exists() and (workdir / f"{name}.dat").exists():
+        return seconds
+    return None
+
+
+def _solve(exe: str, workdir: Path, name: str, timeout: float) -> float:
+    seconds = _run(exe, workdir / f"{name}.inp", timeout)
+    (workdir / f"{name}.runtime").write_text(f"{seconds:.1f}\n")
+    return seconds
+
+
 def run_decks(
     mesh: AircraftMesh,
     plans: dict[str, list[ad.Stage]],
     workdir: Path,
     jobs: int = 2,
     timeout: float = 3 * 3600.0,
+    tolerances: dict[str, float] | None = None,
 ) -> dict[str, RunResult]:
-    """Write and solve one deck per plan (``jobs`` at a time); parse every step."""
+    """Write and solve one deck per plan (``jobs`` at a time); parse every output.
+
+    A run whose deck is identical to a completed earlier run in ``workdir`` is
+    not solved again (a build interrupted half-way resumes where it stopped).
+    ``tolerances`` gives a relaxed residual tolerance per plan (see
+    ``aircraft_deck.write_aircraft_deck``).
+    """
     exe = find_ccx()
     workdir.mkdir(parents=True, exist_ok=True)
-    infos = {}
+    infos, times, todo = {}, {}, []
     for name, steps in plans.items():
-        infos[name] = ad.write_aircraft_deck(workdir / f"{name}.inp", mesh, steps)
+        deck_path = workdir / f"{name}.deck.tmp"
+        infos[name] = ad.write_aircraft_deck(deck_path, mesh, steps, (tolerances or {}).get(name))
+        deck = deck_path.read_text()
+        deck_path.unlink()
+        done = _finished(workdir, name, deck)
+        if done is None:
+            (workdir / f"{name}.inp").write_text(deck)
+            todo.append(name)
+        else:
+            times[name] = done
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        futures = {name: pool.submit(_run, exe, workdir / f"{name}.inp", timeout) for name in plans}
-        times = {name: f.result() for name, f in futures.items()}
+        futures = {name: pool.submit(_solve, exe, workdir, name, timeout) for name in todo}
+        times.update({name: f.result() for name, f in futures.items()})
     solver = ccx_version(exe)
-    return {
-        name: _collect(mesh, workdir / f"{name}.inp", name, infos[name], times[name], solver) for name in plans
-    }
+    return {name: _collect(mesh, workdir / f"{name}.inp", name, infos[name], times[name], solver) for name in plans}
 
 
 def _at_time(records, t: float, what: str, job: str) -> np.ndarray:
