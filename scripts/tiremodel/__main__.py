@@ -45,7 +45,10 @@ def _parser() -> argparse.ArgumentParser:
     )
     a.add_argument("--coarse", action="store_true", help="solve the sweep on the coarse mesh (quick look)")
     a.add_argument(
-        "--out", type=Path, default=REPO / "meshes" / "aircraft", help="output folder (default: meshes/aircraft/)"
+        "--out",
+        type=Path,
+        default=REPO / "meshes" / "aircraft",
+        help="output folder (default: meshes/aircraft/)",
     )
     a.add_argument("--jobs", type=int, default=2, help="CalculiX runs at a time (one thread each)")
     a.add_argument(

@@ -10,11 +10,11 @@ Materials (SI units; where the numbers come from is in meshes/README.md):
   the direction of the radial carcass cords), 2 = circumferential (the belts),
   3 = normal to the wall.
 
-The rim is rigid and held (bead nodes fixed); the road block moves instead (up by the rim travel, and for the rolling stand-in
-along -x), and results are expressed in the road's frame, where the rim moves
-down and along +x. Node-to-surface penalty
-contact with Coulomb friction between the tread/shoulder nodes and the top of
-a fixed road block, as for the small sample tire.
+The rim is rigid and held (bead nodes fixed); the road block moves instead (up
+by the rim travel, and for the rolling stand-in along -x), and results are
+expressed in the road's frame, where the rim moves down and along +x. Node-to-
+surface penalty contact with Coulomb friction between the tread/shoulder nodes
+and the top of the road block, as for the small sample tire.
 
 Node numbers: tire nodes 1..n_tire, then the road block's nodes. Elements: tire 1..e_tire, then the road's.
 """

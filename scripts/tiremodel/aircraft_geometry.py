@@ -182,7 +182,7 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
         surfaces: list[tuple[int, int, int]] = []  # (surface tag, region, layer)
         prev = None  # (points, lines) at the start of the current arc
         sym_lines: list[int] = []
-        for k, (yc, rc, rr, b0, b1) in enumerate(arcs):
+        for k, (yc, rc, _, b0, b1) in enumerate(arcs):
             if prev is None:
                 p0 = profile_points(k, b0, 0)
                 l0 = [geo.addLine(p0[0], p0[1]), geo.addLine(p0[1], p0[2])]

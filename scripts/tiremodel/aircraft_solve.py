@@ -130,7 +130,10 @@ def run_decks(
         futures = {name: pool.submit(_solve, exe, workdir, name, timeout) for name in todo}
         times.update({name: f.result() for name, f in futures.items()})
     solver = ccx_version(exe)
-    return {name: _collect(mesh, workdir / f"{name}.inp", name, infos[name], times[name], solver) for name in plans}
+    return {
+        name: _collect(mesh, workdir / f"{name}.inp", name, infos[name], times[name], solver)
+        for name in plans
+    }
 
 
 def _at_time(records, t: float, what: str, job: str) -> np.ndarray:
