@@ -189,3 +189,23 @@ def test_exodus_and_vtu_agree(case):
 def test_samples_are_small():
     total = sum(f.stat().st_size for f in FOLDER.iterdir() if f.is_file())
     assert total < 10e6
+    # everything under meshes/ (small tire + aircraft tire) stays within 25 MB
+    assert sum(f.stat().st_size for f in FOLDER.parent.rglob("*") if f.is_file()) < 25e6
+
+
+def test_travel_for_loads_inverts_a_known_curve():
+    """The pre-estimate inversion: a curve F = k (d - c)^1.4 sampled at increments, zero before
+    contact, is inverted to within the sampling error; a target beyond it is extrapolated."""
+    import sys
+
+    sys.path.insert(0, str(FOLDER.parents[1]))
+    from scripts.tiremodel.aircraft_solve import travel_for_loads
+
+    c, k = 0.02, 3.0e6
+    d = np.linspace(0.0, 0.15, 151)
+    f = k * np.clip(d - c, 0.0, None) ** 1.4
+    targets = np.array([5e4, 1e5, 2e5])
+    exact = c + (targets / k) ** (1 / 1.4)
+    np.testing.assert_allclose(travel_for_loads(d, f, targets), exact, atol=0.5 * (d[1] - d[0]))
+    beyond = travel_for_loads(d, f, np.array([f[-1] * 1.05]))[0]
+    assert d[-1] < beyond < d[-1] + 0.01
