@@ -37,7 +37,8 @@ ROLL_TOLERANCE = 0.05  # the same for the rolling run's vertical load
 BRACKET = (-0.025, 0.0, 0.025)  # relative rim-travel offsets written around each estimate
 PROBE_TRAVEL = 0.165  # m, rim travel of the coarse pre-estimate (past 150 % of rated load)
 ROLL_DX = 0.03  # m, rim travel along +x of the rolling stand-in
-RESIDUAL_TOLERANCE = 0.02  # CalculiX R_n of the fine runs (see aircraft_deck.write_aircraft_deck)
+# relaxed CalculiX convergence criteria (R_n, C_n) of the fine runs; see aircraft_deck.write_aircraft_deck
+TOLERANCES = {"sweep": (0.02, 0.5), "rolling": (0.02, None)}
 
 
 def static_name(fraction: float) -> str:
@@ -101,7 +102,7 @@ def build_aircraft(out: Path, coarse: bool = False, jobs: int = 2, work: Path | 
                 _plans(travels, rated_travel),
                 tmp / f"pass{attempt}",
                 jobs=jobs,
-                tolerances={"sweep": RESIDUAL_TOLERANCE, "rolling": RESIDUAL_TOLERANCE},
+                tolerances=TOLERANCES,
             )
             sweep, rolling = runs["sweep"], runs["rolling"]
             chosen = []

@@ -103,21 +103,22 @@ def run_decks(
     workdir: Path,
     jobs: int = 2,
     timeout: float = 3 * 3600.0,
-    tolerances: dict[str, float] | None = None,
+    tolerances: dict[str, tuple[float, float | None]] | None = None,
 ) -> dict[str, RunResult]:
     """Write and solve one deck per plan (``jobs`` at a time); parse every output.
 
     A run whose deck is identical to a completed earlier run in ``workdir`` is
     not solved again (a build interrupted half-way resumes where it stopped).
-    ``tolerances`` gives a relaxed residual tolerance per plan (see
-    ``aircraft_deck.write_aircraft_deck``).
+    ``tolerances`` gives relaxed (residual, correction) tolerances per plan
+    (see ``aircraft_deck.write_aircraft_deck``).
     """
     exe = find_ccx()
     workdir.mkdir(parents=True, exist_ok=True)
     infos, times, todo = {}, {}, []
     for name, steps in plans.items():
         deck_path = workdir / f"{name}.deck.tmp"
-        infos[name] = ad.write_aircraft_deck(deck_path, mesh, steps, (tolerances or {}).get(name))
+        tol = (tolerances or {}).get(name, (None, None))
+        infos[name] = ad.write_aircraft_deck(deck_path, mesh, steps, *tol)
         deck = deck_path.read_text()
         deck_path.unlink()
         done = _finished(workdir, name, deck)
