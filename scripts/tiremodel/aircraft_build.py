@@ -38,7 +38,7 @@ BRACKET = (-0.025, 0.0, 0.025)  # relative rim-travel offsets written around eac
 PROBE_TRAVEL = 0.165  # m, rim travel of the coarse pre-estimate (past 150 % of rated load)
 ROLL_DX = 0.03  # m, rim travel along +x of the rolling stand-in
 # relaxed CalculiX convergence criteria (R_n, C_n) of the fine runs; see aircraft_deck.write_aircraft_deck
-TOLERANCES = {"sweep": (0.02, 0.5), "rolling": (0.02, None)}
+TOLERANCES = {"sweep": (0.02, 0.5), "rolling": (0.02, 0.5)}
 
 
 def static_name(fraction: float) -> str:
