@@ -57,7 +57,7 @@ class AircraftParams:
     # circumferential layers, per side of the bottom: the first layer spans
     # ``first_deg`` and each next one is ``growth`` times longer up to ``fine_deg``;
     # beyond it ``n_coarse`` layers of geometrically growing size up to 180 deg
-    first_deg: float = 0.6
+    first_deg: float = 0.45
     growth: float = 1.02
     fine_deg: float = 55.0
     n_coarse: int = 22

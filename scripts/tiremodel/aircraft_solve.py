@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -77,6 +78,9 @@ def _run(exe: str, inp: Path, timeout: float) -> float:
     return dt
 
 
+_PARSE_LOCK = threading.Lock()
+
+
 def _finished(workdir: Path, name: str, deck: str) -> float | None:
     """Run time of an earlier, completed run of exactly this deck in ``workdir``, else None."""
     inp, stamp = workdir / f"{name}.inp", workdir / f"{name}.runtime"
@@ -131,10 +135,11 @@ def run_decks(
         futures = {name: pool.submit(_solve, exe, workdir, name, timeout) for name in todo}
         times.update({name: f.result() for name, f in futures.items()})
     solver = ccx_version(exe)
-    return {
-        name: _collect(mesh, workdir / f"{name}.inp", name, infos[name], times[name], solver)
-        for name in plans
-    }
+    with _PARSE_LOCK:  # ccx2paraview keeps the node renumbering in module state
+        return {
+            name: _collect(mesh, workdir / f"{name}.inp", name, infos[name], times[name], solver)
+            for name in plans
+        }
 
 
 def _at_time(records, t: float, what: str, job: str) -> np.ndarray:
