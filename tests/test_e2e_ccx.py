@@ -93,3 +93,33 @@ def test_missing_ccx_one_line_error_and_outputs_untouched(tmp_path, monkeypatch,
     assert len(lines) == 1
     assert "ccx" in lines[0] and "not found" in lines[0]
     assert {f.name: f.read_bytes() for f in out.iterdir()} == before
+
+
+def test_aircraft_deck_cards(tmp_path):
+    """The aircraft-tire deck (coarse mesh, no solve): one orientation per carcass element,
+    engineering-constant carcass and Neo-Hooke rubber, amplitudes for pressure and road
+    travel, results at the requested times only, y = 0 symmetry and the clamped bead."""
+    pytest.importorskip("gmsh")
+    from scripts.tiremodel import aircraft_deck as ad
+    from scripts.tiremodel.aircraft_geometry import build_aircraft_mesh, coarse_aircraft_params
+
+    mesh = build_aircraft_mesh(coarse_aircraft_params())
+    assert np.abs(mesh.nodes[mesh.symmetry_nodes, 1]).max() < 1e-12
+    assert mesh.nodes[:, 1].min() > -1e-12  # half model
+    # material frames: unit, orthogonal; meridional axis along y on the crown centre line
+    np.testing.assert_allclose(np.linalg.norm(mesh.meridian, axis=1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", mesh.meridian, mesh.circumferential), 0.0, atol=1e-12)
+    stage = ad.Stage(0.1, 0.0, (("half", 0.5), ("end", 1.0)))
+    info = ad.write_aircraft_deck(tmp_path / "a.inp", mesh, [stage], residual_tolerance=0.02)
+    text = (tmp_path / "a.inp").read_text()
+    n_carcass = int((mesh.layer == 1).sum())
+    assert text.count("*ORIENTATION, NAME=") == n_carcass
+    assert text.count("*ELASTIC, TYPE=ENGINEERING CONSTANTS") == 2
+    assert text.count("*HYPERELASTIC, NEO HOOKE") == 2
+    assert "*BOUNDARY, AMPLITUDE=AROADZ" in text and "*DLOAD, AMPLITUDE=APRESS" in text
+    assert "*CONTROLS, PARAMETERS=FIELD\n0.02" in text
+    assert info.output_times == {"inflation": ad.INFLATION_TIME, "half": ad.INFLATION_TIME + 0.5,
+                                 "end": ad.INFLATION_TIME + 1.0}
+    assert "SYMN, 2, 2" in text and "BEAD, 1, 3" in text
+    for c in ad.CARCASS.values():
+        assert ad.orthotropic_ok(c)

@@ -1,4 +1,13 @@
-"""CLI: python -m scripts.tiremodel build --case static|rolling|heavy|all [--coarse] [--out DIR]
+"""CLI: python -m scripts.tiremodel build|aircraft ...
+
+- ``build --case static|rolling|heavy|all [--coarse] [--out DIR]``: the small
+  sample tire (meshes/*.vtu, the test data);
+- ``aircraft [--coarse] [--out DIR] [--jobs N]``: the aircraft main-gear tire
+  (meshes/aircraft/: load sweep 25-150 % of the rated load and the rolling
+  stand-in at the rated load);
+- ``check-elements``: tip deflection of a rubber cantilever (C3D8I / C3D8,
+  K/G = 100 / 1000) against Timoshenko's beam, the locking check behind the
+  element choice.
 
 Every case is solved in a temporary folder; the exported files are moved into
 ``--out`` only when all requested cases have succeeded, so a failed or
@@ -31,6 +40,26 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--keep", type=Path, default=None, help="also copy the CalculiX work files here")
     b.add_argument("--threads", type=int, default=2)
     b.add_argument("--debug", action="store_true", help="show tracebacks")
+    a = sub.add_parser(
+        "aircraft", help="aircraft main-gear tire: load sweep + rolling stand-in (meshes/aircraft/)"
+    )
+    a.add_argument("--coarse", action="store_true", help="solve the sweep on the coarse mesh (quick look)")
+    a.add_argument(
+        "--out",
+        type=Path,
+        default=REPO / "meshes" / "aircraft",
+        help="output folder (default: meshes/aircraft/)",
+    )
+    a.add_argument("--jobs", type=int, default=2, help="CalculiX runs at a time (one thread each)")
+    a.add_argument(
+        "--work",
+        type=Path,
+        default=None,
+        help="keep the CalculiX files here; runs already completed there with the same deck are reused",
+    )
+    a.add_argument("--debug", action="store_true", help="show tracebacks")
+    c = sub.add_parser("check-elements", help="cantilever check of the rubber elements against Timoshenko")
+    c.add_argument("--debug", action="store_true", help="show tracebacks")
     return ap
 
 
@@ -75,9 +104,18 @@ def build(
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
-    cases = list(dk.CASES) if args.case == "all" else [args.case]
     try:
-        build(cases, args.coarse, args.out, args.keep, args.threads)
+        if args.command == "check-elements":
+            from .element_check import main as check_main
+
+            return check_main()
+        if args.command == "aircraft":
+            from .aircraft_build import build_aircraft
+
+            build_aircraft(args.out, coarse=args.coarse, jobs=args.jobs, work=args.work)
+        else:
+            cases = list(dk.CASES) if args.case == "all" else [args.case]
+            build(cases, args.coarse, args.out, args.keep, args.threads)
     except ModelError as exc:
         if args.debug:
             raise

@@ -21,6 +21,8 @@ class FrdResults:
     steps: list[tuple[int, float]] = field(default_factory=list)  # (step, time) of stored increments
     # last stored increment of each step: {step: {block name: (components, (n, k) array)}}
     last: dict[int, dict[str, tuple[list[str], np.ndarray]]] = field(default_factory=dict)
+    # every stored increment (only with read_frd(..., every=True)): [(time, blocks)]
+    every: list[tuple[float, dict[str, tuple[list[str], np.ndarray]]]] = field(default_factory=list)
 
     def field(self, step: int, name: str) -> tuple[list[str], np.ndarray]:
         if step not in self.last or name not in self.last[step]:
@@ -28,8 +30,12 @@ class FrdResults:
         return self.last[step][name]
 
 
-def read_frd(path) -> FrdResults:
-    """Parse mesh coordinates and, per step, the last increment's nodal blocks."""
+def read_frd(path, every: bool = False) -> FrdResults:
+    """Parse mesh coordinates and, per step, the last increment's nodal blocks.
+
+    With ``every`` the blocks of every stored increment are kept too (in
+    ``FrdResults.every``), e.g. for output at several time points of one step.
+    """
     try:
         from ccx2paraview import common as c2p
     except ImportError as exc:  # pragma: no cover - import guard
@@ -55,9 +61,13 @@ def read_frd(path) -> FrdResults:
             blocks = frd.parse_results(cnt, t)
             step = step_of.get(cnt, 1)
             res.steps.append((step, t))
-            if cnt != last_cnt[step]:
+            if cnt != last_cnt[step] and not every:
                 continue
-            store = res.last.setdefault(step, {})
+            store: dict[str, tuple[list[str], np.ndarray]] = {}
+            if cnt == last_cnt[step]:
+                res.last[step] = store
+            if every:
+                res.every.append((float(t), store))
             for b in blocks:
                 if not getattr(b, "results", None) or b.name is None:
                     continue
@@ -104,4 +114,40 @@ def read_dat_totals(path) -> list[tuple[str, float, np.ndarray]]:
     out = []
     for m in _TOTAL.finditer(text):
         out.append((m.group(1), float(m.group(2)), np.array([float(m.group(i)) for i in (3, 4, 5)])))
+    return out
+
+
+_BLOCK = re.compile(r"^ ([a-z ]+) \(([a-z,]+)\) for set (\S+) and time\s+(\S+)\s*$")
+
+
+def read_dat_blocks(path) -> list[tuple[str, str, float, np.ndarray]]:
+    """All printed blocks of a .dat file, in file order.
+
+    Each is (kind, set name, time, rows): ``kind`` is the block title
+    ('total force', 'displacements', 'forces', ...); ``rows`` holds the numbers
+    of each printed line (a node number first, except for totals).
+    """
+    out: list[tuple[str, str, float, np.ndarray]] = []
+    cur: tuple[str, str, float] | None = None
+    rows: list[list[float]] = []
+
+    def flush():
+        if cur is not None:
+            out.append((*cur, np.array(rows, dtype=float)))
+
+    with open(path, encoding="latin-1") as fh:
+        for line in fh:
+            m = _BLOCK.match(line.rstrip("\n"))
+            if m:
+                flush()
+                cur, rows = (m.group(1).strip(), m.group(3), float(m.group(4))), []
+                continue
+            f = line.split()
+            if cur is not None and f:
+                try:
+                    rows.append([float(v) for v in f])
+                except ValueError:
+                    flush()
+                    cur, rows = None, []
+    flush()
     return out
