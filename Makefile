@@ -55,7 +55,7 @@ system-deps-test:
 	$(call apt_install,$(TEST_PACKAGES))
 
 demo: $(DEMO_STAMP) system-deps-demo
-	@echo "== fepost report on the sample meshes -> $(OUT)/"
+	@echo "== fepost report on the sample aircraft tire (meshes/aircraft/, rated load) -> $(OUT)/"
 	$(VENV)/bin/fepost report --out $(OUT) --force
 	@echo "== open $(OUT)/report.html"
 

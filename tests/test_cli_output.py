@@ -250,9 +250,11 @@ def project(tmp_path, monkeypatch, small_map):
     static = shutil.copy(small_map, data / "static.vtu")
     meshes = tmp_path / "samples" / "meshes"
     meshes.mkdir(parents=True)
-    for name in ("static.vtu", "rolling.vtu"):
-        shutil.copy(small_map, meshes / name)
     import fepost.report.samples as samples
+
+    for name in ("static.vtu", "rolling.vtu", samples.SAMPLE_STATIC, samples.SAMPLE_ROLLING):
+        (meshes / name).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(small_map, meshes / name)
 
     monkeypatch.setattr(samples, "meshes_folder", lambda: meshes)
     home = tmp_path / "home"

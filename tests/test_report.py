@@ -37,6 +37,8 @@ PROMISED = (
     "coefficients.json",
     "table1.json",
     "closed_form_vs_exact.json",
+    "error_map.json",
+    "error_map_rolling.json",
     "curves.csv",
     "fig1_static.png",
     "fig2_rolling.png",
@@ -45,11 +47,22 @@ PROMISED = (
     "patch_plan.pdf",
     *(
         f"{stem}.{ext}"
-        for stem in ("fig3_sections", "fig4_f_parallel", "fig5_torque", "fig6_f_perp")
+        for stem in (
+            "fig3_sections",
+            "fig4_f_parallel",
+            "fig5_torque",
+            "fig6_f_perp",
+            "error_map",
+            "error_map_rolling",
+        )
         for ext in ("png", "svg", "pdf")
     ),
     *(f"{m}_{part}" for m in ("static", "rolling") for part in ("map.vtu", "patch.vtp", "outline.vtp")),
 )
+#: Written by the sample load sweep's section (the report of the sample tire only).
+SWEEP_FILES = ("sweep/coefficients.csv", "sweep/coefficients.parquet", "sweep/load_trends.png")
+#: JSON documents the page's tagged numbers come from (data-key prefix = file stem).
+JSON_SOURCES = ("coefficients", "table1", "closed_form_vs_exact", "error_map", "error_map_rolling")
 NNBSP = "\u202f"
 TABLE1_NAMES = ["f", "F0", "M0", "a", "m", "k_x"]
 
@@ -122,9 +135,9 @@ def report(tmp_path_factory):
 
 @pytest.mark.slow
 def test_report_writes_every_promised_file(report):
-    code, out, _, _ = report
+    code, out, _, inputs = report
     assert code == 0
-    for name in PROMISED:
+    for name in PROMISED + (() if inputs else SWEEP_FILES):
         assert (out / name).is_file(), name
         assert (out / name).stat().st_size > 0, name
     assert not [p.name for p in out.parent.iterdir() if p.name.startswith(".")], (
@@ -157,8 +170,8 @@ def test_report_html_is_self_contained(report):
     page), so report.html shows everything on its own; alt texts are plain text."""
     _, out, _, _ = report
     page = _page(out)
-    pngs = sorted(p.name for p in out.glob("*.png"))
-    assert len(page.images) == len(pngs) == 7
+    pngs = sorted(str(p.relative_to(out)) for p in out.rglob("*.png"))
+    assert len(page.images) == len(pngs) >= 9
     embedded = {}
     for src, alt in page.images:
         assert src.startswith("data:image/png;base64,"), src[:40]
@@ -230,10 +243,7 @@ def test_report_vtk_files(report):
 def test_report_numbers_equal_the_json(report):
     _, out, _, _ = report
     page = _page(out)
-    sources = {
-        name: json.loads((out / f"{name}.json").read_text())
-        for name in ("coefficients", "table1", "closed_form_vs_exact")
-    }
+    sources = {name: json.loads((out / f"{name}.json").read_text()) for name in JSON_SOURCES}
     checked = 0
     for key, value in page.values.items():
         src, path = key.split(".", 1)
@@ -247,7 +257,12 @@ def test_report_numbers_equal_the_json(report):
             assert f"table1.rows.{i}.{part}" in page.values
     for curve in ("f_parallel", "torque", "f_perp"):
         assert f"closed_form_vs_exact.{curve}.max_abs_relative" in page.values
-    assert checked >= 40
+        assert f"closed_form_vs_exact.{curve}.model_max_abs_relative" in page.values
+    for i in range(6):
+        assert f"table1.generalised.rows.{i}.fitted" in page.values
+    for key in ("direction_coefficients.a.0", "direction_coefficients.m.1", "static.Q.0.0", "static.S.1.1"):
+        assert f"coefficients.model.{key}" in page.values
+    assert checked >= 90
 
 
 @pytest.mark.slow
@@ -274,7 +289,7 @@ def test_report_curves_csv_matches_the_fit(report):
     assert figures == {"F_parallel", "M_C", "F_perp"}
     for fig in figures:
         series = {r["series"] for r in rows if r["figure"] == fig}
-        assert series == {"exact", "closed_form", "fit", "band_lo", "band_hi", "test"}
+        assert series == {"exact", "closed_form", "model", "fit", "band_lo", "band_hi", "test"}
     # The closed form at υ = 0 is M0 exactly.
     coef = json.loads((out / "coefficients.json").read_text())
     m0 = [float(r["value"]) for r in rows if r["figure"] == "M_C" and r["series"] == "closed_form"][0]
@@ -297,7 +312,8 @@ def test_report_table1_json_is_fepost_table1(report, tmp_path):
     """The report's table1.json is Table1.to_dict() (what fepost table1 --json writes,
     less its "inputs"), for the same inputs and seed."""
     _, out, _, inputs = report
-    sample = ["--static", inputs[0], "--rolling", inputs[1]] if inputs else []
+    static, rolling = inputs or [str(p) for p in sample_paths()]
+    sample = ["--static", static, "--rolling", rolling]
     cli_json = tmp_path / "t1.json"
     assert main(["table1", *sample, "--seed", "3", "--json", str(cli_json)]) == 0
     expected = json.loads(cli_json.read_text())
@@ -350,6 +366,8 @@ def test_report_and_table1_agree_on_analytic_maps(tmp_path):
     assert from_report["settings"]["seed"] == from_table1["settings"]["seed"] == DEFAULT_SEED
     assert [row["name"] for row in from_report["rows"]] == TABLE1_NAMES
     assert from_report["rows"] == from_table1["rows"]
+    # a report of other files than the sample tire's has no sample sweep
+    assert not (out / "sweep").exists() and 'id="sweep"' not in (out / "report.html").read_text()
 
 
 @pytest.fixture
@@ -463,6 +481,157 @@ def test_report_optional_sections(tmp_path, small_map):
     page = _page(out)
     assert ("An extra figure" in [alt for _, alt in page.images]) and "extra.csv" in page.refs
     assert {"extra_fig.png", "extra_fig.svg", "extra.csv"} <= set(res.files)
-    base = build_report(small_map, out=tmp_path / "plain", seed=1, sections=(nothing,))
-    plain = (tmp_path / "plain" / "report.html").read_text(encoding="utf-8")
-    assert plain.count("<h2") == 8 and "extra" not in plain and "extra.csv" not in base.files
+    # the provider that returned None left no trace: 8 core sections and the extra one, no files
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith("extra")) == [
+        "extra.csv",
+        "extra_fig.pdf",
+        "extra_fig.png",
+        "extra_fig.svg",
+    ]
+
+
+# ------------------------------------ the demo's case, the generalised model and the sample sweep
+def test_default_inputs_are_the_aircraft_tire():
+    """`fepost report` without inputs, and so `make demo`, reports on the aircraft tire at its
+    rated load, static and rolling."""
+    from fepost.report.samples import sample_inputs
+
+    static, rolling = sample_inputs()
+    assert static == REPO / "meshes" / "aircraft" / "static_100.vtu"
+    assert rolling == REPO / "meshes" / "aircraft" / "rolling_100.vtu"
+    make = (REPO / "Makefile").read_text()
+    demo = re.search(r"^demo:.*\n((?:\t.*\n)+)", make, re.M)
+    assert demo is not None
+    lines = [ln.strip() for ln in demo.group(1).splitlines()]
+    commands = [ln for ln in lines if "fepost report" in ln and not ln.startswith("@")]
+    assert commands == ["$(VENV)/bin/fepost report --out $(OUT) --force"]  # no inputs: the samples
+
+
+@pytest.mark.slow
+def test_report_default_case_is_the_aircraft_tire(report):
+    _, out, _, inputs = report
+    if inputs:
+        pytest.skip("the sample meshes are absent: the report ran on analytic stand-ins")
+    coef = json.loads((out / "coefficients.json").read_text())
+    static, rolling = sample_paths()
+    assert Path(coef["static"]["source"]).resolve() == static.resolve()
+    assert Path(coef["rolling"]["source"]).resolve() == rolling.resolve()
+    side = json.loads(static.with_suffix(".json").read_text())
+    assert coef["reaction_z"] == side["reaction_z"]
+    assert coef["N"] == pytest.approx(side["reaction_z"], rel=0.005)  # the solver's own reaction
+    text = "".join(_page(out).text)
+    assert f"{side['inflation_pressure'] / 1e3:g}{NNBSP}kPa (sidecar)" in text
+
+
+@pytest.mark.slow
+def test_report_error_maps_quote_their_json(report):
+    """The error maps are embedded, and the largest errors the page quotes are those of
+    error_map*.json, which are the largest values of the maps themselves."""
+    _, out, _, _ = report
+    page = _page(out)
+    alts = {base64.b64decode(src.split(",", 1)[1]): alt for src, alt in page.images}
+    coef = json.loads((out / "coefficients.json").read_text())
+    for stem, tag in (("error_map", "static"), ("error_map_rolling", "rolling")):
+        doc = json.loads((out / f"{stem}.json").read_text())
+        assert alts[(out / f"{stem}.png").read_bytes()].startswith(f"Error map of the {tag} map")
+        assert (len(doc["beta_deg"]), len(doc["t"])) == (19, 33)
+        for name in ("paper", "base", "model"):
+            for q in ("force", "torque"):
+                quoted = page.values[f"{stem}.worst.{name}.{q}"]
+                assert quoted == doc["worst"][name][q] == max(max(row) for row in doc[q][name])
+        worst = doc["worst"]
+        # what the page says: the closed forms miss by more than 10 % of F0 and M0, the
+        # generalised model stays inside the 3 % goal
+        assert worst["paper"]["force"] > 0.10 and worst["paper"]["torque"] > 0.15
+        assert worst["model"]["force"] < 0.03 and worst["model"]["torque"] < 0.03
+        # a second, different grid (the model's own staggered check grid) finds the same levels
+        acc = coef["model"][tag]["accuracy"]
+        assert worst["paper"]["force"] == pytest.approx(acc["compare_force"], rel=0.05)
+        assert worst["paper"]["torque"] == pytest.approx(acc["compare_torque"], rel=0.05)
+        assert abs(worst["model"]["force"] - acc["model_force"]) < 0.005
+        assert abs(worst["model"]["torque"] - acc["model_torque"]) < 0.005
+    # pure sliding (t = 1) on the static map: the closed forms give F0 along -v, as the exact integral
+    doc = json.loads((out / "error_map.json").read_text())
+    assert doc["t"][-1] == 1.0 and max(row[-1] for row in doc["force"]["paper"]) < 1e-6
+
+
+@pytest.mark.slow
+def test_figures_4_6_show_the_generalised_model(report):
+    """Figures 4-6 carry a third line, the generalised model, whose values are those of
+    Table 1's generalised form at the FE maps' own coefficients."""
+    import fepost
+    from fepost.table1 import table1
+
+    _, out, _, inputs = report
+    static, rolling = inputs or [str(p) for p in sample_paths()]
+    expected_table = table1(fepost.analyse(static, rolling, friction=0.3), seed=3)
+    assert expected_table.generalised is not None
+    with open(out / "curves.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    errors = json.loads((out / "closed_form_vs_exact.json").read_text())
+    for fig, key, stem in (
+        ("F_parallel", "f_parallel", "fig4_f_parallel"),
+        ("M_C", "torque", "fig5_torque"),
+        ("F_perp", "f_perp", "fig6_f_perp"),
+    ):
+
+        def series(name, fig=fig):
+            pts = [(r["x"], r["value"]) for r in rows if r["figure"] == fig and r["series"] == name]
+            return np.array(pts, dtype=float)
+
+        model, exact = series("model"), series("exact")
+        assert len(model) == len(exact) > 100
+        want = expected_table.generalised.form.curves(model[:, 0])[key]
+        np.testing.assert_allclose(model[:, 1], want, rtol=1e-12, atol=0)
+        # the quoted gap is the gap of these curves, and within the 3 % goal
+        gap = np.max(np.abs(model[:, 1] - exact[:, 1])) / errors[key]["scale"]
+        assert gap == pytest.approx(errors[key]["model_max_abs_relative"], rel=1e-9) and gap < 0.03
+        assert 'id="model"' in (out / f"{stem}.svg").read_text(encoding="utf-8")  # the line is drawn
+
+
+@pytest.mark.slow
+def test_report_sample_sweep_section(report):
+    """The report of the sample tire shows its load sweep: 6 loads, the power law of R with
+    its 95 % interval (equal to an independent fit of the table), and the report's own case
+    taken from its analysis, equal to a fresh computation of that row."""
+    from scipy import stats
+
+    from fepost.sweep.jobs import Job, run_job
+    from fepost.sweep.options import RowOptions
+    from fepost.sweep.table import read_table
+
+    _, out, _, inputs = report
+    if inputs:
+        pytest.skip("the sample meshes are absent: no sample sweep")
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert '<h2 id="sweep">Load sweep</h2>' in html
+    section = html.split('<h2 id="sweep">', 1)[1].split("<h2", 1)[0]
+    rows = read_table(out / "sweep" / "coefficients.csv")
+    assert [r["case"] for r in rows] == [f"static_{p:03d}" for p in (25, 50, 75, 100, 125, 150)]
+    assert all(r["status"] == "ok" for r in rows) and all(r["case"] in section for r in rows)
+    loads = [r["load"] for r in rows]
+    assert loads == sorted(loads) and loads[0] < 0.3 * loads[-1]
+    # R ∝ N^α: the exponent and interval quoted equal a least-squares fit of log R on log N
+    fit = stats.linregress(np.log([r["N"] for r in rows]), np.log([r["R"] for r in rows]))
+    half = stats.t.ppf(0.975, len(rows) - 2) * fit.stderr
+    number = r"([−\d.]+)"
+    m = re.search(rf"R ∝ N\^{number}, 95{NNBSP}% interval \[{number}, {number}\], from 6 loads", section)
+    assert m, section[:2000]
+    quoted = [float(g.replace("−", "-")) for g in m.groups()]
+    assert quoted == pytest.approx([fit.slope, fit.slope - half, fit.slope + half], abs=6e-4)
+    assert 0.3 < fit.slope < 0.7
+    # the rated-load row is the report's own analysis (not computed again: no worker time) ...
+    coef = json.loads((out / "coefficients.json").read_text())
+    own = rows[3]
+    assert own["seconds"] is None and all(r["seconds"] is not None for i, r in enumerate(rows) if i != 3)
+    for key in ("N", "R", "M0", "a", "m", "k_x", "x_c", "aR2", "m_over_R2"):
+        assert own[key] == coef[key], key
+    # ... and equals the row a sweep computes for that file
+    static, rolling = sample_paths()
+    job = Job(own["source"], str(static.resolve()), None, RowOptions(friction=0.3),
+              rolling=str(rolling.resolve()), rolling_given=own["rolling"])  # fmt: skip
+    fresh = run_job(job)
+    assert fresh["status"] == "ok", fresh["error"]
+    for key in ("N", "R", "M0", "a", "m", "k_x", "aspect", "circular", "load", "case", "deflection"):
+        assert own[key] == fresh[key], key
+    assert "The report above is the case static_100 of this sweep." in section

@@ -479,9 +479,10 @@ def test_report_section_provider(tmp_path):
     assert section.table[0][:3] == ("case", "load (N)", "N (N)")
     rows = {r[0]: r for r in section.table[1:]}
     assert list(rows) == ["static_025", "static_050", "static_100", "static_150"]  # rolling map paired
-    assert rows["static_100"][8] == pytest.approx(0.2, rel=0.05) and rows["static_025"][8] == "—"
+    kx = section.table[0].index("k_x")
+    assert rows["static_100"][kx] == pytest.approx(0.2, rel=0.05) and rows["static_025"][kx] == "—"
     assert all(r[-1] == "ok" for r in rows.values())
-    assert any(p.startswith("R ∝ N^0.333, 95 % interval") for p in section.paragraphs)
+    assert any(p.startswith("R ∝ N^0.333, 95\u202f% interval") for p in section.paragraphs)
     assert "sweep/coefficients.csv" in section.files and "sweep/load_trends.svg" in section.files
     assert all((report / f).is_file() for f in section.files)
     table = read_table(report / "sweep" / "coefficients.parquet")

@@ -37,6 +37,8 @@ _ARRAYS = ("x", "closed_form", "exact", "fit", "band_lo", "band_hi", "test_x", "
 
 #: Line colour of the generalised model (purple: apart from the theme's exact/closed/fit colours).
 MODEL_COLOUR = "#7d3c98"
+#: About this many open markers along the generalised model's line (it lies on the exact curve).
+MODEL_MARKERS = 16
 #: Unicode letters mathtext spells by name.
 _TEX = {
     "α": r"\alpha", "β": r"\beta", "ε": r"\varepsilon", "θ": r"\theta", "μ": r"\mu",
@@ -181,12 +183,18 @@ def plot_curve(data: CurveData, ax=None):
             gid="closed_form",
         )
         if data.model is not None:
+            # On top of the exact curve, which it follows closely: dotted with open markers.
             ax.plot(
                 data.x,
                 data.model,
                 color=MODEL_COLOUR,
-                lw=1.6,
+                lw=1.8,
                 ls=":",
+                marker="o",
+                ms=4.5,
+                mfc="none",
+                markevery=max(1, data.x.size // MODEL_MARKERS),
+                zorder=3,
                 label=lab["model"],
                 gid="model",
             )

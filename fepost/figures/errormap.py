@@ -58,7 +58,9 @@ def plot_error_map(data: ErrorMap, names: Sequence[str] = ("paper", "model"), fi
             for j, name in enumerate(names):
                 ax = axes[i, j]
                 err = np.clip(getattr(data, q)[name], FLOOR, None)
-                mesh = ax.pcolormesh(data.beta, data.t, err.T, norm=norm, cmap=theme.CMAP, shading="nearest")
+                mesh = ax.pcolormesh(
+                    data.beta, data.t, err.T, norm=norm, cmap=theme.CMAP, shading="nearest", rasterized=True
+                )
                 if np.nanmax(err) > GOAL:
                     ax.contour(data.beta, data.t, err.T, levels=[GOAL], colors="white", linewidths=1.0)
                 worst = data.worst(name)

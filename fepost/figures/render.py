@@ -33,6 +33,8 @@ from .outline import circle_points, ellipse_points, level_segments
 
 #: Default inflation pressure P* (Pa): the paper's 200 kPa.
 DEFAULT_INFLATION_PRESSURE = 200e3
+#: Half-width of the framed square as a multiple of r_max (before rounding up to a round value).
+EXTENT_FACTOR = 1.15
 #: Height of the tallest point of the surface as a fraction of r_max.
 HEIGHT_FRACTION = 0.4
 #: The surface stops where the pressure falls below this fraction of its peak (the contact edge).
@@ -311,7 +313,9 @@ def pressure_surface(
         Colour range in kPa (default 0 … peak); the top is rounded up to a round
         tick of the colour bar.
     extent : float, optional
-        Half-width in m of the square the axes frame (default 1.3 r_max, rounded up).
+        Half-width in m of the square the axes frame, rounded up to a round value
+        (default :data:`EXTENT_FACTOR` × r_max; give Figures 1 and 2 the same value
+        so they compare).
 
     The caller saves it with ``plotter.screenshot(path)``; :func:`layout`
     gives the text actors, legend and surface it placed.
@@ -335,7 +339,7 @@ def pressure_surface(
     top, cstep = nice_top(hi - lo, 7)
     n_colour_labels = int(round(top / cstep)) + 1
     r = patch.r_max
-    ext = nice_ceil(1.15 * r if extent is None else float(extent))
+    ext = nice_ceil(EXTENT_FACTOR * r if extent is None else float(extent))
 
     if plotter is None:
         theme.use_headless_vtk()
@@ -454,7 +458,9 @@ def pressure_surface(
         )
 
     xs = axis(xy_ticks, (0, -ext, 0), (1, 0, 0), (0, -1, 0), 0.12 * ext, "center", "top")
-    ys = axis(xy_ticks, (-ext, 0, 0), (0, 1, 0), (-1, 0, 0), 0.12 * ext, "right", "center")
+    # The back-left corner (y = +ext) carries the height axis and its 0: no y tick there.
+    y_ticks = xy_ticks[xy_ticks < ext * (1.0 - 1e-9)]
+    ys = axis(y_ticks, (-ext, 0, 0), (0, 1, 0), (-1, 0, 0), 0.12 * ext, "right", "center")
     z_ticks = np.arange(0.0, z_range + 0.5 * z_step, z_step)
     zs = axis(z_ticks, (-ext, ext, 0), (0, 0, 1), (-1, 0, 0), 0.08 * ext, "right", "center", scale=hs)
     texts += xs + ys + zs

@@ -93,10 +93,16 @@ def friction_curves(analysis: Analysis, table: Table1) -> FrictionCurves:
 
     Dense curves on :data:`CURVE_POINTS` values of ψ, υ in [0, ``table.span``]: the
     exact Coulomb integrals over the static map (F∥, M_C) and the rolling map (F⊥);
-    the closed forms (1.8) with the theoretical coefficients of ``table``; the fitted
-    curves with their 95 % prediction band
+    the closed forms (1.8) with the theoretical coefficients of ``table``; the
+    generalised model built from the FE maps (``table.generalised.form``, at the
+    maps' own coefficients; absent when ``table`` has no generalised rows); the
+    fitted curves with their 95 % prediction band
     (:meth:`fepost.identify.Identification.prediction_band`); and the noisy test
     points of ``table.curves``. Figure 6 only with a rolling map.
+
+    ``errors[curve]`` holds the closed form's largest gap (``max_abs_relative``,
+    ``at``) and, with the generalised model, the model's
+    (``model_max_abs_relative``, ``model_at``), both over the same scale.
     """
     from ..figures.curves import CurveData
     from ..friction.quadrature import PressureQuadrature
@@ -117,6 +123,7 @@ def friction_curves(analysis: Analysis, table: Table1) -> FrictionCurves:
     )
     theory = [table.row(name).theory for name in identify.PARAMETERS]
     closed = {name: identify.curve_model(name, x, theory, R)[0] for name in identify.CURVES}
+    gen = table.generalised.form.curves(x) if table.generalised is not None else None
     scales = {
         "f_parallel": ("psi", "F0", theory[0]),
         "torque": ("upsilon", "M0", theory[1]),
@@ -137,6 +144,10 @@ def friction_curves(analysis: Analysis, table: Table1) -> FrictionCurves:
             "x_name": x_name,
             "scale_name": scale_name,
         }
+        if gen is not None:
+            dm = np.abs(exact[key] - gen[key])
+            j = int(np.argmax(dm))
+            errors[key].update(model_max_abs_relative=float(dm[j] / scale), model_at=float(x[j]))
     fit = table.identification
     curves = []
     for key in shown:
@@ -159,6 +170,7 @@ def friction_curves(analysis: Analysis, table: Table1) -> FrictionCurves:
                 band_hi=hi,
                 test_x=test_x,
                 test_y=test_y,
+                model=None if gen is None else gen[key],
             )
         )
     return FrictionCurves(tuple(curves), errors)
@@ -215,6 +227,65 @@ COEFFICIENT_ROWS = (
     ("k_x", "k_x", None, "R·x_c/⟨x²⟩ (rolling shift of the centre of pressure)"),
     ("x_c", "x_c", "length", "centre of pressure of the rolling map along x"),
 )
+#: Rows of the generalised model in the coefficient table: (key under coefficients.json
+#: "model", label, unit kind, definition). Directions: index 0 is β = 0° (x), 1 is β = 90° (y).
+MODEL_ROWS = (
+    (
+        "direction_coefficients.a.0",
+        "a(0°), sliding along x",
+        None,
+        "1/(x̂ᵀŜx̂)²: the force slope at pure spin",
+    ),
+    ("direction_coefficients.a.1", "a(90°), sliding along y", None, "1/(ŷᵀŜŷ)²"),
+    (
+        "direction_coefficients.m.0",
+        "m(0°), sliding along x",
+        None,
+        "(Û0/x̂ᵀQ̂x̂)²: the torque slope at pure sliding",
+    ),
+    ("direction_coefficients.m.1", "m(90°), sliding along y", None, "(Û0/ŷᵀQ̂ŷ)²"),
+    (
+        "direction_coefficients.kappa1.0",
+        "κ1(0°)",
+        None,
+        "x̂ᵀQ̂x̂/Û0² (κ1 = κ2 = 1: ellipsoidal limit surface)",
+    ),
+    ("direction_coefficients.kappa2.0", "κ2(0°)", None, "Û0·x̂ᵀŜx̂"),
+    ("static.U0", "Û0", None, "M0/(F0 R)"),
+    ("static.Q.0.0", "Q̂xx", None, "∬ σ x² dA/(N R²)"),
+    ("static.Q.1.1", "Q̂yy", None, "∬ σ y² dA/(N R²)"),
+    ("static.Q.0.1", "Q̂xy", None, "∬ σ x y dA/(N R²)"),
+    ("static.S.0.0", "Ŝxx", None, "R ∬ σ cos²φ / r dA / N"),
+    ("static.S.1.1", "Ŝyy", None, "R ∬ σ sin²φ / r dA / N"),
+    ("static.S.0.1", "Ŝxy", None, "R ∬ σ cos φ sin φ / r dA / N"),
+    ("static.K", "K", None, "correction: harmonics in the direction of the centre of rotation"),
+    ("static.L", "L", None, "correction: Chebyshev polynomials in t; (2K + 1)·L numbers"),
+    (
+        "static.accuracy.model_force",
+        "model: largest |ΔF|/F0",
+        "fraction",
+        "generalised model against the exact integrals (check grid)",
+    ),
+    ("static.accuracy.model_torque", "model: largest |ΔMz|/M0", "fraction", "the same for the torque"),
+    (
+        "static.accuracy.compare_force",
+        "paper: largest |ΔF|/F0",
+        "fraction",
+        "the closed forms (1.8) with the coefficients above",
+    ),
+    ("static.accuracy.compare_torque", "paper: largest |ΔMz|/M0", "fraction", "the same for the torque"),
+    ("rolling.g.0", "ĝx (rolling map)", None, "−∬ σ cos φ dA / N: force at pure spin of the rolling map"),
+    ("rolling.xc.0", "x̂c (rolling map)", None, "x_c/R: centre of pressure of the rolling map"),
+    (
+        "rolling.accuracy.model_force",
+        "rolling: model |ΔF|/F0",
+        "fraction",
+        "generalised model of the rolling map",
+    ),
+    ("rolling.accuracy.model_torque", "rolling: model |ΔMz|/M0", "fraction", "the same for the torque"),
+    ("rolling.accuracy.compare_force", "rolling: paper |ΔF|/F0", "fraction", "the closed forms with k_x"),
+    ("rolling.accuracy.compare_torque", "rolling: paper |ΔMz|/M0", "fraction", "the same for the torque"),
+)
 #: Rows of the patch table: (key in coefficients.json "patch", label, unit kind).
 PATCH_ROWS = (
     ("r_max", "r_max (= R)", "length"),
@@ -241,6 +312,54 @@ def _row(key, label, kind, definition, value, prefix):
     }
 
 
+def _dig(doc: Any, dotted: str) -> Any:
+    """The value at ``dotted`` (keys and list indices) in ``doc``, None where it is missing."""
+    for part in dotted.split("."):
+        if isinstance(doc, list):
+            i = int(part)
+            doc = doc[i] if i < len(doc) else None
+        elif isinstance(doc, Mapping):
+            doc = doc.get(part)
+        else:
+            return None
+        if doc is None:
+            return None
+    return doc
+
+
+def model_rows(coef: Mapping[str, Any]) -> list[dict]:
+    """Rows of the generalised model (:data:`MODEL_ROWS`) present in ``coef["model"]``."""
+    model = coef.get("model")
+    if not model:
+        return []
+    rows = []
+    for key, label, kind, definition in MODEL_ROWS:
+        value = _dig(model, key)
+        if value is not None:
+            rows.append(_row(key, label, kind, definition, value, "coefficients.model"))
+    return rows
+
+
+def error_map_context(docs: Mapping[str, Mapping[str, Any]]) -> list[dict]:
+    """Per error-map document (``{file stem: parsed JSON}``): its stem, map and the largest
+    errors of the paper's forms and the generalised model, for the page."""
+    out = []
+    for stem, doc in docs.items():
+        worst = doc["worst"]
+        out.append(
+            {
+                "stem": stem,
+                "map": "rolling" if stem.endswith("rolling") else "static",
+                "source": doc.get("source", ""),
+                "models": [name for name in ("paper", "base", "model") if name in worst],
+                "worst": worst,
+                "n_beta": len(doc["beta_deg"]),
+                "n_t": len(doc["t"]),
+            }
+        )
+    return out
+
+
 def page_context(
     analysis: Analysis,
     coef: Mapping[str, Any],
@@ -251,13 +370,14 @@ def page_context(
     p_star_source: str,
     seed: int | None,
     version: str,
+    error_maps: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> dict:
     """Every value ``report.html`` shows, from the JSON documents written beside it.
 
     ``coef``, ``table``, ``errors``: the parsed ``coefficients.json``,
-    ``table1.json`` and ``closed_form_vs_exact.json`` (so the page shows exactly
-    what the files hold). Figures, files, sections and timings are added by the
-    caller.
+    ``table1.json`` and ``closed_form_vs_exact.json``; ``error_maps``: the parsed
+    ``error_map*.json`` by file stem (so the page shows exactly what the files
+    hold). Figures, files, sections and timings are added by the caller.
     """
     a = analysis
     p = a.static_patch
@@ -312,4 +432,8 @@ def page_context(
         "paper_notes": [n.removeprefix("paper:").strip() for n in notes if n.startswith("paper:")],
         "bias_names": ("F0", "M0", "a", "m", "k_x"),
         "errors": errors,
+        "model_rows": model_rows(coef),
+        "model_recommendation": _dig(coef, "model.recommendation"),
+        "generalised": table.get("generalised"),
+        "error_maps": error_map_context(error_maps or {}),
     }

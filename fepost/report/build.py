@@ -27,6 +27,10 @@ FILE_NOTES = {
     "table1.json": "Table 1 (as fepost table1 --json, without its inputs)",
     "closed_form_vs_exact.json": "largest gap between the closed forms and the exact integrals",
     "curves.csv": "the curves of Figures 4–6 in long form",
+    "error_map.json": (
+        "errors of the closed forms and the generalised model over the kinematic sphere, static map"
+    ),
+    "error_map_rolling.json": "the same for the rolling map",
     "static_map.vtu": "the static polar map (σ in Pa, quadrature weights dA in m²)",
     "rolling_map.vtu": "the rolling polar map",
     "static_patch.vtp": "the loaded FE faces of the static map with their pressure (Pa)",
@@ -34,6 +38,10 @@ FILE_NOTES = {
     "static_outline.vtp": "static patch: outline, frame axes, R and r_equiv circles, best-fit ellipse",
     "rolling_outline.vtp": "rolling patch: the same, in the static frame",
 }
+#: Grid of the error maps: sliding directions β in [0°, 180°] and meridian points t in [0, 1]
+#: (10° and 1/32 steps: the maps show where the errors lie; the largest errors of the
+#: generalised model on its own, finer check grid are in coefficients.json "model").
+ERROR_MAP_GRID = {"n_beta": 19, "n_t": 33}
 #: Units of the closed-form error scales (curve -> unit).
 CURVE_UNITS = {"f_parallel": "N", "torque": "N·m", "f_perp": "N"}
 
@@ -137,7 +145,7 @@ def build_report(
     from ..figures import diameter_sections, plot_curve, plot_patch_plan, plot_sections
     from ..figures.curves import curve_table
     from ..figures.patchplan import circularity_verdict
-    from ..figures.render import EDGE_FRACTION, default_height_scale, pressure_surface
+    from ..figures.render import EDGE_FRACTION, EXTENT_FACTOR, default_height_scale, pressure_surface
     from .html import render_report
     from .vtkfiles import write_vtk_files
 
@@ -147,7 +155,7 @@ def build_report(
     if inflation_pressure is not None:
         _check_inflation_option(inflation_pressure)
     has_roll = rolling is not None
-    steps = _Steps(total=10 + (1 if has_roll else 0), progress=progress)
+    steps = _Steps(total=12 + (1 if has_roll else 0), progress=progress)
     with staged_folder(out, force=force) as tmp:
         a = steps.run(
             "read and analyse the FE maps",
@@ -163,8 +171,12 @@ def build_report(
         clim = (0.0, max(float(np.max(pp.values)) for pp in patches) / 1e3)
         figs: dict[str, Figure] = {}
 
+        extent = max(pp.r_max for pp in patches) * EXTENT_FACTOR
+
         def render(patch, stem, key, title):
-            pl = pressure_surface(patch, inflation_pressure=p_star, title=title, height_scale=hs, clim=clim)
+            pl = pressure_surface(
+                patch, inflation_pressure=p_star, title=title, height_scale=hs, clim=clim, extent=extent
+            )
             return save_plotter(pl, tmp, stem, key, title)
 
         figs["fig1"] = steps.run(
@@ -215,6 +227,28 @@ def build_report(
 
         figs.update(steps.run("Figures 4-6 (friction curves)", curve_figs))
 
+        def error_maps():
+            from ..figures.errormap import plot_error_map
+            from ..friction.summary import analysis_error_map
+
+            made, docs = {}, {}
+            for stem, rolling in (("error_map", False), ("error_map_rolling", True)):
+                if rolling and a.rolling_map is None:
+                    continue
+                em = analysis_error_map(a, rolling=rolling, **ERROR_MAP_GRID)
+                key = stem.replace("_", "-")
+                alt = (
+                    f"Error map of the {'rolling' if rolling else 'static'} map: "
+                    "closed forms and generalised model"
+                )
+                made[key] = save_matplotlib(plot_error_map(em), tmp, stem, key, alt)
+                docs[stem] = em.to_dict()
+            return made, docs
+
+        steps.run("generalised friction model of the maps", lambda: a.model_summary)
+        maps, map_docs = steps.run("error maps (closed forms and generalised model)", error_maps)
+        figs.update(maps)
+
         def vtk_files():
             names = write_vtk_files(tmp, "static", a.static_map, a.static_patch, a.static_patch)
             if a.rolling_map is not None and a.rolling_patch is not None:
@@ -222,7 +256,7 @@ def build_report(
             return names
 
         vtk_names = steps.run("VTK files of the polar maps and patches", vtk_files)
-        data = ReportData(a, t, fc, p_star, seed, friction)
+        data = ReportData(a, t, fc, p_star, seed, friction, analysis_kwargs or {})
         extra = steps.run("optional sections", run_providers, sections, data, tmp)
 
         def write_data():
@@ -232,6 +266,7 @@ def build_report(
                 "table1.json": to_json(t.to_dict()),
                 "closed_form_vs_exact.json": to_json(fc.errors_dict()),
             }
+            texts.update({f"{stem}.json": to_json(doc) for stem, doc in map_docs.items()})
             for name, text in texts.items():
                 (tmp / name).write_text(text + "\n", encoding="utf-8")
             header, rows = curve_table(fc.curves)
@@ -251,6 +286,7 @@ def build_report(
                 p_star_source=p_src,
                 seed=seed,
                 version=_version(),
+                error_maps={stem: json.loads(texts[f"{stem}.json"]) for stem in map_docs},
             )
             ctx.update(
                 figures=figs,

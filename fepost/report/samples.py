@@ -1,7 +1,11 @@
 """The sample FE exports the report uses when it is given no inputs.
 
 The one place that names them: ``fepost report`` without inputs, ``make demo``
-and the documentation's examples all go through :func:`sample_inputs`.
+and the documentation's examples all go through :func:`sample_inputs`. They are
+the aircraft main-gear tire of ``meshes/aircraft/`` (46×17R20 size class,
+1.38 MPa) at its rated load, static and rolling; ``meshes/README.md`` describes
+the model. The small stand-in tire (``meshes/static.vtu``, ``rolling.vtu``,
+``heavy.*``) stays for the tests, which name it explicitly.
 """
 
 from __future__ import annotations
@@ -10,9 +14,10 @@ from pathlib import Path
 
 from ..errors import ArgumentError
 
-#: Sample static and rolling maps, in the repository's ``meshes/`` folder.
-SAMPLE_STATIC = "static.vtu"
-SAMPLE_ROLLING: str | None = "rolling.vtu"
+#: Sample static and rolling maps, relative to the repository's ``meshes/`` folder:
+#: the aircraft tire at its rated load (100 %).
+SAMPLE_STATIC = "aircraft/static_100.vtu"
+SAMPLE_ROLLING: str | None = "aircraft/rolling_100.vtu"
 
 
 def meshes_folder() -> Path:

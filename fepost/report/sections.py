@@ -5,7 +5,9 @@ it gets the :class:`ReportData` (the analysis, Table 1, the friction curves,
 P*, ...) and the folder being written (to save figures or tables into), and
 returns a :class:`Section`, or ``None`` when it has nothing to show (then the
 report has no trace of it). :data:`DEFAULT_SECTIONS` lists the providers
-``fepost report`` runs, in page order; they come after the friction curves.
+``fepost report`` runs, in page order; they come after the friction curves:
+today the load sweep of the sample aircraft tire (:func:`sample_sweep`), shown
+in the report of one of its cases.
 
 A section renders ``templates/sections/<template>`` with the names ``section``
 (the :class:`Section`) and ``figure`` (the figure macro) in scope; the generic
@@ -31,7 +33,12 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class ReportData:
-    """What a section provider may look at: the report's results, never recomputed."""
+    """What a section provider may look at: the report's results, never recomputed.
+
+    ``analysis_kwargs``: the reading and grid options the report passed to
+    :func:`fepost.analysis.analyse` (read-only), so a provider that analyses
+    further files can use the same ones.
+    """
 
     analysis: Analysis
     table1: Table1
@@ -39,6 +46,10 @@ class ReportData:
     inflation_pressure: float
     seed: int | None
     friction: float
+    analysis_kwargs: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "analysis_kwargs", MappingProxyType(dict(self.analysis_kwargs)))
 
 
 @dataclass(frozen=True)
@@ -68,8 +79,17 @@ class Section:
 
 SectionProvider = Callable[[ReportData, Path], "Section | None"]
 
+
+def sample_sweep(data: ReportData, folder: Path) -> Section | None:
+    """The load sweep of the sample aircraft tire, in the report of one of its cases
+    (:func:`fepost.sweep.reportsection.sample_sweep_section`; imported when run)."""
+    from ..sweep.reportsection import sample_sweep_section
+
+    return sample_sweep_section(data, folder)
+
+
 #: Providers run by ``fepost report``, in page order.
-DEFAULT_SECTIONS: tuple[SectionProvider, ...] = ()
+DEFAULT_SECTIONS: tuple[SectionProvider, ...] = (sample_sweep,)
 
 
 def run_providers(providers, data: ReportData, folder: Path) -> list[Section]:

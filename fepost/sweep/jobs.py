@@ -18,7 +18,7 @@ import warnings
 from dataclasses import dataclass
 from functools import partial
 
-from ..errors import FepostError, FepostWarning
+from ..errors import ArgumentError, FepostError, FepostWarning
 from .metadata import case_metadata, sidecar_path
 from .options import RowOptions
 from .steps import time_steps
@@ -97,6 +97,34 @@ def _count_steps(path: str, units) -> int | None:
     return len(listed) if listed else None
 
 
+def analysis_row(job: Job, res) -> dict:
+    """The ok row of ``job`` from its analysis ``res`` (:class:`fepost.analysis.Analysis`):
+    the job's identity columns, the coefficient columns and the sidecar metadata.
+
+    :func:`run_job` makes its rows with it; a caller that already holds the
+    analysis of a job (the report, for its own case) makes the same row without
+    analysing the file again.
+
+    Raises
+    ------
+    ArgumentError
+        The job names no file.
+    InputFileError
+        The sidecar cannot be read (:func:`fepost.sweep.metadata.case_metadata`).
+    """
+    path = job.path
+    if path is None:
+        raise ArgumentError(f"{job.source}: the job names no file")
+    row = job.base_row()
+    step = res.static_field.step
+    n_steps = job.n_steps if job.n_steps is not None else partial(_count_steps, path, job.options.units)
+    meta = case_metadata(path, step, n_steps)
+    columns = coefficient_columns(res.to_dict(model=False))  # the table has no model block
+    row.update(step=step, time=res.static_field.time, **columns, **meta)
+    row["status"], row["error"] = "ok", ""
+    return row
+
+
 def run_job(job: Job) -> dict:
     """Analyse one row (on a worker); never raises for a bad input.
 
@@ -117,14 +145,7 @@ def run_job(job: Job) -> dict:
         warnings.simplefilter("always", FepostWarning)
         try:
             res = analyse(path, job.rolling, step=job.step, **job.options.analyse_kwargs())
-            step = res.static_field.step
-            n_steps = (
-                job.n_steps if job.n_steps is not None else partial(_count_steps, path, job.options.units)
-            )
-            meta = case_metadata(path, step, n_steps)
-            columns = coefficient_columns(res.to_dict(model=False))  # the table has no model block
-            row.update(step=step, time=res.static_field.time, **columns, **meta)
-            row["status"], row["error"] = "ok", ""
+            row = analysis_row(job, res)
         except FepostError as exc:
             row["status"], row["error"] = "error", one_line(str(exc))
         except MemoryError:

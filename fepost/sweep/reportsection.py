@@ -2,16 +2,22 @@
 
 :func:`sample_sweep_section` is the provider for the sample load sweep shipped
 in ``meshes/aircraft/`` (``static_*.vtu``, ``rolling_*.vtu`` paired by
-``static=rolling``): when those files exist it runs the sweep, draws the load
-trends and returns a :class:`fepost.report.Section`; otherwise it returns None
+``static=rolling``), listed in :data:`fepost.report.sections.DEFAULT_SECTIONS`:
+when the report's static map is one of those files (the report of the sample
+tire, as ``fepost report`` without inputs and ``make demo`` write it) it runs
+the sweep, draws the load trends and returns a :class:`fepost.report.Section`;
+otherwise (a report of other inputs, or the files are absent) it returns None
 and the report has no trace of it. :func:`sweep_provider` makes a provider for
-any other inputs. A provider is listed in
-:data:`fepost.report.sections.DEFAULT_SECTIONS` to appear in ``fepost report``.
+any other inputs.
 
 The sweep runs on one worker thread of an in-process Dask cluster (it starts
 in well under a second; the sample is a handful of files), with the report's
-friction coefficient, and writes into ``sweep/`` beside ``report.html``:
-``coefficients.csv``, ``coefficients.parquet`` and the figures (PNG, SVG).
+friction coefficient and reading options, and writes into ``sweep/`` beside
+``report.html``: ``coefficients.csv``, ``coefficients.parquet`` and the
+figures (PNG, SVG). The row of the report's own case (same static and rolling
+file, same options) is not analysed again: it is made from the report's
+analysis (:func:`fepost.sweep.jobs.analysis_row`) and handed to the sweep as a
+finished row.
 """
 
 from __future__ import annotations
@@ -38,8 +44,10 @@ TABLE = (
     ("N", "N (N)"),
     ("R", "R (m)"),
     ("M0", "M0 (N·m)"),
+    ("a", "a"),
+    ("m", "m"),
     ("aR2", "a·R² (m²)"),
-    ("m_over_R2", "m/R² (1/m²)"),
+    ("m_over_R2", "m/R² (m⁻²)"),
     ("aspect", "aspect"),
     ("k_x", "k_x"),
     ("status", "status"),
@@ -55,16 +63,47 @@ def _cell(row, key: str):
     return v
 
 
+def _signed(v: float, fmt: str) -> str:
+    return fmt.format(v).replace("-", "−")
+
+
 def _exponent_text(fit) -> str:
     if not fit.fitted:
         return f"{fit.label}: no power law ({fit.note})."
     lo, hi = fit.ci95
-    hertz = "" if fit.hertz is None else f"; Hertz contact: {fit.hertz:.3g}"
+    hertz = "" if fit.hertz is None else f"; Hertz contact: {_signed(fit.hertz, '{:.3g}')}"
     group = "" if fit.group == "all" else f" ({fit.group})"
     return (
-        f"{fit.label} ∝ N^{fit.exponent:.3f}{group}, 95 % interval [{lo:.3f}, {hi:.3f}], "
-        f"from {fit.n} loads{hertz}."
+        f"{fit.label} ∝ N^{_signed(fit.exponent, '{:.3f}')}{group}, 95\u202f% interval "
+        f"[{_signed(lo, '{:.3f}')}, {_signed(hi, '{:.3f}')}], from {fit.n} loads{hertz}."
     )
+
+
+def _same_file(a, b) -> bool:
+    if a is None or b is None:
+        return a is None and b is None
+    try:
+        return Path(str(a)).resolve() == Path(str(b)).resolve()
+    except OSError:
+        return False
+
+
+def _analysis_kwargs(data) -> dict:
+    return dict(getattr(data, "analysis_kwargs", None) or {})
+
+
+def _report_case(data: ReportData, pairings) -> tuple[int | None, bool]:
+    """(index of the pairing that is the report's static map, or None; whether its row
+    is the report's own computation: same rolling map and no other time step)."""
+    a = getattr(data, "analysis", None)
+    if a is None:
+        return None, False
+    for i, pr in enumerate(pairings):
+        if pr.static.path is not None and _same_file(a.static_field.source, pr.static.path):
+            rolling = None if a.rolling_field is None else a.rolling_field.source
+            same = _same_file(rolling, pr.rolling) and _analysis_kwargs(data).get("step") is None
+            return i, same
+    return None, False
 
 
 def sweep_provider(
@@ -73,11 +112,16 @@ def sweep_provider(
     *,
     key: str = "sweep",
     title: str = "Load sweep",
+    only_with_report_case: bool = False,
 ) -> Callable[[ReportData, Path], Section | None]:
     """A report section provider sweeping ``inputs`` (paths or glob patterns).
 
     The provider returns None when no input exists, so a report built where the
-    sweep's files are missing shows no empty section.
+    sweep's files are missing shows no empty section; with
+    ``only_with_report_case`` also when the report's static map is not one of the
+    inputs (a report of other files). The report's own case, when it is a row, is
+    taken from the report's analysis (module docstring). ``data`` needs
+    ``friction``; ``analysis`` and ``analysis_kwargs`` are used when present.
     """
 
     def provider(data: ReportData, folder: Path) -> Section | None:
@@ -88,25 +132,37 @@ def sweep_provider(
         from ..report.figures import Figure, png_data_uri
         from ..report.sections import Section
         from .inputs import expand_inputs
+        from .jobs import Job, analysis_row
         from .options import RowOptions
         from .page import draw_figures
         from .pairs import pair_sources, parse_rolling_pairs
         from .run import run_sweep
-        from .store import WORK
+        from .store import WORK, WorkFolder
         from .trends import load_trends
 
         pairs = None if rolling_pairs is None else parse_rolling_pairs(rolling_pairs)
-        if pairs is not None:
-            try:
-                pair_sources(expand_inputs(present), pairs)
-            except ArgumentError:  # no rolling map among the files: a static-only sweep
-                pairs = None
+        sources = expand_inputs(present)
+        try:
+            pairings = pair_sources(sources, pairs)
+        except ArgumentError:  # no rolling map among the files: a static-only sweep
+            pairs = None
+            pairings = pair_sources(sources, None)
+        own, same = _report_case(data, pairings)
+        if only_with_report_case and own is None:
+            return None
+        options = RowOptions.from_analysis_kwargs(_analysis_kwargs(data), friction=float(data.friction))
         out = Path(folder) / FOLDER
+        if own is not None and same:
+            pr = pairings[own]
+            job = Job(pr.static.given, pr.static.path, None, options, rolling=pr.rolling,
+                      rolling_given=pr.rolling_given)  # fmt: skip
+            with WorkFolder(out, force=True) as work:
+                work.save_row(job.key(), analysis_row(job, data.analysis))
         result = run_sweep(
             present,
             out,
             rolling_pairs=pairs,
-            options=RowOptions(friction=float(data.friction)),
+            options=options,
             workers=1,
             processes=False,
             progress=False,
@@ -130,6 +186,9 @@ def sweep_provider(
             "fepost sweep. Power laws y = c·N^α are fitted by least squares of log y on log N; "
             "the intervals use Student's t with n − 2 degrees of freedom."
         )
+        if own is not None:
+            name = _cell(rows[own], "case") if own < len(rows) else pairings[own].static.given
+            intro += f" The report above is the case {name} of this sweep."
         table = (tuple(h for _, h in TABLE), *(tuple(_cell(r, k) for k, _ in TABLE) for r in rows))
         return Section(
             key=key,
@@ -145,8 +204,9 @@ def sweep_provider(
 
 
 def sample_sweep_section(data: ReportData, folder: Path) -> Section | None:
-    """The section of the sample load sweep in ``meshes/aircraft/``, or None when it is not there."""
+    """The section of the sample load sweep in ``meshes/aircraft/`` in the report of one of
+    its cases; None for a report of other files, or when the sample is not there."""
     from ..report.samples import meshes_folder
 
     inputs = [str(meshes_folder() / p) for p in SAMPLE_INPUTS]
-    return sweep_provider(inputs, SAMPLE_PAIRS)(data, folder)
+    return sweep_provider(inputs, SAMPLE_PAIRS, only_with_report_case=True)(data, folder)
