@@ -55,7 +55,7 @@ class Analysis:
         return summarise(self)
 
     def to_dict(self, model: bool = True) -> dict:
-        """The coefficients JSON of INTERFACE.md (SI units), with provenance.
+        """The coefficients JSON (SI units, keys in docs/formats.md), with provenance.
 
         ``model``: include the generalised friction model (key ``model``; building
         it takes about a second: a table of many analyses may leave it out)."""

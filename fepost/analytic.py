@@ -1,4 +1,5 @@
-"""Closed-form reference pressure maps and their integrals (THEORY.md §5).
+"""Closed-form reference pressure maps and their integrals (docs/theory.md,
+"Reference values").
 
 Every profile is a function of ρ = r/R on the unit disc, scaled by a peak
 pressure ``p`` (Pa). The closed forms below are checked in the tests against
@@ -32,7 +33,7 @@ _PROFILES: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "tire": lambda rho: np.sqrt(np.clip(1.0 - rho**2, 0.0, None)) * (0.6 + 1.2 * rho**2),
 }
 
-#: A^k/p for k = 0..3, closed forms (THEORY.md §5 and direct integration).
+#: A^k/p for k = 0..3, closed forms (docs/theory.md, "Reference values", and direct integration).
 MOMENTS: dict[str, tuple[float, float, float, float]] = {
     "uniform": (1.0, 1.0 / 2.0, 1.0 / 3.0, 1.0 / 4.0),
     "hertz": (np.pi / 4.0, 1.0 / 3.0, np.pi / 16.0, 2.0 / 15.0),
@@ -68,7 +69,7 @@ def pressure_function(
 ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """σ(x, y) in Pa for a profile on a patch of ``radius`` m.
 
-    ``k_x`` applies the rolling shift σ(1 + k_x x/R) (THEORY.md §1);
+    ``k_x`` applies the rolling shift σ(1 + k_x x/R) (docs/theory.md, "Integrals of the pressure");
     ``aspect`` stretches the patch along x by √aspect and shrinks it along y
     by the same factor (equal area); ``centre`` offsets the patch (m).
     """
@@ -97,7 +98,7 @@ def load(name: str, radius: float, peak: float = 1.0) -> float:
 
 
 def coefficients(name: str, radius: float, peak: float = 1.0, friction: float = 0.3) -> dict:
-    """F0, M0, a, m, b, b1 (SI) of a circular profile, per THEORY.md §2."""
+    """F0, M0, a, m, b, b1 (SI) of a circular profile (docs/theory.md, "Integrals of the pressure")."""
     A = moments(name, peak)
     F0 = 2.0 * np.pi * friction * radius**2 * A[1]
     M0 = 2.0 * np.pi * friction * radius**3 * A[2]

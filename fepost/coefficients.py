@@ -1,4 +1,5 @@
-"""Friction-model coefficients from the moments (THEORY.md §2, paper 1.2, 1.4–1.6).
+"""Friction-model coefficients from the moments (docs/theory.md, "Integrals of the
+pressure"; paper 1.2, 1.4–1.6).
 
     F0 = 2π f R² A¹ = f N          M0 = 2π f R³ A² = f ∬σ0 r dA
     √a = 2A¹/A⁰                     √m = 2A²/A³        b = m/4     b1 = M0/2

@@ -1,4 +1,5 @@
-"""Integrals of a polar pressure map (THEORY.md §2, paper 1.1, 1.2, 1.5).
+"""Integrals of a polar pressure map (docs/theory.md, "Integrals of the
+pressure"; paper 1.1, 1.2, 1.5).
 
 All moments are about the map's centre (the static centre of pressure):
 

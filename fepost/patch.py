@@ -1,7 +1,7 @@
 """The contact patch: loaded region, ground plane, frame and circularity check.
 
-Definitions (THEORY.md §1)
---------------------------
+Definitions (docs/theory.md, "The contact patch and its frame")
+---------------------------------------------------------------
 * **Loaded**: an element face is loaded when the FE pressure exceeds the
   threshold somewhere on it: for nodal data when one of its nodes does, for
   face data when its value does. The threshold is ``threshold`` × the peak

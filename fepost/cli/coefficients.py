@@ -15,7 +15,10 @@ def add_parser(sub) -> None:
     p = sub.add_parser(
         "coefficients",
         help="patch, circularity and friction-model coefficients of an FE contact map",
-        description="Compute the contact patch and the coefficients of THEORY.md sections 1-2.",
+        description=(
+            "Compute the contact patch and its frame, the paper's coefficients and the generalised "
+            "friction model of the map. Definitions: docs/theory.md; the model: docs/model.md."
+        ),
     )
     p.add_argument("static", metavar="STATIC", help="static contact map (.vtu .vtk .vtp .e .exo)")
     p.add_argument("--rolling", metavar="ROLLING", help="rolling contact map at the same deflection")
