@@ -148,18 +148,50 @@ def tutorial(tmp_path_factory):
 def test_tutorial_has_the_steps_it_promises():
     steps = tutorial_steps()
     commands = [s.split()[1] for k, s in steps if k == "console"]
-    assert commands == ["coefficients", "report", "diagnose"]
-    assert [k for k, _ in steps].count("python") == 1
+    assert commands == ["coefficients", "report", "predict", "sweep", "diagnose"]
+    assert [k for k, _ in steps].count("python") == 2
+    report = next(s for k, s in steps if k == "console" and s.split()[1] == "report")
+    assert shlex.split(report)[2:] == ["--out", "report", "--force"]  # the demo's case: no inputs
 
 
 @pytest.mark.slow
 def test_tutorial_runs_and_says_what_happens(tutorial):
+    import csv
+
     coef = json.loads((tutorial / "coefficients.json").read_text())
     text = (DOCS / "tutorial.md").read_text(encoding="utf-8")
     # the numbers quoted in the tutorial are the ones the commands give
     assert f"{coef['N']:.6g} N" in text and f"{coef['M0']:.6g} N m" in text
     assert f"{coef['k_x']:.6g}" in text and f"aspect {coef['patch']['aspect']:.4f}" in text
-    assert (tutorial / "report" / "report.html").is_file()
+    assert f"agree to {100 * abs(coef['N'] / coef['reaction_z'] - 1):.2f} %" in text
+    # ... the generalised model's lines and the accuracy claimed for it
+    d = coef["model"]["direction_coefficients"]
+    assert f"a along x, y                {d['a'][0]:.6g}, {d['a'][1]:.6g}" in text
+    assert f"m along x, y                {d['m'][0]:.6g}, {d['m'][1]:.6g}" in text
+    acc = coef["model"]["static"]["accuracy"]
+    assert f"within {100 * max(acc['model_force'], acc['model_torque']):.1f} %" in text
+    assert f"miss by up to {100 * max(acc['compare_force'], acc['compare_torque']):.0f} %" in text
+    # the report of the demo's case, with its error maps and the sample sweep
+    report = tutorial / "report"
+    assert (report / "report.html").is_file() and (report / "error_map.json").is_file()
+    assert json.loads((report / "coefficients.json").read_text())["N"] == coef["N"]
+    assert (report / "sweep" / "coefficients.csv").is_file()
+    # predict: the torques quoted, and what the text says about them
+    with open(tutorial / "predicted.csv", newline="") as fh:
+        rows = {float(r["wz"]): r for r in csv.DictReader(fh)}
+    assert len(rows) == 9
+    assert json.loads((tutorial / "model.json").read_text())["F0"] == pytest.approx(coef["F0"], rel=1e-12)
+    for wz in (0.5, 1.5, 4.0):
+        mz = [float(rows[wz][f"Mz_{m}"]) for m in ("exact", "paper", "model")]
+        assert f"{wz:g}   {mz[0]:.1f}   {mz[1]:.1f}   {mz[2]:.1f}" in text, wz
+        if wz < 2:
+            assert 0.2 <= abs(mz[1] / mz[0] - 1) <= 0.31 and abs(mz[2] / mz[0] - 1) < 0.01
+    # the sweep's trends as quoted
+    fits = {f["quantity"]: f for f in json.loads((tutorial / "sweep" / "trends.json").read_text())["fits"]}
+    for q in ("R", "M0"):
+        lo, hi = fits[q]["ci95"]
+        assert f"{q} ∝ N^{fits[q]['exponent']:.3f}, 95 % interval [{lo:.3f}, {hi:.3f}]" in text, q
+    assert fits["R"]["n"] == 6
     diag = json.loads((tutorial / "diagnosis" / "diagnosis.json").read_text())
     assert diag["cause"] == "friction_level"
     lo, hi = diag["parameters"]["f"]["ci95"]
@@ -173,6 +205,7 @@ def test_formats_page_documents_every_report_file(tutorial):
     file named there is written."""
     text = (DOCS / "formats.md").read_text(encoding="utf-8")
     section = text.split("### `fepost report --out DIR`", 1)[1].split("\n### ", 1)[0]
+    section = section.split("\n#### ", 1)[0]  # the file table, not the subsections' key tables
     documented = set()
     for cell in re.findall(r"^\| ([^|]+) \|", section, re.M):
         for name in re.findall(r"`([^`]+)`", cell):
@@ -182,7 +215,9 @@ def test_formats_page_documents_every_report_file(tutorial):
                 documented |= {f"{base}.{e}" for e in exts.split("|")}
             else:
                 documented.add(name)
-    written = {p.name for p in (tutorial / "report").iterdir()}
+    report = tutorial / "report"
+    written = {p.relative_to(report).as_posix() for p in report.rglob("*") if p.is_file()}
+    assert any(name.startswith("sweep/") for name in written)  # the demo's case has the sweep
     for name in written:
         stem = name.rsplit(".", 1)[0]
         assert name in documented or f"{stem}.*" in documented, name
