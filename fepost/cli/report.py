@@ -21,12 +21,13 @@ def add_parser(sub) -> None:
         description=(
             "Write DIR/report.html (self-contained, figures embedded) with the figures beside it (PNG, "
             "and SVG/PDF for the plots), coefficients.json, table1.json, curves.csv and VTK files of the "
-            "polar maps and patches. With no inputs, uses the sample meshes shipped in meshes/. "
-            "File formats: docs/formats.md."
+            "polar maps and patches, and the error maps of the closed forms and the generalised model. "
+            "With no inputs, uses the sample aircraft tire at its rated load (meshes/aircraft/static_100.vtu "
+            "and rolling_100.vtu), whose report also shows its load sweep. File formats: docs/formats.md."
         ),
     )
     p.add_argument(
-        "static", metavar="STATIC", nargs="?", help="static contact map (default: the sample mesh)"
+        "static", metavar="STATIC", nargs="?", help="static contact map (default: the sample aircraft tire)"
     )
     p.add_argument("rolling", metavar="ROLLING", nargs="?", help="rolling contact map at the same deflection")
     p.add_argument("--out", metavar="DIR", required=True, help="output folder (created; must be empty)")
