@@ -251,6 +251,18 @@ def heavy():
     return analyse(HEAVY)
 
 
+AIRCRAFT = Path(__file__).resolve().parents[1] / "meshes" / "aircraft"
+
+
+@pytest.fixture(scope="module")
+def aircraft():
+    """The demo's case: the aircraft tire at its rated load, static and rolling."""
+    static, rolling = AIRCRAFT / "static_100.vtu", AIRCRAFT / "rolling_100.vtu"
+    if not (static.is_file() and rolling.is_file()):
+        pytest.skip(f"{AIRCRAFT} not shipped")
+    return analyse(static, rolling)
+
+
 def _projected(points, renderer):
     out = []
     for p in points:
@@ -264,7 +276,7 @@ def _inside(pts, box):
     return (pts[:, 0] > box[0]) & (pts[:, 0] < box[1]) & (pts[:, 1] > box[2]) & (pts[:, 1] < box[3])
 
 
-@pytest.mark.parametrize("case", ["heavy", "maps"])
+@pytest.mark.parametrize("case", ["heavy", "maps", "aircraft"])
 def test_figure1_texts_legend_and_colour_bar_are_legible(case, request):
     """No two labels overlap, the legend and colour bar hold no data and touch no label,
     tick labels are not tiny, the height axis has a title, the colour bar ticks are round."""
@@ -305,6 +317,30 @@ def test_figure1_texts_legend_and_colour_bar_are_legible(case, request):
         assert any(np.isclose(mantissa, m) for m in (1, 2, 2.5, 5)), step
     finally:
         pl.close()
+
+
+def test_figures_1_and_2_share_one_frame_and_label_every_axis_at_zero(aircraft):
+    """As the report draws them: the same framed square for the static and the rolling map
+    (their r_max differ), and the height axis keeps its 0 (no y tick at the corner it
+    stands on, where the two labels collided and the height's 0 was dropped)."""
+    from fepost.figures.render import EXTENT_FACTOR, boxes_overlap, layout, text_box
+
+    patches = (aircraft.static_patch, aircraft.rolling_patch)
+    assert patches[0].r_max != patches[1].r_max
+    extent = max(p.r_max for p in patches) * EXTENT_FACTOR
+    frames = []
+    for patch in patches:
+        pl = pressure_surface(patch, inflation_pressure=1.38e6, extent=extent)
+        try:
+            texts = [(t.GetInput(), text_box(t, pl.renderer)) for t in layout(pl).texts]
+            assert [t for t, _ in texts].count("0") == 3, [t for t, _ in texts]  # x, y and height
+            for i, (a, ba) in enumerate(texts):
+                for b, bb in texts[i + 1 :]:
+                    assert not boxes_overlap(ba, bb), (a, b)
+            frames.append(pl.bounds)
+        finally:
+            pl.close()
+    np.testing.assert_allclose(frames[0][:4], frames[1][:4])
 
 
 def test_figure1_surface_ends_at_the_contact_edge(heavy):
@@ -389,7 +425,7 @@ def test_figure3_y_limits_hold_every_peak(heavy):
         assert hi <= 1.1 * plotted_values(sec).max()
 
 
-@pytest.mark.parametrize("case", ["heavy", "maps"])
+@pytest.mark.parametrize("case", ["heavy", "maps", "aircraft"])
 def test_figure3_legend_and_labels_clear_of_data(case, request):
     a = request.getfixturevalue(case)
     sec = diameter_sections(a.static_patch, a.rolling_patch)
@@ -402,7 +438,7 @@ def test_figure3_legend_and_labels_clear_of_data(case, request):
     assert labels[:1] == ["static"] and ("rolling" in labels) == (a.rolling_patch is not None)
 
 
-@pytest.mark.parametrize("case", ["heavy", "maps"])
+@pytest.mark.parametrize("case", ["heavy", "maps", "aircraft"])
 def test_patch_plan_labels_and_legend_clear(case, request):
     a = request.getfixturevalue(case)
     fig = plot_patch_plan(a.static_patch)
