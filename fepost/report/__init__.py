@@ -14,6 +14,11 @@ map and writes into ``out``:
 ``fig4_f_parallel.*``           Figure 4: F∥(ψ)
 ``fig5_torque.*``               Figure 5: M_C(υ)
 ``fig6_f_perp.*``               Figure 6: F⊥(υ) (with a rolling map)
+``error_map.*``                 error of the closed forms and of the generalised
+                                model over the kinematic sphere (PNG, SVG, PDF;
+                                ``error_map_rolling.*`` with a rolling map)
+``error_map.json``              :meth:`fepost.friction.sphere.ErrorMap.to_dict`
+                                of that map (``error_map_rolling.json``)
 ``coefficients.json``           :meth:`fepost.analysis.Analysis.to_dict`
 ``table1.json``                 :meth:`fepost.table1.Table1.to_dict` (``rows`` of
                                 name, theory, fitted, ci95)
@@ -23,6 +28,8 @@ map and writes into ``out``:
 ``static_map.vtu``              the polar maps, patches and outlines as VTK files
 ``static_patch.vtp``            for ParaView (:mod:`fepost.report.vtkfiles`; and
 ``static_outline.vtp``          ``rolling_*`` with a rolling map)
+``sweep/``                      the optional sections' files: the load sweep of the
+                                sample tire in its report (:mod:`.sections`)
 ==============================  ====================================================
 
 Everything is written into a temporary folder beside ``out`` and moved into
@@ -34,7 +41,8 @@ inputs and seed, default :data:`fepost.table1.DEFAULT_SEED`): the closed-form
 curves (1.8) with the map's coefficients, 20 % uniform noise, a joint
 least-squares fit, and the same fit on exact-integral data for the bias of the
 approximation. Figures 4–6 show its test points and fitted curves with their
-95 % prediction band (:meth:`fepost.identify.Identification.prediction_band`).
+95 % prediction band (:meth:`fepost.identify.Identification.prediction_band`),
+and the generalised model of the FE maps (Table 1's generalised form).
 
 The subpackage, by job: :mod:`.assemble` (the data the page shows),
 :mod:`.figures` (saving and embedding figures), :mod:`.vtkfiles` (VTK output),

@@ -36,6 +36,8 @@ FILE_NOTES = {
     "static_patch.vtp": "the loaded FE faces of the static map with their pressure (Pa)",
     "rolling_patch.vtp": "the loaded FE faces of the rolling map",
     "static_outline.vtp": "static patch: outline, frame axes, R and r_equiv circles, best-fit ellipse",
+    "sweep/coefficients.csv": "the load sweep's table, one row per load (as fepost sweep writes it)",
+    "sweep/coefficients.parquet": "the same table as Parquet, with each column's unit",
     "rolling_outline.vtp": "rolling patch: the same, in the static frame",
 }
 #: Grid of the error maps: sliding directions β in [0°, 180°] and meridian points t in [0, 1]

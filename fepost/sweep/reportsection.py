@@ -129,16 +129,8 @@ def sweep_provider(
         if not present:
             return None
         from ..errors import ArgumentError
-        from ..report.figures import Figure, png_data_uri
-        from ..report.sections import Section
         from .inputs import expand_inputs
-        from .jobs import Job, analysis_row
-        from .options import RowOptions
-        from .page import draw_figures
         from .pairs import pair_sources, parse_rolling_pairs
-        from .run import run_sweep
-        from .store import WORK, WorkFolder
-        from .trends import load_trends
 
         pairs = None if rolling_pairs is None else parse_rolling_pairs(rolling_pairs)
         sources = expand_inputs(present)
@@ -149,7 +141,15 @@ def sweep_provider(
             pairings = pair_sources(sources, None)
         own, same = _report_case(data, pairings)
         if only_with_report_case and own is None:
-            return None
+            return None  # decided before the sweep's heavier imports (Dask, pyarrow)
+        from ..report.figures import Figure, png_data_uri
+        from ..report.sections import Section
+        from .jobs import Job, analysis_row
+        from .options import RowOptions
+        from .page import draw_figures
+        from .run import run_sweep
+        from .store import WORK, WorkFolder
+        from .trends import load_trends
         options = RowOptions.from_analysis_kwargs(_analysis_kwargs(data), friction=float(data.friction))
         out = Path(folder) / FOLDER
         if own is not None and same:
