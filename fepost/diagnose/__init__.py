@@ -1,6 +1,6 @@
 """``fepost diagnose``: what the simulation gets wrong against rig data, and why.
 
-:func:`diagnose` compares measured Fx, Fy, Mz (the CSV of INTERFACE.md) with the
+:func:`diagnose` compares measured Fx, Fy, Mz (the measured-data CSV of docs/diagnose.md) with the
 exact friction integrals over the FE contact pressure, fits every candidate cause
 (:data:`~fepost.diagnose.causes.CAUSES`) as a physical extension of the model,
 names the one the data support (BIC with nesting tests and a held-out check,
