@@ -21,9 +21,10 @@ profiled likelihood −(n/2) Σ_c [ln(2π RSS_c/n) + 1].
 **Robust fit** (``loss="huber"``). The same alternation with Huber's loss
 ρ_k(z) (k = 1.345: quadratic within k noise SDs, linear beyond; ``loss="huber"``
 with ``f_scale=k`` of least_squares on the whitened residuals) and Huber's scale
-equation for the noise parameters (:mod:`~fepost.diagnose.noise`); the first
-scale is 1.4826 × MAD of the residuals at the start values. ``log_likelihood``
-is then −Σ [ρ_k(z) + ln σ], the Huber-density log-likelihood up to a constant.
+equation for the noise parameters (Huber's Proposal 2, :mod:`~fepost.diagnose.noise`);
+the first scale is 1.4826 × MAD of the residuals at the start values.
+``log_likelihood`` is then −Σ [ρ_k(z) + ln σ], the log-likelihood of Huber's
+least-favourable density up to a constant, evaluated at that scale.
 Robust fits serve only to find outliers and the noise model's reference
 (:mod:`~fepost.diagnose.robust`); every score, test and interval comes from a
 Gaussian fit on the rows that remain.

@@ -38,9 +38,11 @@ decides; the combined model must gain more than ln n in −2ℓ.
 score equations Σ w_i (r_i² − σ_i²)(1, g_i²) = 0 with w_i = 1/σ_i⁴: Fisher
 scoring is a weighted regression of r² on (1, g²), iterated, with the bounds
 enforced on the free parameters (:func:`fit_channel`). For the robust pass the
-squared residuals are replaced by Huber's bounded version σ_i² min(z², k|z|)/β
-(z = r/σ, β = 2Φ(k) − 1 so that the estimate is unbiased at the normal), the
-scale equation of Huber's M-estimator; the first scale is 1.4826 × MAD.
+squared residuals are replaced by Huber's bounded version σ_i² min(z², k²)/β
+(z = r/σ, β = E[min(Z², k²)] for Z ~ N(0, 1), so that the estimate is unbiased
+at the normal): the scale equation of Huber's "Proposal 2", whose influence is
+bounded (a gross error counts as k noise SDs, however large it is); the first
+scale is 1.4826 × MAD.
 """
 
 from __future__ import annotations
@@ -61,8 +63,12 @@ N_PARAMS = {"constant": 1, "proportional": 1, "combined": 2}
 NOISE_FLOOR = 1e-3
 #: Huber's tuning constant: 95 % efficiency at the normal.
 HUBER_K = 1.345
-#: E[ψ(Z)Z] = 2Φ(k) − 1 for Z ~ N(0, 1): the consistency constant of the Huber scale.
-HUBER_BETA = float(2.0 * ndtr(HUBER_K) - 1.0)
+#: E[ψ_k(Z)²] = E[min(Z², k²)] for Z ~ N(0, 1): the consistency constant of Huber's scale.
+HUBER_BETA = float(
+    (2.0 * ndtr(HUBER_K) - 1.0)
+    - 2.0 * HUBER_K * np.exp(-0.5 * HUBER_K**2) / np.sqrt(2.0 * np.pi)
+    + 2.0 * HUBER_K**2 * (1.0 - ndtr(HUBER_K))
+)
 #: Normal-consistent MAD.
 MAD_FACTOR = 1.482602218505602
 
@@ -147,8 +153,8 @@ def _targets(r, s2, robust: bool) -> np.ndarray:
     """Squared residuals, or Huber's bounded version at the current variances."""
     if not robust:
         return r**2
-    z = np.abs(r) / np.sqrt(s2)
-    return s2 * np.minimum(z * z, HUBER_K * z) / HUBER_BETA
+    z2 = r * r / s2
+    return s2 * np.minimum(z2, HUBER_K**2) / HUBER_BETA
 
 
 def _scoring_step(t, g2, s2, structure: str, floor2: float) -> tuple[float, float]:

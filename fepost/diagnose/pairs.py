@@ -216,12 +216,22 @@ def search_pairs(
         pvals, reasons = _nesting(jf, jcv, against)
         done.append(
             Trial(
-                second, joint.name, stat, p, need, jf, jcv, pvals, jf.bic - base.bic,
-                not reasons, tuple(reasons),
+                second,
+                joint.name,
+                stat,
+                p,
+                need,
+                jf,
+                jcv,
+                pvals,
+                jf.bic - base.bic,
+                not reasons,
+                tuple(reasons),
             )  # fmt: skip
         )
     admissible = sorted(
-        (t for t in done if t.admissible and t.fit is not None), key=lambda t: t.fit.bic  # type: ignore[union-attr]
+        (t for t in done if t.admissible and t.fit is not None),
+        key=lambda t: t.fit.bic,  # type: ignore[union-attr]
     )
     chosen = admissible[0] if admissible else None
     twins: tuple[str, ...] = ()

@@ -187,7 +187,11 @@ def diagnose(
             owner[p.name] = ext
     params = {
         p.name: ParameterEstimate(
-            p.name, float(v), (float(lo), float(hi)), p.unit, p.description,
+            p.name,
+            float(v),
+            (float(lo), float(hi)),
+            p.unit,
+            p.description,
             owner.get(p.name, "friction_level"),
         )  # fmt: skip
         for p, v, (lo, hi) in zip(final_cand.parameters, final_fit.values, final_fit.ci95, strict=True)

@@ -20,7 +20,7 @@ its three channels lies beyond
 
 i.e. when no cause in the vocabulary explains it. c is the Bonferroni bound over
 the 3n residuals: on clean Gaussian data the chance that any row at all is
-flagged is below 5 % (c = 4.3 for 400 rows); a flagged row costs one test point.
+flagged is below 5 % (c = 4.1 for 400 rows); a flagged row costs one test point.
 A misfit that a candidate explains (a real effect) is not flagged, because that
 candidate's residuals are small there. When more than
 :data:`MAX_OUTLIER_FRACTION` of the rows lie beyond c, they are not isolated
