@@ -22,6 +22,12 @@ case (base + index), chosen before the first run and never changed.
   pressure shift;
 * an exponential (Stribeck-type) fall of friction with sliding speed, which
   fepost fits as linear: still ``speed_dependent_friction``.
+
+Known interval misses (:data:`KNOWN_MISSES`): the intervals' coverage is
+measured by ``benchmarks/bench_diagnose_coverage.py --sets rig pairs`` (200 noise
+draws per case at its own design); a case must miss exactly its listed
+parameters at its committed seed (any other miss, or a listed one that starts
+covering, fails) and is then reported as xfail, as in test_diagnose_detect.py.
 """
 
 from __future__ import annotations
@@ -37,6 +43,19 @@ pytestmark = pytest.mark.slow
 LOADS = (0.7, 1.0, 1.3)
 CASES = (("none", {}), *VALIDATION_SET_A)
 
+#: Parameters whose truth lies outside the 95 % interval at the committed seed, with
+#: z = (estimate − truth)/SE there and the interval's coverage over 200 noise draws.
+KNOWN_MISSES = {
+    "friction_level+sensor_offset": {"offset_Mz": "z = +2.07; coverage 95.5 +- 1.5 %"},
+}
+
+
+def _assert_misses(case, misses):
+    known = KNOWN_MISSES.get(case, {})
+    assert set(misses) == set(known), f"interval misses {misses}; known at this seed: {sorted(known)}"
+    if known:
+        pytest.xfail(f"known 1-in-20 interval miss at this seed: {known}")
+
 
 @pytest.fixture(scope="module")
 def tire():
@@ -44,12 +63,13 @@ def tire():
 
 
 def _covers(d, syn, effect):
-    misses = []
+    """{parameter: why} for every true parameter outside its interval."""
+    misses = {}
     for name, truth in syn.truth.items():
         if name == "f" and "friction_level" not in syn.effects:
             truth = syn.friction
         if name in d.parameters and not d.parameters[name].covers(truth):
-            misses.append(f"{name} = {truth} outside {d.parameters[name].ci95}")
+            misses[name] = f"{name} = {truth} outside {d.parameters[name].ci95}"
     return misses
 
 
@@ -64,9 +84,9 @@ def test_outliers_and_proportional_noise_on_each_cause(tire, i, effect, params):
     assert list(d.outliers) == list(syn.outliers)
     assert [d.noise[c]["model"] for c in ("Fx", "Fy", "Mz")] == ["proportional"] * 3
     assert not d.lack_of_fit["detected"], d.lack_of_fit
-    assert not _covers(d, syn, effect)
     if effect != "none":
         assert d.gain["rmse_after"] < d.gain["rmse_before"] and d.gain["delta_bic"] < -10
+    _assert_misses(effect, _covers(d, syn, effect))
 
 
 def test_proportional_noise_alone_gives_none(tire):
@@ -116,7 +136,6 @@ def test_two_causes_at_once(tire, effects, params, seed):
     assert set(d.causes) == set(effects) and len(d.causes) == 2, d.summary()
     assert d.cause == d.causes[0]
     assert set(d.parameters) == set(syn.truth) | {"f"}
-    assert not _covers(d, syn, effects)
     assert d.gain["model"] in ("+".join(effects), "+".join(effects[::-1]), "sensor_offset")
     assert not d.lack_of_fit["detected"]
     summary = d.summary()
@@ -124,6 +143,7 @@ def test_two_causes_at_once(tire, effects, params, seed):
     js = d.to_dict()
     assert js["causes"] == list(d.causes) and js["cause"] == d.causes[0]
     assert {p["cause"] for p in js["parameters"].values()} >= set(effects) - {"friction_level"}
+    _assert_misses("+".join(effects), _covers(d, syn, effects))
 
 
 def test_exponential_speed_law_is_still_speed_dependent(tire):

@@ -23,7 +23,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..analysis import analyse
 from ..errors import ArgumentError
+from ..polar import PolarMap
 from .causes import CAUSES
 from .measured import write_csv
 from .simulation import load_simulation
@@ -70,20 +72,26 @@ def make_example(
 ) -> SyntheticData:
     """Write an example measured-data CSV over ``simulation`` to ``out``; returns the synthetic data.
 
-    ``simulation``/``rolling`` as for :func:`~fepost.diagnose.diagnose`; with a
-    rolling map the rows carry roll = −1, 0, +1. The file's header comments
-    document the hidden cause, its parameters, the noise, the outlier rows and
-    the seed.
+    ``simulation``/``rolling``: FE exports (paths or ContactFields) or polar maps;
+    the generator works on the analysis's polar maps (finer than diagnose's fit
+    grid, as for measured data). With a rolling map the rows carry roll = −1, 0, +1.
+    The file's header comments document the hidden cause, its parameters, the
+    noise, the outlier rows and the seed.
     """
     if cause not in CAUSES:
         raise ArgumentError(f"--cause must be one of {', '.join(CAUSES)}, got {cause!r}")
-    sim = load_simulation(simulation, rolling, friction=friction, **(analyse_kwargs or {}))
+    if isinstance(simulation, PolarMap):
+        static, rolling_map = simulation, rolling
+    else:  # the analysis's own polar maps, not the coarser fit grid of a Simulation
+        result = analyse(simulation, rolling, friction=friction, **(analyse_kwargs or {}))
+        static, rolling_map = result.static_map, result.rolling_map
+    sim = load_simulation(static, rolling_map, friction=friction)
     params = example_parameters(cause, sim.friction, sim.load, sim.radius)
     syn = synthesize(
-        sim.static,
+        static,
         cause,
         params,
-        rolling=sim.rolling,
+        rolling=rolling_map,
         friction=sim.friction,
         n=EXAMPLE_POINTS,
         noise=EXAMPLE_NOISE,

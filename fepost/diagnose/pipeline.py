@@ -85,6 +85,15 @@ def closed_form_prediction(sim: Simulation, data: MeasuredData) -> np.ndarray:
     return out
 
 
+def screen(cands: dict, Y: np.ndarray):
+    """Step 3: the robust pass, the rows kept and the noise model (with its selection tables)."""
+    g0 = np.abs(cands["none"].predict(np.empty(0)))
+    rob = robust_pass(cands, Y, g0)
+    rows = np.setdiff1d(np.arange(Y.shape[0]), rob.outliers)
+    noise, tables = _noise_model(rob, cands, Y, rows)
+    return rob, rows, noise, tables
+
+
 def _noise_model(rob, cands, Y, rows) -> tuple[Noise, dict]:
     """The noise model of every Gaussian fit: reference magnitudes and per-channel structure."""
     ref = rob.fits[rob.reference]
@@ -143,13 +152,9 @@ def diagnose(
     table = extension_parameters(pred)
     scale = pred.scale
     Y = data.forces / scale
-    n = len(data)
 
     # 3. robust fits, outliers, noise model
-    g0 = np.abs(cands["none"].predict(np.empty(0)))
-    rob = robust_pass(cands, Y, g0)
-    rows = np.setdiff1d(np.arange(n), rob.outliers)
-    noise, noise_tables = _noise_model(rob, cands, Y, rows)
+    rob, rows, noise, noise_tables = screen(cands, Y)
     t_robust = time.perf_counter() - t0
 
     # 4. Gaussian fits on the kept rows, held-out check, the primary cause
