@@ -214,12 +214,12 @@ def lack_of_fit(
             checked.append("no replicated test points: the pure-error test was not possible")
         message = "no structure left beyond the noise: " + "; ".join(checked)
     return {
-        "observations_tested": int(np.count_nonzero(used)),
         "detected": bool(detected),
         "p_value": float(adjusted[strongest]),
         "test": TITLES[strongest],
         "message": message,
         "level": LOF_LEVEL,
         "correction": f"Holm over {len(tests)} tests",
+        "observations_tested": int(np.count_nonzero(used)),
         "tests": tests,
     }
