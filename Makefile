@@ -1,46 +1,80 @@
 # fepost: `make demo` runs the main job on the sample meshes, `make test` runs the tests.
-# Both create their own virtual environment (.venv) and install what they need.
+# Both create their own virtual environment (.venv) and install what they need, saying
+# what they do: the demo only the package and the GL libraries VTK renders with; the
+# tests also the test, model and docs extras, CalculiX and Chromium.
 
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
-STAMP  := $(VENV)/.installed
-APT_PACKAGES := calculix-ccx chromium libgl1 libegl1 libosmesa6 libxrender1
+PIP    := $(PY) -m pip --disable-pip-version-check
 OUT    ?= report
+# One stamp per set of extras: `make demo` then `make test` in one clone installs the
+# extras the tests need on top of the demo's install.
+DEMO_STAMP := $(VENV)/.installed-demo
+TEST_STAMP := $(VENV)/.installed-test
+# Debian packages. GL: the libraries VTK's off-screen rendering loads (Figures 1-2).
+GL_PACKAGES   := libgl1 libegl1 libosmesa6 libxrender1
+# Tests only: CalculiX (the sample model's end-to-end test), Chromium (report screenshot).
+TEST_PACKAGES := calculix-ccx chromium $(GL_PACKAGES)
 
-.PHONY: demo test venv system-deps lint bench clean
+.PHONY: demo test docs venv system-deps-demo system-deps-test lint bench clean
 
-$(STAMP): pyproject.toml
+$(PY):
+	@echo "== creating the virtual environment $(VENV) with $(PYTHON)"
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test,model]'
-	touch $(STAMP)
+	$(PIP) install --upgrade pip
 
-venv: $(STAMP)
+$(DEMO_STAMP): pyproject.toml | $(PY)
+	@echo "== installing fepost and its run-time dependencies from PyPI (a few minutes the first time)"
+	$(PIP) install --progress-bar on -e .
+	@touch $@
 
-# System packages: CalculiX (sample model and its end-to-end test), Chromium (report
-# screenshot test) and the GL libraries VTK's off-screen rendering loads.
-system-deps:
-	@missing=""; for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
-	if [ -n "$$missing" ]; then \
-	  echo "installing system packages:$$missing"; \
-	  if [ "$$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi; \
-	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing >/dev/null; \
-	fi
+$(TEST_STAMP): pyproject.toml | $(PY)
+	@echo "== installing fepost with the test, model and docs extras from PyPI"
+	$(PIP) install --progress-bar on -e '.[test,model,docs]'
+	@touch $@
 
-demo: $(STAMP) system-deps
+venv: $(TEST_STAMP)
+
+# Installs the Debian packages of $(1) that are missing (as root, or through sudo).
+define apt_install
+	@if ! command -v dpkg >/dev/null 2>&1; then \
+	  echo "== not a Debian system: install $(1) (or your system's equivalents) yourself"; exit 0; \
+	fi; \
+	missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -z "$$missing" ]; then echo "== system packages present: $(1)"; exit 0; fi; \
+	echo "== installing system packages:$$missing"; \
+	if [ "$$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi; \
+	$$SUDO apt-get update -q && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -q --no-install-recommends $$missing
+endef
+
+system-deps-demo:
+	$(call apt_install,$(GL_PACKAGES))
+
+system-deps-test:
+	$(call apt_install,$(TEST_PACKAGES))
+
+demo: $(DEMO_STAMP) system-deps-demo
+	@echo "== fepost report on the sample meshes -> $(OUT)/"
 	$(VENV)/bin/fepost report --out $(OUT) --force
-	@echo "open $(OUT)/report.html"
+	@echo "== open $(OUT)/report.html"
 
-test: $(STAMP) system-deps
-	$(PY) -m pytest; rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; rc=0; fi; exit $$rc
+# FEPOST_REQUIRE_DOCS: tests/test_docs.py fails (instead of skipping) without the docs
+# tooling, so the strict docs build always runs here.
+test: $(TEST_STAMP) system-deps-test
+	@echo "== running the test suite (includes the strict docs build)"
+	FEPOST_REQUIRE_DOCS=1 $(PY) -m pytest; rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; rc=0; fi; exit $$rc
 
-lint: $(STAMP)
-	$(VENV)/bin/ruff check fepost tests scripts benchmarks
+# The documentation site (MkDocs, warnings are errors) -> site/
+docs: $(TEST_STAMP)
+	$(VENV)/bin/mkdocs build --strict --site-dir site
+
+lint: $(TEST_STAMP)
+	$(VENV)/bin/ruff check fepost tests scripts benchmarks docs
 	$(VENV)/bin/mypy fepost
 
-bench: $(STAMP)
+bench: $(TEST_STAMP)
 	for b in benchmarks/bench_*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(OUT) site .pytest_cache

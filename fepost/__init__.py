@@ -7,9 +7,33 @@ Python API (the CLI is a thin shell over it):
 * :func:`fepost.resample.resample` – FE interpolation onto a :class:`~fepost.polar.PolarGrid`
 * :func:`fepost.moments.moments`, :func:`fepost.coefficients.coefficients_from_moments`
 * :func:`fepost.analysis.analyse` – all of the above in one call
+
+``import fepost`` is light: ``fepost.analyse`` and ``fepost.Analysis`` import the
+pipeline (numpy, scipy, VTK) on first use, so the command line starts quickly.
 """
 
-from .analysis import Analysis, analyse
+from __future__ import annotations
+
+from importlib import import_module
+from typing import TYPE_CHECKING
 
 __all__ = ["Analysis", "analyse", "__version__"]
 __version__ = "0.1.0"
+
+#: Names re-exported from submodules, imported on first access.
+_LAZY = {"Analysis": "analysis", "analyse": "analysis"}
+
+if TYPE_CHECKING:
+    from .analysis import Analysis, analyse
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

@@ -65,3 +65,7 @@ class PatchWarning(FepostWarning):
 
 class FitWarning(FepostWarning):
     """A fit converged but its uncertainty is poorly determined."""
+
+
+class OptionWarning(FepostWarning):
+    """A command-line option is valid but implausible (e.g. ``--friction 3``)."""

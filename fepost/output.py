@@ -1,25 +1,48 @@
-"""Atomic output: files and folders appear whole or not at all."""
+"""Atomic output: files and folders appear whole or not at all.
+
+A file is written to a hidden temporary file beside it and renamed over the
+target (:func:`write_text_atomic`); a folder is built in a hidden temporary folder
+beside it and swapped into place when complete (:func:`staged_folder`). On any
+error, Ctrl-C or SIGTERM (which the CLI turns into an exception) the temporary
+is removed and the target is left as it was. Files and folders are created
+with the usual modes masked by the umask (``0o666`` and ``0o777``), like any
+other program's output, not the private modes of :mod:`tempfile`.
+
+Temporary names carry the writer's host and process id,
+``.<name>.fepost-<host>-<pid>-<token>.tmp`` (``.old`` for a folder being
+replaced), so a run killed outright (SIGKILL, power loss) leaves litter that the
+next write into the same folder recognises and removes
+(:func:`remove_stale_temporaries`): only entries of this naming pattern, from
+this host, whose process is gone or started after the entry was last touched
+(its pid was reused).
+
+:func:`check_replaceable` refuses to replace a folder that holds the run's own
+inputs, the current folder, the home folder or the file-system root.
+"""
 
 from __future__ import annotations
 
+import hashlib
 import json
+import math
 import os
+import re
+import secrets
 import shutil
-import tempfile
-from collections.abc import Iterator
+import signal
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-import numpy as np
-
 from .errors import OutputError
+
+_HOST = hashlib.blake2s(os.uname().nodename.encode(), digest_size=3).hexdigest()
+_TEMP = re.compile(r"^\..+\.fepost-(?P<host>[0-9a-f]{6})-(?P<pid>\d+)-[0-9a-f]{8}\.(tmp|old)$")
+#: Slack (s) when comparing a process's start time with a file's mtime (clock ticks, rounding).
+_CLOCK_SLACK = 2.0
 
 
 def _default(o):
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, np.generic):
-        return o.item()
     if isinstance(o, Path):
         return str(o)
     raise TypeError(f"not JSON serialisable: {type(o).__name__}")
@@ -35,58 +58,201 @@ def _clean(o):
         return {str(k): _clean(v) for k, v in o.items()}
     if isinstance(o, list | tuple):
         return [_clean(v) for v in o]
-    if isinstance(o, np.ndarray):
-        return _clean(o.tolist())
-    if isinstance(o, float | np.floating):
-        return float(o) if np.isfinite(o) else None
-    if isinstance(o, np.integer):
-        return int(o)
-    if isinstance(o, np.bool_):
-        return bool(o)
+    if type(o).__module__ == "numpy" and hasattr(o, "tolist"):
+        return _clean(o.tolist())  # arrays and numpy scalars, without importing numpy here
+    if isinstance(o, float):
+        return float(o) if math.isfinite(o) else None
     return o
 
 
+def _temporary_name(name: str, kind: str = "tmp") -> str:
+    return f".{name}.fepost-{_HOST}-{os.getpid()}-{secrets.token_hex(4)}.{kind}"
+
+
+def _start_time(pid: int) -> float | None:
+    """Start of process ``pid`` in seconds since the epoch (Linux /proc), None if unknown."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+        ticks = int(stat.rsplit(")", 1)[1].split()[19])
+        boot = next(
+            float(line.split()[1]) for line in Path("/proc/stat").read_text().splitlines()
+            if line.startswith("btime ")
+        )  # fmt: skip
+        return boot + ticks / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError, StopIteration):
+        return None
+
+
+def _is_stale(entry: Path, pid: int) -> bool:
+    if pid != os.getpid():
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        except PermissionError:
+            pass  # alive, another user's
+        except OSError:
+            return False
+    started = _start_time(pid)
+    if started is None:
+        return False
+    try:
+        touched = entry.lstat().st_mtime
+    except OSError:
+        return False
+    return started > touched + _CLOCK_SLACK
+
+
+def remove_stale_temporaries(folder: str | Path) -> list[Path]:
+    """Remove fepost temporaries in ``folder`` left by runs that no longer exist.
+
+    Only names of this module's pattern written from this host are considered;
+    an entry is stale when its process is gone, or when the process now holding
+    that pid started after the entry was last modified. Returns what was removed.
+    """
+    removed: list[Path] = []
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return removed
+    for name in names:
+        m = _TEMP.match(name)
+        if not m or m["host"] != _HOST:
+            continue
+        entry = Path(folder) / name
+        if not _is_stale(entry, int(m["pid"])):
+            continue
+        try:
+            if entry.is_dir() and not entry.is_symlink():
+                shutil.rmtree(entry)
+            else:
+                entry.unlink()
+        except OSError:
+            continue
+        removed.append(entry)
+    return removed
+
+
+def _folder_of(path: Path) -> Path:
+    return path.parent if str(path.parent) else Path(".")
+
+
 def write_text_atomic(path: str | Path, text: str) -> Path:
-    """Write ``text`` to ``path`` via a temporary file in the same folder, then rename."""
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same folder, then rename."""
+    given = Path(path)
+    path = Path(os.path.realpath(given)) if given.is_symlink() else given  # keep the link
+    folder = _folder_of(path)
+    if path.is_dir():
+        raise OutputError(f"{given}: is a folder, not a file")
+    if path.exists() and not path.is_file():  # /dev/stdout, a FIFO: write through, never replace
+        return _write_through(given, text)
     if not folder.is_dir():
-        raise OutputError(f"{path}: folder {folder} does not exist")
+        raise OutputError(f"{given}: folder {folder} does not exist")
+    remove_stale_temporaries(folder)
+    tmp = folder / _temporary_name(path.name)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
     except OSError as exc:
-        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        raise OutputError(f"{given}: cannot write ({exc.strerror or exc})") from None
     try:
-        with os.fdopen(fd, "w") as fh:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
         os.replace(tmp, path)
     except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
+        raise OutputError(f"{given}: cannot write ({exc.strerror or exc})") from None
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return given
+
+
+def _write_through(path: Path, text: str) -> Path:
+    try:
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(text)
+    except OSError as exc:
         raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
     return path
 
 
 def write_json_atomic(path: str | Path, data) -> Path:
+    """:func:`to_json` of ``data`` written with :func:`write_text_atomic`."""
     return write_text_atomic(path, to_json(data) + "\n")
 
 
+def _contains(folder: Path, other: Path) -> bool:
+    return folder == other or folder in other.parents
+
+
+def check_replaceable(out: str | Path, inputs: Iterable[str | Path | None] = ()) -> None:
+    """Refuse writing ``out`` when that would delete an input or a folder one works in.
+
+    ``out`` (a file or a folder) must not be, or contain, any of ``inputs``, the
+    current folder, the home folder or the file-system root. Raises
+    :class:`~fepost.errors.OutputError` with one line naming what it holds.
+    """
+    try:
+        target = Path(out).resolve()
+    except OSError as exc:  # a name too long, a symlink loop
+        raise OutputError(f"{out}: cannot write here ({exc.strerror or exc})") from None
+    guarded = [(Path(p).resolve(), f"the input {p}") for p in inputs if p is not None]
+    guarded.append((Path.cwd().resolve(), "the current folder"))
+    try:
+        guarded.append((Path.home().resolve(), "the home folder"))
+    except (RuntimeError, KeyError):  # no HOME and no password entry
+        pass
+    kind = "overwrite this file" if os.path.isfile(target) else "replace this folder"
+    for path, what in guarded:
+        if _contains(target, path):
+            rel = "is" if target == path else "contains"
+            raise OutputError(f"{out}: refusing to {kind}: it {rel} {what}")
+    if target == Path(target.anchor):
+        raise OutputError(f"{out}: refusing to replace the file-system root")
+
+
 @contextmanager
-def staged_folder(out: str | Path, force: bool = False) -> Iterator[Path]:
+def _signals_deferred() -> Iterator[None]:
+    """Hold SIGINT/SIGTERM/SIGHUP while a few renames run, so they complete together."""
+    try:
+        block = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, block)
+    except (AttributeError, OSError, ValueError):
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+@contextmanager
+def staged_folder(
+    out: str | Path, force: bool = False, protect: Iterable[str | Path | None] = ()
+) -> Iterator[Path]:
     """Yield a temporary folder beside ``out``; on success it replaces ``out``.
 
-    An existing non-empty ``out`` is refused unless ``force``. On any error the
-    temporary folder is removed and ``out`` is left as it was.
+    An existing non-empty ``out`` is refused unless ``force``; an existing
+    ``out`` that holds any of ``protect`` (the run's inputs), the current or the
+    home folder is always refused (:func:`check_replaceable`). On any error or
+    interruption the temporary folder is removed and ``out`` is left as it was.
     """
-    out = Path(out)
+    out = Path(os.path.realpath(out)) if Path(out).is_symlink() else Path(out)
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and not force:
-        raise OutputError(f"{out}: folder exists and is not empty (use --force to replace it)")
-    parent = out.parent if str(out.parent) else Path(".")
+    if out.is_dir():
+        check_replaceable(out, protect)
+        if not force and any(out.iterdir()):
+            raise OutputError(f"{out}: folder exists and is not empty (use --force to replace it)")
+    parent = _folder_of(out)
     if not parent.is_dir():
         raise OutputError(f"{out}: parent folder {parent} does not exist")
+    remove_stale_temporaries(parent)
+    tmp = parent / _temporary_name(out.name)
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent))
+        os.mkdir(tmp, 0o777)
     except OSError as exc:
         raise OutputError(f"{out}: cannot write in {parent} ({exc.strerror or exc})") from None
     try:
@@ -94,14 +260,19 @@ def staged_folder(out: str | Path, force: bool = False) -> Iterator[Path]:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    try:
-        if out.is_dir():
-            old = parent / f".{out.name}.old-{os.getpid()}"
-            os.replace(out, old)
-            os.replace(tmp, out)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, out)
-    except OSError as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise OutputError(f"{out}: cannot move results into place ({exc.strerror or exc})") from None
+    old = parent / _temporary_name(out.name, "old")
+    with _signals_deferred():
+        try:
+            if out.is_dir():
+                os.replace(out, old)
+                try:
+                    os.replace(tmp, out)
+                except OSError:
+                    os.replace(old, out)
+                    raise
+            else:
+                os.replace(tmp, out)
+        except OSError as exc:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise OutputError(f"{out}: cannot move results into place ({exc.strerror or exc})") from None
+        shutil.rmtree(old, ignore_errors=True)

@@ -1,10 +1,11 @@
 """Verification meshes: analytic pressure maps written as unstructured FE exports.
 
 Used by the tests and benchmarks to check the pipeline against closed forms
-(THEORY.md §5) on meshes a solver could have written: triangles or quads, nodal
-or face data, any plane orientation, any offset, VTU / legacy VTK / VTP /
-Exodus II (VTK formats written by meshio/pyvista; Exodus by pyexodus, since
-meshio's Exodus writer produces files VTK's reader cannot read).
+(the reference values on the theory page, docs/theory.md) on meshes a solver
+could have written: triangles or quads, nodal or face data, any plane
+orientation, any offset, VTU / legacy VTK / VTP / Exodus II (VTK formats
+written by meshio/pyvista; Exodus by pyexodus, since meshio's Exodus writer
+produces files VTK's reader cannot read).
 """
 
 from __future__ import annotations

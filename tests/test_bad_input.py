@@ -158,7 +158,8 @@ def test_two_patches(capsys, tmp_path):
 
 def test_bad_friction_argument(capsys, tmp_path):
     p = disc(tmp_path / "m.vtu")
-    run_bad(capsys, tmp_path, [p, "--friction", "-1"], r"friction must be a positive number, got -1")
+    message = r"argument --friction: must be a positive number, got '-1'"
+    run_bad(capsys, tmp_path, [p, "--friction", "-1"], message)
 
 
 def test_bad_step_for_vtu(capsys, tmp_path):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import base64
 import csv
 import json
 import re
@@ -11,14 +12,26 @@ import sys
 from html.parser import HTMLParser
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from fepost.cli import main
+from fepost.report.samples import SAMPLE_ROLLING, SAMPLE_STATIC, meshes_folder
 from fepost.synthetic import write_map
 from fepost.table1 import DEFAULT_SEED
 
 REPO = Path(__file__).resolve().parents[1]
-SAMPLES = (REPO / "meshes" / "static.vtu", REPO / "meshes" / "rolling.vtu")
+
+
+def sample_paths():
+    """The report's default inputs (named in one place: fepost.report.samples)."""
+    return (
+        meshes_folder() / SAMPLE_STATIC,
+        None if SAMPLE_ROLLING is None else meshes_folder() / SAMPLE_ROLLING,
+    )
+
+
+SAMPLES = tuple(p for p in sample_paths() if p is not None)
 PROMISED = (
     "report.html",
     "coefficients.json",
@@ -35,25 +48,47 @@ PROMISED = (
         for stem in ("fig3_sections", "fig4_f_parallel", "fig5_torque", "fig6_f_perp")
         for ext in ("png", "svg", "pdf")
     ),
+    *(f"{m}_{part}" for m in ("static", "rolling") for part in ("map.vtu", "patch.vtp", "outline.vtp")),
 )
+NNBSP = "\u202f"
 TABLE1_NAMES = ["f", "F0", "M0", "a", "m", "k_x"]
 
 
 class _Page(HTMLParser):
-    """Links and the numbers tagged with data-key / data-value."""
+    """Links, images (src, alt) and the numbers tagged with data-key / data-value."""
 
     def __init__(self):
         super().__init__()
         self.refs: list[str] = []
+        self.images: list[tuple[str, str]] = []
         self.values: dict[str, float] = {}
+        self.text: list[str] = []
+        self._skip = 0
 
     def handle_starttag(self, tag, attrs):
         a = dict(attrs)
-        for key in ("src", "href"):
-            if a.get(key):
-                self.refs.append(a[key])
+        if tag in ("style", "script"):
+            self._skip += 1
+        if tag == "img":
+            self.images.append((a.get("src", ""), a.get("alt", "")))
+        elif a.get("href"):
+            self.refs.append(a["href"])
         if "data-key" in a:
             self.values[a["data-key"]] = float(a["data-value"])
+
+    def handle_endtag(self, tag):
+        if tag in ("style", "script"):
+            self._skip -= 1
+
+    def handle_data(self, data):
+        if not self._skip:
+            self.text.append(data)
+
+
+def _page(out: Path) -> _Page:
+    page = _Page()
+    page.feed((out / "report.html").read_text(encoding="utf-8"))
+    return page
 
 
 def _lookup(data, dotted: str):
@@ -109,8 +144,7 @@ def test_report_progress_lines(report):
 @pytest.mark.slow
 def test_report_html_references_only_existing_files(report):
     _, out, _, _ = report
-    page = _Page()
-    page.feed((out / "report.html").read_text(encoding="utf-8"))
+    page = _page(out)
     assert page.refs
     for ref in page.refs:
         assert not re.match(r"^[a-z]+:", ref), f"external reference {ref}"
@@ -118,10 +152,84 @@ def test_report_html_references_only_existing_files(report):
 
 
 @pytest.mark.slow
+def test_report_html_is_self_contained(report):
+    """Every image is embedded (a data: URI holding exactly the PNG written beside the
+    page), so report.html shows everything on its own; alt texts are plain text."""
+    _, out, _, _ = report
+    page = _page(out)
+    pngs = sorted(p.name for p in out.glob("*.png"))
+    assert len(page.images) == len(pngs) == 7
+    embedded = {}
+    for src, alt in page.images:
+        assert src.startswith("data:image/png;base64,"), src[:40]
+        embedded[base64.b64decode(src.split(",", 1)[1])] = alt
+        assert alt and "<" not in alt and "&" not in alt and "$" not in alt, alt
+    assert set(embedded) == {(out / name).read_bytes() for name in pngs}
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "<link" not in html and "<script" not in html
+
+
+@pytest.mark.slow
+def test_report_units_one_style(report):
+    """SI units with N·m (never "N m"), lengths in m (no mm), a narrow no-break space
+    between every number and its unit, and the R line reads R = r_max = <value> m."""
+    _, out, _, _ = report
+    page = _page(out)
+    text = "".join(page.text)
+    assert "N m" not in text and "Nm" not in text
+    assert not re.search(r"\dmm|\d mm|\(mm\)", text)
+    loose = re.findall(r"\d (?:N·m|kPa|MPa|Pa|m²|m|N|s)(?![\w²])", text)
+    assert not loose, loose[:5]
+    coef = json.loads((out / "coefficients.json").read_text())
+    r_line = re.search(r"R used\s*R = r_max = ([0-9.]+)" + NNBSP + r"m: smallest circle", text)
+    assert r_line and float(r_line.group(1)) == pytest.approx(coef["R"], rel=1e-3)
+    assert "THEORY.md" not in text and "INTERFACE.md" not in text and "shared/" not in text
+
+
+@pytest.mark.slow
+def test_report_vtk_files(report):
+    """The VTK files hold the polar maps and the patches: read back with pyvista and,
+    independently, meshio, they integrate to N and draw R, r_equiv and the ellipse."""
+    import meshio
+    import pyvista as pv
+
+    _, out, _, _ = report
+    coef = json.loads((out / "coefficients.json").read_text())
+    grid = pv.read(out / "static_map.vtu")
+    n = float(np.sum(grid.point_data["sigma"] * grid.point_data["dA"]))
+    assert n == pytest.approx(coef["N"], rel=1e-12)
+    m = meshio.read(out / "static_map.vtu")
+    assert float(np.sum(m.point_data["sigma"] * m.point_data["dA"])) == pytest.approx(coef["N"], rel=1e-12)
+    assert float(grid.field_data["R"][0]) == coef["R"]
+    np.testing.assert_allclose(grid.field_data["frame_origin"], coef["patch"]["centre"], rtol=1e-12)
+    rolling = pv.read(out / "rolling_map.vtu")
+    n_roll = float(np.sum(rolling.point_data["sigma"] * rolling.point_data["dA"]))
+    assert n_roll == pytest.approx(coef["N_rolling"], rel=1e-12)
+    lines = pv.read(out / "static_outline.vtp")
+    names = list(lines.field_data["part_names"])
+    part = np.asarray(lines.cell_data["part"])
+
+    def radii(name, centre=(0.0, 0.0)):
+        cells = lines.extract_cells(np.flatnonzero(part == names.index(name)))
+        return np.hypot(cells.points[:, 0] - centre[0], cells.points[:, 1] - centre[1])
+
+    np.testing.assert_allclose(radii("circle_R"), coef["R"], rtol=1e-12)
+    np.testing.assert_allclose(
+        radii("circle_r_equiv", coef["patch"]["ellipse_centre"]), coef["patch"]["r_equiv"]
+    )
+    ell = radii("ellipse", coef["patch"]["ellipse_centre"])
+    assert ell.max() == pytest.approx(coef["patch"]["ellipse_semi_axes"][0], rel=1e-4)
+    assert ell.min() == pytest.approx(coef["patch"]["ellipse_semi_axes"][1], rel=1e-4)
+    assert radii("outline").max() == pytest.approx(coef["R"], rel=1e-12)
+    patch = pv.read(out / "static_patch.vtp")
+    assert patch.n_cells == coef["patch"]["n_faces"]
+    assert float(np.max(patch.point_data["pressure"])) > 0
+
+
+@pytest.mark.slow
 def test_report_numbers_equal_the_json(report):
     _, out, _, _ = report
-    page = _Page()
-    page.feed((out / "report.html").read_text(encoding="utf-8"))
+    page = _page(out)
     sources = {
         name: json.loads((out / f"{name}.json").read_text())
         for name in ("coefficients", "table1", "closed_form_vs_exact")
@@ -314,3 +422,47 @@ def test_report_screenshot(report, tmp_path):
     width = int.from_bytes(head[16:20], "big")
     height = int.from_bytes(head[20:24], "big")
     assert (width, height) == (1280, 4000)
+
+
+@pytest.mark.slow
+def test_report_optional_sections(tmp_path, small_map):
+    """A section provider's section appears (title, text, table, figure embedded, files
+    listed); one that returns None leaves no trace."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from fepost.report import Section, build_report
+    from fepost.report.figures import save_matplotlib
+
+    def extra(data, folder):
+        fig, ax = plt.subplots()
+        ax.plot([0, 1], [0, data.analysis.coefficients.N])
+        f = save_matplotlib(fig, folder, "extra_fig", "extra-fig", "An extra figure")
+        (folder / "extra.csv").write_text("a,b\n1,2\n")
+        return Section(
+            key="extra-section",
+            title="Extra section <demo>",
+            paragraphs=("N is shown & checked.",),
+            table=(("name", "value"), ("N", data.analysis.coefficients.N)),
+            figures=(f,),
+            captions={"extra-fig": "The extra caption."},
+            files=("extra.csv",),
+        )
+
+    def nothing(data, folder):
+        return None
+
+    out = tmp_path / "rep"
+    res = build_report(small_map, out=out, seed=1, sections=(nothing, extra))
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert html.count("<h2") == 9  # the 8 core sections and the extra one
+    assert '<h2 id="extra-section">Extra section &lt;demo&gt;</h2>' in html
+    assert "<p>N is shown &amp; checked.</p>" in html and "The extra caption." in html
+    page = _page(out)
+    assert ("An extra figure" in [alt for _, alt in page.images]) and "extra.csv" in page.refs
+    assert {"extra_fig.png", "extra_fig.svg", "extra.csv"} <= set(res.files)
+    base = build_report(small_map, out=tmp_path / "plain", seed=1, sections=(nothing,))
+    plain = (tmp_path / "plain" / "report.html").read_text(encoding="utf-8")
+    assert plain.count("<h2") == 8 and "extra" not in plain and "extra.csv" not in base.files

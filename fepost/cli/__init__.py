@@ -1,63 +1,301 @@
 """Command-line interface: a thin shell over the Python API.
 
-Each subcommand lives in its own module exposing ``add_parser(subparsers)``
-and ``run(args) -> int``. Errors derived from :class:`fepost.errors.FepostError`
-become a one-line message on stderr and exit status 2 (a traceback only with
-``--debug``).
+Each subcommand is a module of this package named in :data:`COMMANDS`, exposing
+``add_parser(subparsers)`` and ``run(args) -> int``. A subcommand module is light
+at import (argparse, this package's helpers, :mod:`fepost.errors`): the whole
+parser is built from them on every run, so ``fepost --help`` and usage errors
+never import numpy, scipy, VTK or matplotlib; ``run`` imports what it needs.
+Option types and ranges are in :mod:`fepost.cli._validate`.
+
+:func:`main` is the edge where exceptions become exit statuses
+(:data:`EXIT_STATUSES`, also in ``docs/cli-exit-codes.md``): every failure is
+one line on stderr, a traceback only with ``--debug``; fepost's warnings are
+printed as one line each, other libraries' warnings (numpy's RuntimeWarnings
+among them) are not shown to users (``--debug`` shows them; the test suite
+turns them into errors, so each one is a defect to fix where it arises).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
+import threading
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from importlib import import_module
 
+from .. import __version__
 from ..errors import FepostError, FepostWarning
 
-_COMMANDS = ("coefficients", "table1", "report", "diagnose")
+#: The subcommands, in the order ``fepost --help`` lists them; each is the module
+#: ``fepost.cli.<name>``. Registering a new command is one line here.
+COMMANDS = [
+    "coefficients",
+    "table1",
+    "report",
+    "diagnose",
+]
+
+#: Exit statuses of ``fepost`` (the ``--help`` epilog and docs/cli-exit-codes.md).
+EXIT_STATUSES = {
+    0: "success",
+    1: "finished, but some inputs failed (a table or report marks them)",
+    2: "bad input or usage: a file or option refused, named in one line",
+    3: "internal error: a bug in fepost or a library, or out of memory (--debug shows it)",
+    130: "interrupted (Ctrl-C); nothing half-written is left",
+    141: "the output pipe was closed (e.g. '| head'); stopped quietly",
+    143: "terminated (SIGTERM; 129 for SIGHUP); nothing half-written is left",
+}
+OK, FAILED_INPUTS, BAD_INPUT, INTERNAL = 0, 1, 2, 3
+INTERRUPTED, BROKEN_PIPE = 130, 141
+
+
+class UsageError(Exception):
+    """A command line the parser refuses (printed as one line, exit status 2)."""
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP arrived: unwinds like Ctrl-C so temporary outputs are removed."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+class _Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line (no usage block) and do not exit."""
+
+    def error(self, message: str):  # type: ignore[override]
+        raise UsageError(f"{message} (see '{self.prog} --help')")
+
+    def _print_message(self, message: str, file=None) -> None:
+        # argparse swallows OSError here; a closed pipe must reach main() (exit status 141)
+        if message:
+            (file or sys.stderr).write(message)
+
+
+def _epilog() -> str:
+    lines = ["exit status:"]
+    lines += [f"  {code:>3}  {text}" for code, text in EXIT_STATUSES.items()]
+    lines.append("Details: docs/cli-exit-codes.md.")
+    return "\n".join(lines)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from importlib import import_module
-
-    parser = argparse.ArgumentParser(
+    """The ``fepost`` parser with every subcommand in :data:`COMMANDS` (light imports only)."""
+    parser = _Parser(
         prog="fepost",
         description="FE tire-road contact results -> coupled dry-friction model coefficients.",
+        epilog=_epilog(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    parser.add_argument("--version", action="version", version=f"fepost {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks and library warnings")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in _COMMANDS:
+    for name in COMMANDS:
         import_module(f"{__name__}.{name}").add_parser(sub)
     return parser
 
 
-def _show_warning(message, category, filename, lineno, file=None, line=None):
-    name = category.__name__
-    print(f"fepost: warning ({name}): {message}", file=sys.stderr)
+#: Longest message printed; longer ones (a 200 kB CSV cell quoted back) lose their middle.
+MESSAGE_MAX = 1000
+
+
+def _one_line(text: object) -> str:
+    line = " ".join(str(text).split())
+    if len(line) > MESSAGE_MAX:
+        cut = len(line) - MESSAGE_MAX + 40
+        half = (MESSAGE_MAX - 40) // 2
+        line = f"{line[:half]} ...[{cut} characters]... {line[-half:]}"
+    return line
+
+
+class _Run:
+    """State of one run: ``--debug``, and the signal that stopped it, if any.
+
+    The signal is recorded before its exception is raised because a library may
+    turn that exception into another one on its way up (an interrupted import
+    inside VTK surfaces as ImportError and then as "cannot read the file"); the
+    recorded signal decides the exit status.
+    """
+
+    def __init__(self) -> None:
+        self.debug = False
+        self.signum: int | None = None
+
+    def show_warning(self, message, category, filename, lineno, file=None, line=None) -> None:
+        """``warnings.showwarning``: fepost's warnings as one line, others only with --debug."""
+        if issubclass(category, FepostWarning):
+            print(f"fepost: warning ({category.__name__}): {_one_line(message)}", file=sys.stderr)
+        elif self.debug:
+            where = f"{os.path.basename(filename)}:{lineno}"
+            print(f"fepost: debug: {category.__name__} at {where}: {_one_line(message)}", file=sys.stderr)
+
+    def on_signal(self, signum, frame) -> None:
+        """SIGINT/SIGTERM/SIGHUP: record it and raise, unless an import is running.
+
+        An exception raised while VTK's extension modules initialise crashes the
+        process (SIGSEGV, seen in testing); inside an import the raise waits for
+        a SIGALRM 50 ms later that checks again (:meth:`on_alarm`).
+        """
+        self.signum = self.signum or signum
+        self.on_alarm(signal.SIGALRM, frame)
+
+    def on_alarm(self, signum, frame) -> None:
+        if self.signum is None:
+            return
+        if _importing(frame):
+            signal.setitimer(signal.ITIMER_REAL, _RECHECK)
+            return
+        if self.signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise Terminated(self.signum)
+
+    def stopped(self) -> int:
+        """Report the recorded signal; the exit status 128 + signal number (130 for Ctrl-C)."""
+        assert self.signum is not None
+        if self.signum == signal.SIGINT:
+            _say("fepost: interrupted")
+        else:
+            _say(f"fepost: terminated by {signal.Signals(self.signum).name}")
+        return 128 + self.signum
+
+
+#: Delay (s) before a signal that arrived during an import is checked again.
+_RECHECK = 0.05
+
+
+def _importing(frame) -> bool:
+    """Whether ``frame`` (a signal handler's) runs inside an import."""
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib._bootstrap"):
+            return True
+        frame = frame.f_back
+    return False
+
+
+@contextmanager
+def _signals_unwind(run: _Run) -> Iterator[None]:
+    """SIGINT, SIGTERM and SIGHUP raise (recorded in ``run``) while the command runs.
+
+    Only in the main thread, and only for signals not set to be ignored (``nohup``).
+    SIGALRM is used to defer a signal that arrives during an import.
+    """
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        yield
+        return
+    old = {signal.SIGALRM: signal.signal(signal.SIGALRM, run.on_alarm)}
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        if sig is not None and signal.getsignal(sig) is not signal.SIG_IGN:
+            old[sig] = signal.signal(sig, run.on_signal)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush cannot fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+def _say(line: str) -> None:
+    try:
+        print(line, file=sys.stderr)
+    except (OSError, ValueError):
+        pass
+
+
+def _error(message: object) -> None:
+    _say(f"fepost: error: {_one_line(message)}")
+
+
+def _internal(exc: BaseException) -> int:
+    _error(f"internal error: {type(exc).__name__}: {exc} (rerun with --debug and report it)")
+    return INTERNAL
+
+
+def _run(argv: list[str], run: _Run) -> int:
+    from ._validate import check_grid, check_outputs, check_strings, resolve_defaults
+
+    run.debug = "--debug" in argv[: next((i for i, a in enumerate(argv) if a in COMMANDS), len(argv))]
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        resolve_defaults(args)
+        check_strings(parser, args)
+        check_grid(args)
+        check_outputs(args)
+        status = int(args.func(args) or 0)
+        sys.stdout.flush()
+        return status
+    except SystemExit as exc:  # --help, --version
+        sys.stdout.flush()
+        return exc.code if isinstance(exc.code, int) else (OK if exc.code is None else BAD_INPUT)
+    except UsageError as exc:
+        _error(exc)
+        return BAD_INPUT
+    except (KeyboardInterrupt, Terminated, BrokenPipeError):
+        raise
+    except Exception as exc:
+        if run.signum is not None:  # a signal's exception, changed on its way up
+            return run.stopped()
+        if run.debug:
+            raise
+        if isinstance(exc, FepostError):
+            _error(exc)
+            return BAD_INPUT
+        if isinstance(exc, OSError) and exc.filename is not None:  # names the file
+            _error(f"{exc.filename}: {exc.strerror or exc}")
+            return BAD_INPUT
+        if isinstance(exc, MemoryError):
+            _error("out of memory (a smaller grid, --nr/--nphi, or a smaller model may fit)")
+            return INTERNAL
+        return _internal(exc)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit status."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    old = warnings.showwarning
-    warnings.showwarning = _show_warning
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("always", FepostWarning)
-            return int(args.func(args) or 0)
-    except FepostError as exc:
-        if args.debug:
-            raise
-        print(f"fepost: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("fepost: interrupted", file=sys.stderr)
-        return 130
-    finally:
-        warnings.showwarning = old
+    """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit status.
+
+    Never raises (except with ``--debug``) and never exits: the status follows
+    :data:`EXIT_STATUSES`.
+    """
+    argv = list(sys.argv[1:] if argv is None else argv)
+    run = _Run()
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", FepostWarning)
+        warnings.showwarning = run.show_warning
+        try:
+            with _signals_unwind(run):
+                return _run(argv, run)
+        except KeyboardInterrupt:
+            run.signum = run.signum or signal.SIGINT
+            return run.stopped()
+        except Terminated as exc:
+            run.signum = exc.signum
+            return run.stopped()
+        except BrokenPipeError:
+            _silence_stdout()
+            return BROKEN_PIPE
 
 
 def console_main() -> None:
-    sys.exit(main())
+    """Entry point of the ``fepost`` script."""
+    status = main()
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+        status = status or BROKEN_PIPE
+    sys.exit(status)

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..errors import ArgumentError
-from ..polar import DEFAULT_NPHI, DEFAULT_NR, PolarGrid
+from . import _validate as v
 
 
 def repo_meshes() -> Path:
@@ -24,7 +24,7 @@ def sample_mesh(name: str) -> Path:
 
 def add_friction_option(p: argparse.ArgumentParser, what: str = "friction coefficient f") -> None:
     """``--friction F`` (default 0.3), shared by every command that needs f."""
-    p.add_argument("--friction", type=float, default=0.3, metavar="F", help=f"{what} (default 0.3)")
+    p.add_argument("--friction", type=v.friction, default=0.3, metavar="F", help=f"{what} (default 0.3)")
 
 
 def add_input_options(p: argparse.ArgumentParser) -> None:
@@ -39,15 +39,25 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
         help="nodal displacement array added to the coordinates ('auto' default, 'none' to skip)",
     )
     g.add_argument("--rolling-axis", metavar="X,Y,Z", help="global rolling direction (default 1,0,0)")
-    g.add_argument("--threshold", type=float, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
-    g.add_argument("--nr", type=int, default=DEFAULT_NR, help=f"radial grid nodes (default {DEFAULT_NR})")
+    g.add_argument("--threshold", type=v.fraction, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
     g.add_argument(
-        "--nphi", type=int, default=DEFAULT_NPHI, help=f"angular grid nodes (default {DEFAULT_NPHI})"
+        "--nr",
+        type=v.radial_nodes,
+        default=v.LibraryDefault("fepost.polar", "DEFAULT_NR"),
+        help="radial grid nodes (default %(default)s)",
+    )
+    g.add_argument(
+        "--nphi",
+        type=v.angular_nodes,
+        default=v.LibraryDefault("fepost.polar", "DEFAULT_NPHI"),
+        help="angular grid nodes (default %(default)s)",
     )
     g.add_argument("--rule", choices=("gauss", "trapezoid"), default="gauss", help="radial quadrature rule")
 
 
 def analysis_kwargs(args: argparse.Namespace) -> dict:
+    from ..polar import PolarGrid
+
     axis = None
     if args.rolling_axis:
         try:

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-from ..analysis import Analysis, analyse
-from ..output import write_json_atomic
 from ._common import add_friction_option, add_input_options, analysis_kwargs
+
+if TYPE_CHECKING:
+    from ..analysis import Analysis
 
 
 def add_parser(sub) -> None:
@@ -68,6 +70,9 @@ def format_analysis(a: Analysis) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..analysis import analyse
+    from ..output import write_json_atomic
+
     result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
     print(format_analysis(result))
     if args.json:

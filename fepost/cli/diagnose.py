@@ -16,6 +16,7 @@ import argparse
 from pathlib import Path
 
 from ..errors import ArgumentError, OutputError
+from . import _validate as v
 from ._common import add_friction_option, add_input_options, analysis_kwargs
 
 #: Mirrors fepost.diagnose.causes.CAUSES (kept here so that --help imports nothing heavy).
@@ -29,7 +30,6 @@ CAUSE_NAMES = (
     "pressure_shift",
     "sensor_offset",
 )
-FOLDS = 5
 
 
 def add_parser(sub) -> None:
@@ -68,17 +68,17 @@ def add_parser(sub) -> None:
     p.add_argument("--force", action="store_true", help="replace a non-empty output folder")
     p.add_argument(
         "--seed",
-        type=int,
+        type=v.seed,
         default=None,
         metavar="S",
         help="seed of the cross-validation folds (default 0), or of the generator with --make-example",
     )
     p.add_argument(
         "--folds",
-        type=int,
-        default=FOLDS,
+        type=v.integer_in(2),
+        default=v.LibraryDefault("fepost.diagnose.selection", "FOLDS"),
         metavar="K",
-        help=f"cross-validation folds (default {FOLDS})",
+        help="cross-validation folds (default %(default)s)",
     )
     p.add_argument(
         "--make-example",
@@ -99,16 +99,20 @@ def add_parser(sub) -> None:
 
 def _make_example(args: argparse.Namespace) -> int:
     from ..diagnose.example import EXAMPLE_SEED, make_example
+    from ..output import check_replaceable
 
     if args.measured or args.out:
         raise ArgumentError(
             "--make-example writes data and stops: do not combine it with --measured or --out"
         )
     target = Path(args.make_example)
+    check_replaceable(target, [args.simulation, args.rolling])
     if target.is_dir():
         raise OutputError(f"{target}: is a folder; --make-example needs a CSV file name")
     if target.exists() and not args.force:
         raise OutputError(f"{target}: file exists (use --force to replace it)")
+    if not (target.parent if str(target.parent) else Path(".")).is_dir():
+        raise OutputError(f"{target}: folder {target.parent} does not exist")
     seed = EXAMPLE_SEED if args.seed is None else args.seed
     syn = make_example(
         args.simulation,

@@ -1,13 +1,17 @@
-"""``fepost report [STATIC [ROLLING]] --out DIR [--force]``, plus friction, P* and seed options."""
+"""``fepost report [STATIC [ROLLING]] --out DIR [--force]``, plus friction, P* and seed options.
+
+``--force`` replaces a non-empty DIR, but never one that holds the inputs, the
+sample meshes, the current folder, the home folder or the root
+(:func:`fepost.output.check_replaceable`).
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-from ..report import build_report
-from ..table1 import DEFAULT_SEED
-from ._common import add_friction_option, add_input_options, analysis_kwargs, sample_mesh
+from . import _validate as v
+from ._common import add_friction_option, add_input_options, analysis_kwargs
 
 
 def add_parser(sub) -> None:
@@ -15,9 +19,10 @@ def add_parser(sub) -> None:
         "report",
         help="HTML report with Figures 1-6, the coefficients and Table 1",
         description=(
-            "Write DIR/report.html with the figures (PNG, and SVG/PDF for the plots), coefficients.json, "
-            "table1.json and curves.csv. With no inputs, uses the sample meshes meshes/static.vtu and "
-            "meshes/rolling.vtu shipped with fepost."
+            "Write DIR/report.html (self-contained, figures embedded) with the figures beside it (PNG, "
+            "and SVG/PDF for the plots), coefficients.json, table1.json, curves.csv and VTK files of the "
+            "polar maps and patches. With no inputs, uses the sample meshes shipped in meshes/. "
+            "File formats: docs/formats.md."
         ),
     )
     p.add_argument(
@@ -25,7 +30,11 @@ def add_parser(sub) -> None:
     )
     p.add_argument("rolling", metavar="ROLLING", nargs="?", help="rolling contact map at the same deflection")
     p.add_argument("--out", metavar="DIR", required=True, help="output folder (created; must be empty)")
-    p.add_argument("--force", action="store_true", help="replace a non-empty output folder")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace a non-empty output folder (never one holding the inputs or the current folder)",
+    )
     add_friction_option(p)
     p.add_argument(
         "--inflation-pressure",
@@ -35,10 +44,10 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--seed",
-        type=int,
-        default=DEFAULT_SEED,
+        type=v.seed,
+        default=v.LibraryDefault("fepost.table1", "DEFAULT_SEED"),
         metavar="S",
-        help=f"seed of the Table 1 noise (default {DEFAULT_SEED}, as fepost table1)",
+        help="seed of the Table 1 noise (default %(default)s, as fepost table1)",
     )
     add_input_options(p)
     p.set_defaults(func=run)
@@ -49,13 +58,15 @@ def _progress(k: int, n: int, step: str, seconds: float) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    static, rolling = args.static, args.rolling
-    if static is None:
-        static = sample_mesh("static.vtu")
-        rolling = sample_mesh("rolling.vtu")
+    from ..output import check_replaceable
+    from ..report import build_report
+    from ..report.samples import meshes_folder, sample_inputs
+
+    inputs = [args.static, args.rolling] if args.static is not None else [*sample_inputs()]
+    check_replaceable(args.out, [*inputs, meshes_folder()])
     result = build_report(
-        static,
-        rolling,
+        args.static,  # None: the sample meshes (fepost.report.samples)
+        args.rolling,
         args.out,
         force=args.force,
         friction=args.friction,

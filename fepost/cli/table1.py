@@ -11,20 +11,17 @@ from __future__ import annotations
 
 import argparse
 
-from ..analysis import analyse
-from ..identify import DEFAULT_AMPLITUDE, DEFAULT_N_POINTS, DEFAULT_SPAN
-from ..output import write_json_atomic
-from ..table1 import DEFAULT_SEED, format_table, table1
+from . import _validate as v
 from ._common import add_friction_option, add_input_options, analysis_kwargs, sample_mesh
 
-#: The committed seed of ``fepost table1`` (same as :data:`fepost.table1.DEFAULT_SEED`).
-SEED = DEFAULT_SEED
+#: The committed seed of ``fepost table1`` (:data:`fepost.table1.DEFAULT_SEED`).
+SEED = v.LibraryDefault("fepost.table1", "DEFAULT_SEED")
 
 
 def add_parser(sub) -> None:
     p = sub.add_parser(
         "table1",
-        help="the paper's identification experiment (Table 1) on FE maps, with 95 % bounds",
+        help="the paper's identification experiment (Table 1) on FE maps, with 95 %% bounds",
         description=(
             "Make the friction curves of THEORY.md 4 from the coefficients of the FE maps, "
             "add the paper's 20 % noise, fit them back and print theory | fitted | "
@@ -37,7 +34,7 @@ def add_parser(sub) -> None:
         metavar="ROLLING",
         help="rolling contact map (default: meshes/rolling.vtu when --static is not given either)",
     )
-    p.add_argument("--seed", type=int, default=SEED, metavar="S", help=f"noise seed (default {SEED})")
+    p.add_argument("--seed", type=v.seed, default=SEED, metavar="S", help="noise seed (default %(default)s)")
     p.add_argument("--json", metavar="PATH", help="write the table as JSON")
     p.add_argument(
         "--source",
@@ -49,28 +46,28 @@ def add_parser(sub) -> None:
     p.add_argument("--noise", choices=("uniform", "gaussian"), default="uniform", help="noise distribution")
     p.add_argument(
         "--amplitude",
-        type=float,
-        default=DEFAULT_AMPLITUDE,
+        type=v.number_in(0.0, 2.0),
+        default=v.LibraryDefault("fepost.identify", "DEFAULT_AMPLITUDE"),
         metavar="A",
-        help=f"noise amplitude as a fraction of each curve's maximum (default {DEFAULT_AMPLITUDE})",
+        help="noise amplitude as a fraction of each curve's maximum (default %(default)s)",
     )
     p.add_argument(
         "--n-points",
-        type=int,
-        default=DEFAULT_N_POINTS,
+        type=v.integer_in(2, 1_000_000),
+        default=v.LibraryDefault("fepost.identify", "DEFAULT_N_POINTS"),
         metavar="N",
-        help=f"points per curve (default {DEFAULT_N_POINTS})",
+        help="points per curve (default %(default)s)",
     )
     p.add_argument(
         "--span",
-        type=float,
-        default=DEFAULT_SPAN,
+        type=v.span,
+        default=v.LibraryDefault("fepost.identify", "DEFAULT_SPAN"),
         metavar="X",
-        help=f"largest psi and upsilon of the curves (default {DEFAULT_SPAN:g})",
+        help="largest psi and upsilon of the curves (default %(default)s)",
     )
     p.add_argument(
         "--k-x",
-        type=float,
+        type=v.number_in(-10.0, 10.0),
         metavar="K",
         help="assumed k_x when no rolling map is used (default 0.130)",
     )
@@ -79,6 +76,10 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..analysis import analyse
+    from ..output import write_json_atomic
+    from ..table1 import format_table, table1
+
     if args.static is None:
         static = sample_mesh("static.vtu")
         rolling = args.rolling if args.rolling is not None else sample_mesh("rolling.vtu")

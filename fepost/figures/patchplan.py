@@ -1,4 +1,4 @@
-"""The patch in plan: FE faces coloured by pressure, outline circles, fitted ellipse."""
+"""The patch in plan: FE faces coloured by pressure, the contact edge, circles and ellipse."""
 
 from __future__ import annotations
 
@@ -7,33 +7,46 @@ import numpy as np
 from ..errors import ArgumentError
 from ..patch import Patch
 from . import theme
-from .render import circle_points, ellipse_points
+from .outline import circle_points, ellipse_points
+from .render import EDGE_FRACTION, contact_edge
 
 
 def circularity_verdict(patch: Patch) -> str:
-    """One line: circular or not, with the numbers the rule looks at."""
+    """One line of plain text: circular or not, with the numbers the rule looks at."""
     word = "circular" if patch.circular else "NOT circular"
     return f"{word}: aspect {patch.aspect:.3f}, r_max/r_equiv {patch.r_max / patch.r_equiv:.3f}"
 
 
+def verdict_title(patch: Patch) -> str:
+    """The figure's title: :func:`circularity_verdict` with the radii set as subscripts."""
+    word = "circular" if patch.circular else "NOT circular"
+    return (
+        f"Loaded region — {word}: aspect {patch.aspect:.3f}, "
+        rf"$r_{{\max}}/r_{{\mathrm{{equiv}}}}$ {patch.r_max / patch.r_equiv:.3f}"
+    )
+
+
 def plot_patch_plan(patch: Patch, ax=None):
-    """Plot the loaded region in plan (mm, pressure in kPa); return the figure.
+    """Plot the loaded region in plan (m, pressure in kPa); return the figure.
 
     Draws the FE triangles coloured by the FE pressure (Gouraud for nodal data,
-    flat for face data), the r_max circle about the origin, the r_equiv circle
-    (√(area/π)) about the area centroid, the fitted ellipse, the centre of
-    pressure, and the circularity verdict in the title.
+    flat for face data), the contact edge (the contour where the pressure is
+    :data:`~fepost.figures.render.EDGE_FRACTION` of its peak), the r_max circle
+    about the origin, the r_equiv circle (√(area/π)) about the area centroid,
+    the fitted ellipse, the centre of pressure, and the circularity verdict in
+    the title. The legend sits below the axes, clear of the data.
     """
     import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
 
     if not isinstance(patch, Patch):
         raise ArgumentError(f"patch must be a Patch, got {type(patch).__name__}")
     with theme.mpl_style():
         if ax is None:
-            fig, ax = plt.subplots(figsize=(6.4, 5.6), layout="constrained")
+            fig, ax = plt.subplots(figsize=(6.4, 6.0), layout="constrained")
         else:
             fig = ax.figure
-        xy = np.asarray(patch.xy) * 1e3
+        xy = np.asarray(patch.xy)
         kpa = np.asarray(patch.values) / 1e3
         shading = "gouraud" if patch.location == "point" else "flat"
         tpc = ax.tripcolor(
@@ -46,33 +59,39 @@ def plot_patch_plan(patch: Patch, ax=None):
             gid="pressure",
             rasterized=True,
         )
-        ax.triplot(xy[:, 0], xy[:, 1], patch.triangles, color="white", lw=0.15, alpha=0.5, rasterized=True)
-        fig.colorbar(tpc, ax=ax, label="contact pressure (kPa)", shrink=0.85)
-        c = circle_points(patch.r_max * 1e3)
+        fig.colorbar(tpc, ax=ax, label="contact pressure (kPa)", shrink=0.8)
+        edge = contact_edge(patch)
+        ax.add_collection(
+            LineCollection(
+                list(edge),
+                colors=theme.EDGE_COLOUR,
+                linewidths=1.2,
+                label=f"contact edge (p = {EDGE_FRACTION:.0%} of peak)",
+                gid="edge",
+            )
+        )
+        r = patch.r_max
+        c = circle_points(r)
         ax.plot(
             c[:, 0],
             c[:, 1],
             color=theme.RMAX_COLOUR,
             lw=1.5,
-            label=f"r_max = {patch.r_max * 1e3:.1f} mm (R)",
+            label=rf"$r_{{\max}}$ = R = {r:.4g} m",
             gid="r_max",
         )
         ce = patch.ellipse_centre
-        c = circle_points(patch.r_equiv * 1e3, (ce[0] * 1e3, ce[1] * 1e3))
+        c = circle_points(patch.r_equiv, ce)
         ax.plot(
             c[:, 0],
             c[:, 1],
             color=theme.REQUIV_COLOUR,
             lw=1.5,
             ls="--",
-            label=f"r_equiv = {patch.r_equiv * 1e3:.1f} mm",
+            label=rf"$r_{{\mathrm{{equiv}}}}$ = {patch.r_equiv:.4g} m",
             gid="r_equiv",
         )
-        e = ellipse_points(
-            (patch.ellipse_axes[0] * 1e3, patch.ellipse_axes[1] * 1e3),
-            patch.ellipse_angle,
-            (ce[0] * 1e3, ce[1] * 1e3),
-        )
+        e = ellipse_points(patch.ellipse_axes, patch.ellipse_angle, ce)
         ax.plot(
             e[:, 0],
             e[:, 1],
@@ -82,38 +101,30 @@ def plot_patch_plan(patch: Patch, ax=None):
             gid="ellipse",
         )
         cp = patch.centre_of_pressure
-        ax.plot(
-            [cp[0] * 1e3],
-            [cp[1] * 1e3],
-            "+",
-            color="black",
-            ms=10,
-            mew=1.5,
-            label="centre of pressure",
-            gid="cop",
-        )
+        ax.plot([cp[0]], [cp[1]], "+", color="black", ms=10, mew=1.5, label="centre of pressure", gid="cop")
         ax.annotate(
             "",
-            xy=(0.5 * patch.r_max * 1e3, -1.12 * patch.r_max * 1e3),
-            xytext=(-0.5 * patch.r_max * 1e3, -1.12 * patch.r_max * 1e3),
+            xy=(0.5 * r, -1.12 * r),
+            xytext=(-0.5 * r, -1.12 * r),
             arrowprops={"arrowstyle": "-|>", "color": theme.ROLLING_COLOUR, "lw": 1.5},
         )
         ax.text(
             0.0,
-            -1.19 * patch.r_max * 1e3,
+            -1.19 * r,
             "rolling direction +x",
             ha="center",
             va="top",
             color=theme.ROLLING_COLOUR,
-            fontsize=8.5,
+            fontsize=9,
+            gid="rolling",
         )
-        lim = 1.3 * patch.r_max * 1e3
+        lim = 1.3 * r
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
         ax.set_aspect("equal")
-        ax.set_xlabel("x (mm)")
-        ax.set_ylabel("y (mm)")
-        ax.set_title(f"Loaded region — {circularity_verdict(patch)}", fontsize=10)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.set_title(verdict_title(patch), fontsize=10)
         ax.grid(False)
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8.5)
     return fig

@@ -28,9 +28,9 @@ def fe_pressure_at(patch: Patch, x, y) -> np.ndarray:
 
     x = np.asarray(x, float)
     y = np.asarray(y, float)
-    mesh = patch_mesh(patch, 1.0, 0.0)  # mm, flat; "sigma_over_P" = σ in Pa when P* = 1
-    probe = pv.PolyData(np.column_stack([x.ravel() * 1e3, y.ravel() * 1e3, np.zeros(x.size)]))
-    out = probe.sample(mesh, tolerance=1e-6 * max(patch.r_max * 1e3, 1e-12))
+    mesh = patch_mesh(patch, 1.0, 0.0)  # m, flat; "sigma_over_P" = σ in Pa when P* = 1
+    probe = pv.PolyData(np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)]))
+    out = probe.sample(mesh, tolerance=1e-6 * max(patch.r_max, 1e-12))
     valid = np.asarray(out.point_data["vtkValidPointMask"], bool)
     vals = np.asarray(out.point_data["sigma_over_P"], float)
     return np.where(valid, vals, 0.0).reshape(x.shape)
@@ -40,9 +40,9 @@ def fe_pressure_at(patch: Patch, x, y) -> np.ndarray:
 class SectionData:
     """Pressure along the x and y diameters, dimensionless σ/P*.
 
-    ``s`` (mm) is the position along each diameter; ``static_x``, ``static_y``
+    ``s`` (m) is the position along each diameter; ``static_x``, ``static_y``
     (and ``rolling_x``, ``rolling_y`` when a rolling map is given) are σ/P* along
-    y = 0 and x = 0 respectively. ``inflation_pressure`` P* in Pa; ``R`` (mm) the
+    y = 0 and x = 0 respectively. ``inflation_pressure`` P* in Pa; ``R`` (m) the
     static r_max.
     """
 
@@ -62,13 +62,13 @@ class SectionData:
 
     def to_dict(self) -> dict:
         d = {
-            "s_mm": self.s.tolist(),
+            "s": self.s.tolist(),
             "static_x": self.static_x.tolist(),
             "static_y": self.static_y.tolist(),
         }
         if self.rolling_x is not None and self.rolling_y is not None:
             d.update({"rolling_x": self.rolling_x.tolist(), "rolling_y": self.rolling_y.tolist()})
-        d.update({"inflation_pressure": self.inflation_pressure, "R_mm": self.R})
+        d.update({"inflation_pressure": self.inflation_pressure, "R": self.R})
         return d
 
 
@@ -102,20 +102,29 @@ def diameter_sections(
     rx = ry = None
     if rolling is not None:
         rx, ry = along(rolling)
-    return SectionData(s * 1e3, sx, sy, rx, ry, p_star, static.r_max * 1e3)
+    return SectionData(s, sx, sy, rx, ry, p_star, static.r_max)
+
+
+def plotted_values(data: SectionData) -> np.ndarray:
+    """Every σ/P* value Figure 3 plots (the y-limits must hold all of them)."""
+    series = [data.static_x, data.static_y, data.rolling_x, data.rolling_y]
+    return np.concatenate([np.asarray(v) for v in series if v is not None])
 
 
 def plot_sections(data: SectionData, axes=None):
     """Plot the x and y diameters (static solid, rolling dashed); return the figure.
 
     ``axes``: a pair of matplotlib axes (x section, y section); default a new
-    figure with two side-by-side panels.
+    figure with two side-by-side panels sharing the σ/P* axis. The y-limits are
+    set once, after both panels are drawn, from every plotted value (0 … 5 %
+    above the highest peak), so no peak is clipped; the legend sits above the
+    panels, clear of the data.
     """
     import matplotlib.pyplot as plt
 
     with theme.mpl_style():
         if axes is None:
-            fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.2), sharey=True, layout="constrained")
+            fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.4), sharey=True, layout="constrained")
         else:
             fig = axes[0].figure
         for ax, axis, st, ro in (
@@ -134,20 +143,22 @@ def plot_sections(data: SectionData, axes=None):
                     gid=f"rolling_{axis}",
                 )
             for sgn in (-1, 1):
-                ax.axvline(sgn * data.R, color=theme.RMAX_COLOUR, lw=0.8, ls=":")
+                ax.axvline(
+                    sgn * data.R,
+                    color=theme.RMAX_COLOUR,
+                    lw=0.8,
+                    ls=":",
+                    label="±r_max" if sgn < 0 else None,
+                    gid=f"rmax_{axis}_{'minus' if sgn < 0 else 'plus'}",
+                )
             other = "y" if axis == "x" else "x"
-            ax.set_xlabel(f"{axis} (mm), along {other} = 0")
+            ax.set_xlabel(f"{axis} (m), along {other} = 0")
             ax.set_title(f"{axis} diameter" + (" (rolling direction)" if axis == "x" else " (lateral)"))
-            ax.set_xlim(data.s[0], data.s[-1])
-            ax.set_ylim(bottom=0.0)
-        axes[0].set_ylabel(f"p / P*  (P* = {data.inflation_pressure / 1e3:.0f} kPa)")
-        axes[0].legend(loc="upper left")
-        axes[1].text(
-            data.R,
-            0.02,
-            " r_max",
-            color=theme.RMAX_COLOUR,
-            fontsize=8,
-            transform=axes[1].get_xaxis_transform(),
-        )
+            ax.set_xlim(float(data.s[0]), float(data.s[-1]))
+        top = float(np.max(plotted_values(data)))
+        for ax in axes:
+            ax.set_ylim(0.0, 1.05 * top if top > 0 else 1.0)
+        axes[0].set_ylabel(f"p/P* (P* = {data.inflation_pressure / 1e3:.0f} kPa)")
+        handles, labels = axes[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="outside upper center", ncol=len(labels))
     return fig

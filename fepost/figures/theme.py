@@ -17,12 +17,14 @@ from typing import Any
 WINDOW_SIZE = (1200, 900)
 #: Colour map of pressure, everywhere.
 CMAP = "viridis"
-#: Line colours: static, rolling, outline circle r_max, r_equiv, ellipse.
+#: Line colours: static, rolling, outline circle r_max, r_equiv, ellipse, contact edge.
 STATIC_COLOUR = "#1f4e99"
 ROLLING_COLOUR = "#c0392b"
 RMAX_COLOUR = "#222222"
 REQUIV_COLOUR = "#7f7f7f"
 ELLIPSE_COLOUR = "#e67e22"
+#: The contact edge (contour of the FE pressure at a small fraction of its peak).
+EDGE_COLOUR = "#8c8c8c"
 EXACT_COLOUR = "#1f4e99"
 CLOSED_COLOUR = "#2ca02c"
 FIT_COLOUR = "#c0392b"

@@ -1,0 +1,91 @@
+"""The report: every figure, the coefficients and Table 1 in one folder (``fepost report``).
+
+:func:`build_report` runs the pipeline on a static (and optionally a rolling) FE
+map and writes into ``out``:
+
+==============================  ====================================================
+``report.html``                 the report, self-contained: figures embedded as
+                                ``data:`` URIs, style inlined
+``fig1_static.png``             Figure 1: static pressure over the FE patch (3-D)
+``fig2_rolling.png``            Figure 2: rolling pressure (3-D; with a rolling map)
+``fig3_sections.*``             Figure 3: pressure along the x and y diameters
+                                (PNG, SVG, PDF)
+``patch_plan.*``                the loaded region in plan with the circularity check
+``fig4_f_parallel.*``           Figure 4: F∥(ψ)
+``fig5_torque.*``               Figure 5: M_C(υ)
+``fig6_f_perp.*``               Figure 6: F⊥(υ) (with a rolling map)
+``coefficients.json``           :meth:`fepost.analysis.Analysis.to_dict`
+``table1.json``                 :meth:`fepost.table1.Table1.to_dict` (``rows`` of
+                                name, theory, fitted, ci95)
+``closed_form_vs_exact.json``   :meth:`FrictionCurves.errors_dict`: largest gap
+                                between the closed forms and the exact integrals
+``curves.csv``                  the curves of Figures 4–6 in long form
+``static_map.vtu``              the polar maps, patches and outlines as VTK files
+``static_patch.vtp``            for ParaView (:mod:`fepost.report.vtkfiles`; and
+``static_outline.vtp``          ``rolling_*`` with a rolling map)
+==============================  ====================================================
+
+Everything is written into a temporary folder beside ``out`` and moved into
+place only when every step succeeded (:func:`fepost.output.staged_folder`).
+
+Table 1 is :func:`fepost.table1.table1` with its defaults (the same call as
+``fepost table1``, so ``table1.json`` equals ``fepost table1 --json`` on the same
+inputs and seed, default :data:`fepost.table1.DEFAULT_SEED`): the closed-form
+curves (1.8) with the map's coefficients, 20 % uniform noise, a joint
+least-squares fit, and the same fit on exact-integral data for the bias of the
+approximation. Figures 4–6 show its test points and fitted curves with their
+95 % prediction band (:meth:`fepost.identify.Identification.prediction_band`).
+
+The subpackage, by job: :mod:`.assemble` (the data the page shows),
+:mod:`.figures` (saving and embedding figures), :mod:`.vtkfiles` (VTK output),
+:mod:`.sections` (optional sections), :mod:`.html` (the Jinja2 templates in
+``templates/``), :mod:`.build` (the steps), :mod:`.samples` (the default inputs).
+Names are imported on first use, so ``import fepost.report`` stays cheap.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .assemble import (
+        CURVE_POINTS,
+        DEFAULT_INFLATION_PRESSURE,
+        FrictionCurves,
+        friction_curves,
+        resolve_inflation_pressure,
+    )
+    from .build import ReportResult, build_report
+    from .sections import ReportData, Section
+
+_WHERE = {
+    "build_report": "build",
+    "ReportResult": "build",
+    "FrictionCurves": "assemble",
+    "friction_curves": "assemble",
+    "resolve_inflation_pressure": "assemble",
+    "DEFAULT_INFLATION_PRESSURE": "assemble",
+    "CURVE_POINTS": "assemble",
+    "Section": "sections",
+    "ReportData": "sections",
+}
+
+__all__ = [
+    "CURVE_POINTS",
+    "DEFAULT_INFLATION_PRESSURE",
+    "FrictionCurves",
+    "ReportData",
+    "ReportResult",
+    "Section",
+    "build_report",
+    "friction_curves",
+    "resolve_inflation_pressure",
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        from importlib import import_module
+
+        return getattr(import_module(f"{__name__}.{_WHERE[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

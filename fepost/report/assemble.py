@@ -1,0 +1,315 @@
+"""Assembling the report's data: P*, the curves of Figures 4–6, the page's context.
+
+Nothing here draws or writes: :func:`friction_curves` computes the arrays the
+curve figures plot, :func:`page_context` gathers every value the HTML template
+shows (from the JSON documents written beside it, so page and files agree).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .. import identify
+from ..analysis import Analysis
+from ..errors import ArgumentError
+from ..table1 import Table1
+
+if TYPE_CHECKING:
+    from ..figures.curves import CurveData
+
+#: Inflation pressure P* (Pa) when neither the option nor the sidecar gives one: the paper's.
+DEFAULT_INFLATION_PRESSURE = 200e3
+#: Points of the dense curves of Figures 4–6 (on [0, the span of Table 1's test curves]).
+CURVE_POINTS = 201
+
+
+def _check_inflation_option(option) -> float:
+    try:
+        p = float(option)
+    except (TypeError, ValueError):
+        p = math.nan
+    if not (math.isfinite(p) and p > 0):
+        raise ArgumentError(f"--inflation-pressure must be a positive pressure in Pa, got {option!r}")
+    return p
+
+
+def resolve_inflation_pressure(option: float | None, analysis: Analysis) -> tuple[float, str]:
+    """P* (Pa) and where it came from: the option, the static mesh's sidecar, or the default."""
+    if option is not None:
+        return _check_inflation_option(option), "option"
+    side = analysis.static_field.sidecar or {}
+    value = side.get("inflation_pressure")
+    if value is not None:
+        try:
+            p = float(value)
+        except (TypeError, ValueError):
+            p = math.nan
+        if not (math.isfinite(p) and p > 0):
+            raise ArgumentError(
+                f"{analysis.static_field.source}: sidecar inflation_pressure must be a positive "
+                f"pressure in Pa, got {value!r}"
+            )
+        return p, "sidecar"
+    return DEFAULT_INFLATION_PRESSURE, "default (the paper's 200 kPa)"
+
+
+# --------------------------------------------------------------------------------------
+# Curves of Figures 4–6
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class FrictionCurves:
+    """The curves of Figures 4–6 and how far the closed forms lie from the exact integrals.
+
+    ``curves``: one :class:`~fepost.figures.curves.CurveData` per figure (F∥, M_C and,
+    with a rolling map, F⊥); ``errors``: per curve, the largest |exact − closed form|
+    relative to the curve's scale (``max_abs_relative``), where (``at``, ψ or υ) and
+    the scale (N or N·m).
+    """
+
+    curves: tuple[CurveData, ...]
+    errors: Mapping[str, Mapping[str, Any]]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "curves", tuple(self.curves))
+        object.__setattr__(
+            self,
+            "errors",
+            MappingProxyType({k: MappingProxyType(dict(v)) for k, v in self.errors.items()}),
+        )
+
+    def errors_dict(self) -> dict:
+        """``errors`` as plain dicts (the report's ``closed_form_vs_exact.json``)."""
+        return {k: dict(v) for k, v in self.errors.items()}
+
+
+def friction_curves(analysis: Analysis, table: Table1) -> FrictionCurves:
+    """Assemble the arrays of Figures 4–6 from the analysis and its Table 1.
+
+    Dense curves on :data:`CURVE_POINTS` values of ψ, υ in [0, ``table.span``]: the
+    exact Coulomb integrals over the static map (F∥, M_C) and the rolling map (F⊥);
+    the closed forms (1.8) with the theoretical coefficients of ``table``; the fitted
+    curves with their 95 % prediction band
+    (:meth:`fepost.identify.Identification.prediction_band`); and the noisy test
+    points of ``table.curves``. Figure 6 only with a rolling map.
+    """
+    from ..figures.curves import CurveData
+    from ..friction.quadrature import PressureQuadrature
+
+    c = analysis.coefficients
+    R = table.R
+    quad = PressureQuadrature.from_polar(analysis.static_map)
+    rolling_map = analysis.rolling_map
+    rquad = PressureQuadrature.from_polar(rolling_map) if rolling_map is not None else None
+    has_roll = rquad is not None
+    x = np.linspace(0.0, table.span, CURVE_POINTS)
+    exact = dict(
+        zip(
+            identify.CURVES,
+            identify.exact_curves(quad, x, x, R, rolling_quad=rquad, friction=c.f),
+            strict=True,
+        )
+    )
+    theory = [table.row(name).theory for name in identify.PARAMETERS]
+    closed = {name: identify.curve_model(name, x, theory, R)[0] for name in identify.CURVES}
+    scales = {
+        "f_parallel": ("psi", "F0", theory[0]),
+        "torque": ("upsilon", "M0", theory[1]),
+        "f_perp": ("upsilon", "|k_x| M0 / 2R", abs(theory[4]) * theory[1] / (2.0 * R)),
+    }
+    shown = ("f_parallel", "torque") + (("f_perp",) if has_roll else ())
+    errors = {}
+    for key in shown:
+        x_name, scale_name, scale = scales[key]
+        if scale == 0:
+            continue
+        d = np.abs(exact[key] - closed[key])
+        i = int(np.argmax(d))
+        errors[key] = {
+            "max_abs_relative": float(d[i] / scale),
+            "at": float(x[i]),
+            "scale": float(scale),
+            "x_name": x_name,
+            "scale_name": scale_name,
+        }
+    fit = table.identification
+    curves = []
+    for key in shown:
+        name, title, x_name, x_label, y_label, unit = _FIGURES[key]
+        y, lo, hi = fit.prediction_band(key, x)
+        test_x, test_y = table.curves.data(key)
+        curves.append(
+            CurveData(
+                name=name,
+                title=title,
+                x_name=x_name,
+                x_label=x_label,
+                y_label=y_label,
+                unit=unit,
+                x=x,
+                closed_form=closed[key],
+                exact=exact[key],
+                fit=y,
+                band_lo=lo,
+                band_hi=hi,
+                test_x=test_x,
+                test_y=test_y,
+            )
+        )
+    return FrictionCurves(tuple(curves), errors)
+
+
+#: Figures 4–6: curve -> (figure name, title, x name, x label, y label, unit); labels in mathtext.
+_FIGURES = {
+    "f_parallel": (
+        "F_parallel",
+        r"Figure 4: longitudinal friction force $F_\parallel$ against $\psi = u/v$",
+        "psi",
+        r"$\psi = \omega_z R\,/\,v$",
+        r"$F_\parallel$ (N)",
+        "N",
+    ),
+    "torque": (
+        "M_C",
+        r"Figure 5: friction torque $M_C$ against $\upsilon = v/u$",
+        "upsilon",
+        r"$\upsilon = v\,/\,(\omega_z R)$",
+        r"$M_C$ (N·m)",
+        "N·m",
+    ),
+    "f_perp": (
+        "F_perp",
+        r"Figure 6: lateral friction force $F_\perp$ against $\upsilon = v/u$ (rolling map)",
+        "upsilon",
+        r"$\upsilon = v\,/\,(\omega_z R)$",
+        r"$F_\perp = -F_y$ (N)",
+        "N",
+    ),
+}
+
+
+#: Rows of the coefficient table: (JSON key, symbol, unit kind, definition).
+COEFFICIENT_ROWS = (
+    ("N", "N", "force", "∬ σ dA on the polar grid"),
+    ("N_fe", "N_fe", "force", "exact integral of the FE pressure over the FE faces"),
+    (
+        "R",
+        "R",
+        "length",
+        "r_max: smallest circle about the static centre of pressure holding the loaded points",
+    ),
+    ("F0", "F0", "force", "2π f R² A¹ = f N"),
+    ("M0", "M0", "torque", "2π f R³ A² = f ∬ σ r dA"),
+    ("a", "a", None, "(2A¹/A⁰)²"),
+    ("m", "m", None, "(2A²/A³)²"),
+    ("b", "b", None, "m/4"),
+    ("b1", "b1", "torque", "M0/2"),
+    ("f", "f", None, "friction coefficient (input)"),
+    ("aR2", "a·R²", "area", "a·R², independent of the choice of R"),
+    ("m_over_R2", "m/R²", "inverse_area", "m/R², independent of the choice of R"),
+    ("k_x", "k_x", None, "R·x_c/⟨x²⟩ (rolling shift of the centre of pressure)"),
+    ("x_c", "x_c", "length", "centre of pressure of the rolling map along x"),
+)
+#: Rows of the patch table: (key in coefficients.json "patch", label, unit kind).
+PATCH_ROWS = (
+    ("r_max", "r_max (= R)", "length"),
+    ("r_equiv", "r_equiv = √(area/π)", "length"),
+    ("aspect", "aspect (ellipse length/width)", None),
+    ("area", "area of the loaded faces", "area"),
+    ("load_outside_r_equiv", "share of the load outside r_equiv", "fraction"),
+    ("planarity_rms", "RMS distance from the plane", "length"),
+)
+
+
+def _row(key, label, kind, definition, value, prefix):
+    from . import units
+
+    unit = units.UNITS[kind] if kind and kind != "fraction" else ""
+    return {
+        "key": f"{prefix}.{key}",
+        "label": label,
+        "value": value,
+        "unit": unit,
+        "scale": 1e-3 if kind == "pressure" else 1.0,
+        "fmt": "{:.2%}" if kind == "fraction" else "{:.6g}",
+        "definition": definition,
+    }
+
+
+def page_context(
+    analysis: Analysis,
+    coef: Mapping[str, Any],
+    table: Mapping[str, Any],
+    errors: Mapping[str, Any],
+    *,
+    p_star: float,
+    p_star_source: str,
+    seed: int | None,
+    version: str,
+) -> dict:
+    """Every value ``report.html`` shows, from the JSON documents written beside it.
+
+    ``coef``, ``table``, ``errors``: the parsed ``coefficients.json``,
+    ``table1.json`` and ``closed_form_vs_exact.json`` (so the page shows exactly
+    what the files hold). Figures, files, sections and timings are added by the
+    caller.
+    """
+    a = analysis
+    p = a.static_patch
+    coefficient_rows = [
+        _row(key, label, kind, d, coef[key], "coefficients")
+        for key, label, kind, d in COEFFICIENT_ROWS
+        if coef.get(key) is not None
+    ]
+    coefficient_rows += [
+        {**_row(f"A.{j}", f"A{j}", "pressure", f"∫₀¹ σ̄₀(ρ) ρ{'⁰¹²³'[j]} dρ", coef["A"][j], "coefficients")}
+        for j in range(4)
+    ]
+    if coef.get("reaction_z") is not None:
+        coefficient_rows.append(
+            _row(
+                "reaction_z",
+                "solver reaction",
+                "force",
+                "from the solver",
+                coef["reaction_z"],
+                "coefficients",
+            )
+        )
+    pd = coef["patch"]
+    patch_rows = [_row(k, label, kind, "", pd[k], "coefficients.patch") for k, label, kind in PATCH_ROWS]
+    notes = list(table["notes"])
+    return {
+        "version": version,
+        "static": {
+            "source": a.static_field.source,
+            "field": a.static_field.field,
+            "location": p.location,
+            "faces": len(p.triangles),
+        },
+        "rolling": None
+        if a.rolling_field is None
+        else {"source": a.rolling_field.source, "field": a.rolling_field.field},
+        "friction": a.coefficients.f,
+        "p_star": p_star,
+        "p_star_source": p_star_source,
+        "seed": seed,
+        "grid": {"rule": a.grid.rule, "nr": a.grid.shape[0], "nphi": a.grid.shape[1]},
+        "R": coef["R"],
+        "R_definition": coef.get("R_definition", ""),
+        "coefficient_rows": coefficient_rows,
+        "patch": pd,
+        "patch_rows": patch_rows,
+        "rmax_over_requiv": pd["r_max"] / pd["r_equiv"],
+        "patch_notes": list(p.notes),
+        "table1": table,
+        "table1_notes": [n for n in notes if not n.startswith("paper:")],
+        "paper_notes": [n.removeprefix("paper:").strip() for n in notes if n.startswith("paper:")],
+        "bias_names": ("F0", "M0", "a", "m", "k_x"),
+        "errors": errors,
+    }
