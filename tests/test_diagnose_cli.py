@@ -339,11 +339,11 @@ def test_bad_options_and_paths_are_one_line_errors(setup, capsys):
     cases = [
         (
             [*base, "--measured", str(csv), "--out", str(tmp / "o"), "--seed", "-1"],
-            "--seed must be a non-negative",
+            "argument --seed: must be an integer >= 0",
         ),
         (
             [*base, "--measured", str(csv), "--out", str(tmp / "o"), "--folds", "1"],
-            "--folds must be at least 2",
+            "argument --folds",
         ),
         ([*base, "--measured", str(tmp)], "--out required"),
         ([*base, "--out", str(tmp / "o")], "--measured required"),

@@ -286,12 +286,15 @@ def check_plausible(
     """Reject or flag data that cannot be compared with the simulation.
 
     ``friction`` is the nominal f, ``load`` the simulation's N (N), ``radius``
-    its R (m). Errors (:class:`DataError`): fewer than :data:`MIN_ROWS` rows;
-    a channel that is zero in every row (dead sensor); roll = ±1 rows when no
-    rolling map was given (the static map would silently stand in for it);
-    |Fx|, |Fy| above ``UNITS_ERROR_RATIO``·f·N or |Mz| above that times f·N·R
-    in any row (wrong units). Warning (:class:`UnitsWarning`): the largest force
-    of the sliding rows is below ``UNITS_SMALL_RATIO``·f·N (kN given as N?).
+    its R (m). Errors (:class:`DataError`), in this order: fewer than
+    :data:`MIN_ROWS` rows; no row that slides or spins; fewer than
+    :data:`MIN_DISTINCT` distinct test points (nothing varies); a channel that is
+    zero in every row (dead sensor); roll = ±1 rows when no rolling map was given
+    (the static map would silently stand in for it); |Fx|, |Fy| above
+    ``UNITS_ERROR_RATIO``·f·N or |Mz| above that times f·N·R in any row (wrong
+    units); a channel with one value in every row (dead sensor). Warning
+    (:class:`UnitsWarning`): the largest force of the sliding rows is below
+    ``UNITS_SMALL_RATIO``·f·N (kN given as N?).
     """
     src = f"{data.source}: " if data.source else ""
     n = len(data)
@@ -310,13 +313,8 @@ def check_plausible(
             f"(at least {MIN_DISTINCT} are needed)"
         )
     for c in CHANNELS:
-        values = getattr(data, c)
-        if np.all(values == 0.0):
+        if np.all(getattr(data, c) == 0.0):
             raise DataError(f"{src}column {c} is zero in every row: a dead channel cannot be diagnosed")
-        if np.all(values == values[0]):
-            raise DataError(
-                f"{src}column {c} has the same value in every row: a dead channel cannot be diagnosed"
-            )
     rolling_rows = int(np.count_nonzero(data.roll != 0))
     if rolling_rows and not has_rolling:
         raise DataError(
@@ -332,6 +330,12 @@ def check_plausible(
             raise DataError(
                 f"{src}line {line}, column {c}: |{c}| is {ratio[i]:.3g} x {unit} "
                 f"(f = {friction:g}, N = {loads[i]:.6g} N, R = {radius:.4g} m): wrong units?"
+            )
+    for c in CHANNELS:
+        values = getattr(data, c)
+        if np.all(values == values[0]):
+            raise DataError(
+                f"{src}column {c} has the same value in every row: a dead channel cannot be diagnosed"
             )
     sliding = np.hypot(data.vx, data.vy) > 0
     if np.any(sliding):
