@@ -1,9 +1,11 @@
 """Choosing the cause: BIC, a nesting test and a held-out check.
 
-Every candidate is fitted to all points (:mod:`fepost.diagnose.fitting`) and
-scored by the Bayesian information criterion BIC = −2ℓ + k ln(n_obs), with ℓ
-the Gaussian log-likelihood with one noise variance per channel profiled out,
-k = model parameters + 3 variances, n_obs = 3 × test points.
+Every candidate is fitted to the rows kept (outliers left out,
+:mod:`fepost.diagnose.robust`) by maximum likelihood (:mod:`fepost.diagnose.fitting`)
+and scored by the Bayesian information criterion BIC = −2ℓ + k ln(n_obs), with ℓ
+the Gaussian log-likelihood under the noise model of
+:mod:`fepost.diagnose.noise` (its parameters estimated with the model's),
+k = model parameters + noise parameters, n_obs = 3 × rows.
 
 A candidate other than ``none`` is **admissible** when, against every model
 nested in it (``none`` and, for the extensions, ``friction_level``; see
@@ -16,8 +18,8 @@ nested in it (``none`` and, for the extensions, ``friction_level``; see
    stays below 5 %; without the nesting test the richer of two nested models
    wins on AIC about one time in six, P(χ²₁ > 2) = 0.157);
 3. its mean held-out log predictive density per observation under
-   :data:`FOLDS`-fold cross-validation (per-channel variances re-estimated on
-   each training set) is higher.
+   :data:`FOLDS`-fold cross-validation (noise parameters re-estimated on each
+   training set) is higher.
 
 ``none`` is always admissible. The cause is the admissible candidate of lowest
 BIC. Candidates are ranked admissible first, then by BIC.

@@ -1,13 +1,17 @@
-"""Synthetic rig data with one hidden effect, made by the exact integrals.
+"""Synthetic rig data with hidden effects, made by the exact integrals.
 
 :func:`rig_programme` lays out a realistic rig programme: several sliding
 directions, several absolute speeds at the same speed ratios ε = |v|/(|ω|R),
 both spin signs, pure spin and pure sliding (optionally several loads and both
 rolling directions). :func:`synthesize` computes Fx, Fy, Mz at those points
 with :func:`~fepost.friction.exact.friction_resultants` on a fine quadrature of a
-pressure map (48 × 96 nodes, four times the fit grid's), with one effect of
-:data:`fepost.diagnose.causes.CAUSES` hidden in it, and adds Gaussian noise of
-``noise`` × (range of each clean channel).
+pressure map (48 × 96 nodes, four times the fit grid's), with one or several
+effects of :data:`fepost.diagnose.causes.CAUSES` hidden in it, and adds what rigs
+add: Gaussian noise in % of each channel's range and/or of the reading, gross
+errors on a few rows (sign flips, 2.5× spikes), a friction level drifting along
+the run order (with an optional ``time`` column and the file sorted by test
+condition). :class:`StribeckLaw` is a speed law fepost does not fit (an
+exponential fall of friction with sliding speed).
 
 The effects are applied here independently of the diagnosis's own models:
 through :class:`~fepost.friction.law.FrictionLaw` for the friction laws,
