@@ -191,11 +191,14 @@ def fit(
     docstring). Raises :class:`FitError` when the solver fails.
 
     A candidate with ``expand`` (costly geometry) is fitted through local
-    models: fit its second-order expansion about the current values, move there
-    (halving the step while the exact objective drops), expand again, until the
-    parameters move by less than :data:`GN_TOL` standard errors. The returned
-    ``model`` is the final expansion (exact at the expansion point, its
-    Jacobian there that of the exact model to O(h²); it gives the intervals).
+    models: fit its second-order expansion about the current values; when that
+    moves the parameters by less than :data:`GN_TOL` standard errors, stop;
+    else move there (halving the step while the exact objective, one set of
+    integrals per trial point, drops; stop when no halving improves it, or when
+    the step taken is under the tolerance) and expand again. The returned ``model``
+    is the final expansion (exact at its expansion point, within GN_TOL standard
+    errors of the optimum; its Jacobian that of the exact model to O(h²); it
+    gives the intervals).
     """
     if loss not in LOSSES:
         raise ValueError(f"loss must be one of {LOSSES}, got {loss!r}")
@@ -211,19 +214,29 @@ def fit(
     for _ in range(GN_MAX):
         trial = _fit_direct(lin, Y, rows, start=values, noise=current.noise, loss=loss, intervals=True)
         step = trial.values - values
-        new_lin, new = lin, current
-        for _half in range(GN_HALVINGS):
-            new_lin = cand.expand(values + step)
-            new = _fit_direct(
-                new_lin, Y, rows, start=values + step, noise=trial.noise, loss=loss, evaluate_only=True
-            )
-            if new.log_likelihood >= current.log_likelihood - 1e-9 * abs(current.log_likelihood):
-                break
-            step = 0.5 * step
-        values, lin, current = values + step, new_lin, new
         se = np.where(np.isfinite(trial.stderr) & (trial.stderr > 0), trial.stderr, np.inf)
         if np.all(np.abs(step) <= GN_TOL * se) or not np.any(step):
+            # settled: the local model about ``values`` is exact there, and its error at
+            # values + step is third order in a step of under GN_TOL standard errors
             break
+        new, accepted = current, False
+        for _half in range(GN_HALVINGS):
+            # the exact objective at a trial point costs one set of integrals ...
+            new = _fit_direct(
+                cand, Y, rows, start=values + step, noise=trial.noise, loss=loss, evaluate_only=True
+            )
+            if new.log_likelihood >= current.log_likelihood - 1e-9 * abs(current.log_likelihood):
+                accepted = True
+                break
+            step = 0.5 * step
+        if not accepted:
+            # no better point along the step: settled to the resolution of the integrals
+            # (they jump by ~1e-4 f·N when a centre of rotation crosses the patch edge)
+            break
+        values, current = values + step, new
+        if np.all(np.abs(step) <= GN_TOL * se):
+            break  # a halved step under the tolerance: the local model still holds there
+        lin = cand.expand(values)  # ... and only an accepted point is expanded (its centre is cached)
     else:
         warnings.warn(
             f"{cand.name}: the geometry fit did not settle in {GN_MAX} steps",
