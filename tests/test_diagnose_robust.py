@@ -77,3 +77,20 @@ def test_robust_fit_is_not_pulled_by_glitches_while_least_squares_is():
     err_p = np.abs(plain.values - clean.values) / clean.stderr
     # bounded influence: each spike pulls by at most k noise SDs (the final fit then drops them)
     assert np.all(err_h < 2.0) and np.max(err_p) > 10.0 * np.max(err_h), (err_h, err_p)
+
+
+def test_an_unidentifiable_joint_model_is_refused_quietly():
+    """Two parameters the data cannot tell apart: the pair search records why, no warning escapes."""
+    import warnings
+
+    from fepost.diagnose.pairs import _quiet_fit
+
+    twin = Candidate(
+        "twin", (F, C, Parameter("c2", "1", 0.0, -5.0, 5.0, 0.1, 0.0)),
+        lambda p: p[0] * (BASE + (p[1] + p[2]) * PATTERN), ("none",), "toy",
+    )  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ft, trouble = _quiet_fit(twin, _data(4, c=0.1))
+    assert trouble and "not identifiable" in trouble[0]
+    assert np.all(np.isinf(ft.stderr))

@@ -44,11 +44,13 @@ indistinguishable.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import stats
 
+from ..errors import FitWarning
 from ..lsq import jacobian_svd
 from .causes import EXTENSIONS, joint_candidate, pair_name
 from .fitting import Fit, fit
@@ -139,6 +141,15 @@ def score_test(base: Fit, second: Candidate, Y: np.ndarray) -> tuple[float, floa
     return stat, float(stats.chi2.sf(stat, at.size - 1))
 
 
+def _quiet_fit(*args, **kwargs) -> tuple[Fit, list[str]]:
+    """:func:`fit`, with its FitWarnings returned as reasons instead of shown: a joint
+    model the data cannot identify is simply not admitted."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FitWarning)
+        result = fit(*args, **kwargs)
+    return result, [str(w.message) for w in caught if issubclass(w.category, FitWarning)]
+
+
 def needed_ratio(q: int, n_obs: int) -> float:
     """The smallest likelihood-ratio statistic 2Δℓ with which q new parameters can be admitted."""
     return float(max(stats.chi2.isf(PAIR_ALPHA, q), q * np.log(n_obs)))
@@ -210,10 +221,11 @@ def search_pairs(
             done.append(Trial(second, joint.name, stat, p, need))
             continue
         at = np.concatenate([base.values, [q.null for q in table[second]]])
-        jf = fit(joint, Y, base.rows, start=at, noise=base.noise)
+        jf, trouble = _quiet_fit(joint, Y, base.rows, start=at, noise=base.noise)
         jcv = crossvalidate(joint, Y, parts, jf)
         against = {name: (fits[name], cvs[name]) for name in ("none", "friction_level", primary, second)}
         pvals, reasons = _nesting(jf, jcv, against)
+        reasons += trouble
         done.append(
             Trial(
                 second,
@@ -255,10 +267,10 @@ def friction_test(cand: Candidate, full: Fit, cv: CrossValidation, Y: np.ndarray
         out["admissible"] = False
         return out
     fixed = with_fixed(cand, "f", f0, f"{cand.name}|f=f0")
-    ff = fit(fixed, Y, full.rows, start=np.delete(full.values, j), noise=full.noise)
+    ff, trouble = _quiet_fit(fixed, Y, full.rows, start=np.delete(full.values, j), noise=full.noise)
     fcv = crossvalidate(fixed, Y, parts, ff)
     pvals, reasons = _nesting(full, cv, {fixed.name: (ff, fcv)})
-    reasons = [r for r in reasons if not r.startswith("parameter(s) at a bound")]
+    reasons = [r for r in reasons if not r.startswith("parameter(s) at a bound")] + trouble
     out |= {
         "fitted": True,
         "lrt_p": pvals[fixed.name],
