@@ -18,7 +18,8 @@ Blank lines and lines whose first non-blank character is ``#`` are skipped
 :class:`~fepost.errors.DataError` naming the file, the line and the column.
 
 Limits: at most :data:`MAX_ROWS` test points (a rig programme has hundreds;
-diagnose takes about 10 ms per point, see ``benchmarks/bench_diagnose.py``) and
+diagnose takes 1–4 ms per point on a 2-core machine, 7 s for 5000 points, see
+``benchmarks/bench_diagnose.py``) and
 files of at most :data:`MAX_BYTES`; both are refused before the rows are parsed,
 so a file of a million rows is turned away in a second rather than diagnosed for
 an hour. A cell longer than :data:`MAX_CELL` characters is an error.
