@@ -71,7 +71,8 @@ def add_parser(sub) -> None:
         type=v.seed,
         default=None,
         metavar="S",
-        help="seed of the cross-validation folds (default 0), or of the generator with --make-example",
+        help="seed of the cross-validation folds (default 0); "
+        "with --make-example, of the generator (default 1)",
     )
     p.add_argument(
         "--folds",
