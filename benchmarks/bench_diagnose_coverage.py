@@ -16,7 +16,8 @@ Sets (as in the tests): ``A`` tire-like map R = 0.12 m, loads 0.7/1.0/1.3, 400
 points, noise 1.5 %; ``B`` paraboloid R = 0.09 m with a rolling map (k_x = 0.1),
 roll −1/0/+1, 300 points, noise 2 %; ``rig`` the set-A map and effects as in
 tests/test_diagnose_rig.py: 300 points, noise 3 % of |reading| (no floor) and four
-gross errors per data set (the same rows in every replicate); ``pairs`` the two
+gross errors per data set (the same rows in every replicate); ``rig-combined``
+the same with noise SD² = (0.75 % of range)² + (2 % of |reading|)²; ``pairs`` the two
 two-cause cases of that file (friction level with sensor offsets, anisotropy
 with a pressure shift; 400 points, noise 1.5 %), their joint model fitted.
 
@@ -71,6 +72,10 @@ def set_up(name: str):
     if name == "rig":
         pmap = _map("tire", 0.12, 2.5e5)
         kw = {"n": 300, "noise": 0.0, "noise_proportional": 0.03, "outliers": 4, "loads": (0.7, 1.0, 1.3)}
+        return SET_A, 1101, kw, pmap, None
+    if name == "rig-combined":  # as "rig" with a noise floor: (0.75 % of range)² + (2 % of |reading|)²
+        pmap = _map("tire", 0.12, 2.5e5)
+        kw = {"n": 300, "noise": 0.0075, "noise_proportional": 0.02, "outliers": 4, "loads": (0.7, 1.0, 1.3)}
         return SET_A, 1101, kw, pmap, None
     if name == "pairs":
         pmap = _map("tire", 0.12, 2.5e5)
