@@ -1,4 +1,4 @@
-"""The measured-data CSV (INTERFACE.md): parsing, validation, plausibility checks."""
+"""The measured-data CSV: parsing, validation, plausibility checks."""
 
 from __future__ import annotations
 
