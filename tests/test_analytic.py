@@ -19,7 +19,7 @@ def test_moments_match_quadrature(name):
 
 
 def test_theory_reference_values():
-    # THEORY.md §5: Hertz a = (8/3π)², m = (15π/16)², M0 = (3π/16) f N R
+    # docs/theory.md, "Reference values": Hertz a = (8/3π)², m = (15π/16)², M0 = (3π/16) f N R
     c = analytic.coefficients("hertz", radius=1.0, peak=1.0, friction=1.0)
     N = analytic.load("hertz", 1.0, 1.0)
     assert c["a"] == pytest.approx((8 / (3 * np.pi)) ** 2, rel=1e-14)

@@ -122,3 +122,73 @@ def test_synthesize_rejects_unknown_effects_and_parameters():
         synthesize(_map(), "anisotropic_friction", {"beta": 2.0})
     with pytest.raises(ArgumentError, match=r"needs parameter\(s\) \['s'\]"):
         synthesize(_map(), "elliptic_patch", {})
+
+
+PAIRS = [
+    (
+        ("pressure_dependent_friction", "speed_dependent_friction"),
+        {"c_p": 0.3, "c_v": -0.1},
+        [0.3, 0.3, -0.1],
+    ),
+    (("pressure_dependent_friction", "anisotropic_friction"), {"c_p": -0.3, "alpha": 1.2}, [0.3, -0.3, 1.2]),
+    (("anisotropic_friction", "speed_dependent_friction"), {"alpha": 0.85, "c_v": 0.08}, [0.3, 0.85, 0.08]),
+    (
+        ("elliptic_patch", "pressure_shift"),
+        {"s": 1.15, "dx": 0.004, "dy": -0.003},
+        [0.3, 1.15, 0.004, -0.003],
+    ),
+    (
+        ("pressure_shift", "anisotropic_friction"),
+        {"dx": -0.005, "dy": 0.002, "alpha": 1.1},
+        [0.3, -0.005, 0.002, 1.1],
+    ),
+    (("elliptic_patch", "pressure_dependent_friction"), {"s": 0.9, "c_p": 0.25}, [0.3, 0.9, 0.25]),
+    (
+        ("friction_level", "sensor_offset"),
+        {"f": 0.27, "offset_Fx": 30.0, "offset_Fy": -10.0, "offset_Mz": 2.0},
+        [0.27, 30.0, -10.0, 2.0],
+    ),
+]
+
+
+@pytest.mark.parametrize(("effects", "params", "values"), PAIRS, ids=["+".join(p[0]) for p in PAIRS])
+def test_joint_model_equals_both_effects_applied_directly(effects, params, values):
+    """Two causes at once: the joint model's cross terms (bilinear in c_p, c_v; affine in α;
+    stretch then shift) equal the generator's exact integrals with both effects."""
+    from fepost.diagnose.causes import joint_candidate
+
+    static, rolling = _map(), _map(k_x=0.15)
+    syn = synthesize(
+        static, effects, params, rolling=rolling, n=60, noise=0.0, seed=5, loads=(0.8, 1.0, 1.25)
+    )
+    sim = simulation_from_maps(static, rolling, friction=0.3, nr=GEN_NR, nphi=GEN_NPHI)
+    pred = Predictor(sim, syn.data)
+    exts = tuple(e for e in effects if e != "friction_level")
+    cand = joint_candidate(pred, exts)
+    got = cand.predict(np.array(values)) * pred.scale
+    np.testing.assert_allclose(got, syn.clean, rtol=0, atol=TOL * pred.scale.max())
+    if cand.expand is not None:  # the local model is exact at its expansion point
+        local = cand.expand(np.array(values))
+        np.testing.assert_allclose(
+            local.predict(np.array(values)) * pred.scale, got, rtol=0, atol=1e-12 * got.max()
+        )
+
+
+def test_joint_models_nest_their_parts():
+    from fepost.diagnose.causes import joint_candidate
+
+    static = _map()
+    syn = synthesize(static, "none", {}, n=40, noise=0.0, seed=2)
+    pred = Predictor(simulation_from_maps(static, friction=0.3), syn.data)
+    singles = build_candidates(pred)
+    joint = joint_candidate(pred, ("anisotropic_friction", "pressure_dependent_friction"))
+    assert joint.names == ("f", "alpha", "c_p")
+    assert joint.nested == ("none", "friction_level", "anisotropic_friction", "pressure_dependent_friction")
+    np.testing.assert_allclose(
+        joint.predict(np.array([0.31, 1.2, 0.0])),
+        singles["anisotropic_friction"].predict(np.array([0.31, 1.2])),
+    )
+    np.testing.assert_allclose(
+        joint.predict(np.array([0.31, 1.0, 0.2])),
+        singles["pressure_dependent_friction"].predict(np.array([0.31, 0.2])),
+    )

@@ -82,6 +82,10 @@ def _check(diag, syn, effect) -> tuple[list[str], dict[str, str]]:
     after = {ch: st["verdict"] for ch, st in diag.residuals["after"].items()}
     if any(v != "noise" for v in after.values()):
         problems.append(f"{effect}: residuals after the extension {after}")
+    if diag.causes != (effect,):
+        problems.append(f"{effect}: causes {diag.causes}")
+    if diag.lack_of_fit["detected"]:  # (a clean row may be flagged: the outlier rule's 5 % by design)
+        problems.append(f"{effect}: lack of fit: {diag.lack_of_fit['message']}")
     return problems, misses
 
 
@@ -119,7 +123,8 @@ def test_null_data_give_none(seed):
     pmap = _map("tire", 0.12, 2.5e5)
     syn = synthesize(pmap, "none", {}, n=400, seed=seed, loads=(0.7, 1.0, 1.3))
     d = diagnose(pmap, syn.data, friction=0.3, seed=seed)
-    assert d.cause == "none"
+    assert d.cause == "none" and d.causes == ("none",)
+    assert not d.lack_of_fit["detected"]
     assert d.parameters == {}
     assert d.gain["rmse_after"] == d.gain["rmse_before"] and d.gain["delta_bic"] == 0.0
     assert all(st["verdict"] == "noise" for st in d.residuals["before"].values())
@@ -142,7 +147,7 @@ def test_closed_forms_are_compared():
     syn = synthesize(pmap, "none", {}, n=200, seed=9)
     d = diagnose(pmap, syn.data, friction=0.3, seed=9)
     cf = d.closed_form
-    # THEORY.md §4: the square-root forms are off by up to ~0.1-0.2 of F0, M0 near υ ≈ 0.5-1
+    # docs/theory.md: the square-root forms are off by up to ~0.1-0.2 of F0, M0 near υ ≈ 0.5-1
     assert 0.01 < cf["rmse_vs_exact"] < 0.2
     assert cf["rmse_vs_data"] > cf["exact_rmse_vs_data"]
     assert np.all(np.isfinite(d.predictions["closed_form"]))
@@ -168,7 +173,7 @@ def test_set_c_calculix_map(effect, params):
     syn = synthesize(a.static_map, effect, params, n=400, seed=seed, loads=(0.8, 1.0, 1.2))
     d = diagnose(MESHES / "static.vtu", syn.data, friction=0.3, seed=seed)
     if effect == "none":
-        assert d.cause == "none"
+        assert d.causes == ("none",) and not d.lack_of_fit["detected"]
     else:
         problems, misses = _check(d, syn, effect)
         assert not problems, problems

@@ -1,12 +1,15 @@
-"""Diagnose figures at the data level: the plotted group means are the tested ones."""
+"""Diagnose figures say what they claim: the tested group means, the outliers, legible layout."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from fepost.diagnose import diagnose
-from fepost.diagnose.figures import along_sliding, plot_residuals
+from fepost.diagnose.figures import along_sliding, plot_predicted_vs_measured, plot_residuals, run_order
 from fepost.diagnose.measured import CHANNELS
 from fepost.diagnose.residuals import binned_means
 from fepost.diagnose.synthetic import analytic_map, synthesize
@@ -17,6 +20,25 @@ def diag():
     pmap = analytic_map("hertz", 0.1, 3e5)
     syn = synthesize(pmap, "none", {}, n=160, seed=5)
     return diagnose(pmap, syn.data, friction=0.3)
+
+
+@pytest.fixture(scope="module")
+def diag_outliers():
+    """A heavy patch (N ≈ 170 kN) at three loads, a time column (7 panel columns), three gross
+    errors and a pressure effect: long tick labels in narrow panels."""
+    pmap = analytic_map("hertz", 0.2, 2e6)
+    syn = synthesize(
+        pmap, "pressure_dependent_friction", {"c_p": 0.3}, n=200, seed=8, outliers=3,
+        loads=(0.7, 1.0, 1.3), time_column=True,
+    )  # fmt: skip
+    d = diagnose(pmap, syn.data, friction=0.3)
+    assert list(d.outliers) == list(syn.outliers)
+    return d
+
+
+def _drawn_figure(fig):
+    FigureCanvasAgg(fig).draw()
+    return fig.canvas.get_renderer()
 
 
 def test_group_means_are_the_means_per_spin_sign(diag):
@@ -32,25 +54,90 @@ def test_group_means_are_the_means_per_spin_sign(diag):
     assert binned_means(r, "roll", np.zeros(x.size)) is None  # a variable that does not vary
 
 
-def test_residual_figure_draws_the_tested_group_means(diag):
-    fig = plot_residuals(diag)
-    meas = diag.data.forces
-    rb = 100 * (meas - diag.predictions["before"]) / diag.scales
+@pytest.mark.parametrize("which", ["diag", "diag_outliers"])
+def test_residual_figure_draws_the_tested_group_means(which, request):
+    """Every panel's black line is the group means of the kept rows (outliers left out)."""
+    d = request.getfixturevalue(which)
+    fig = plot_residuals(d)
+    meas = d.data.forces
+    rb = 100 * (meas - d.predictions["before"]) / d.scales
+    keep = np.ones(len(d.data), bool)
+    keep[list(d.outliers)] = False
     drawn = [ln for ax in fig.axes for ln in ax.get_lines() if ln.get_gid() == "group-means"]
+    label, order = run_order(d)
+    columns = {**{k: np.asarray(v, float) for k, v in d.variables.items()}, "run order": order}
     expected = []
-    rows = [rb[:, c] for c in range(len(CHANNELS))] + [along_sliding(diag.data, rb)]
-    for r in rows:
-        ok = np.isfinite(r)
-        for name, x in diag.variables.items():
-            g = binned_means(r[ok], name, np.asarray(x, float)[ok])
+    for r in [rb[:, c] for c in range(len(CHANNELS))] + [along_sliding(d.data, rb)]:
+        ok = np.isfinite(r) & keep
+        for name, x in columns.items():
+            g = binned_means(r[ok], name, x[ok])
             if g is not None:
-                expected.append(g)
+                scale = 1e-3 if name.startswith("load N") else 1.0  # drawn in kN
+                expected.append((g[0] * scale, g[1]))
     assert len(drawn) == len(expected) > 0
-    got = {(tuple(np.round(ln.get_xdata(), 12)), tuple(np.round(ln.get_ydata(), 12))) for ln in drawn}
-    want = {(tuple(np.round(g[0], 12)), tuple(np.round(g[1], 12))) for g in expected}
+    got = {(tuple(np.round(ln.get_xdata(), 9)), tuple(np.round(ln.get_ydata(), 9))) for ln in drawn}
+    want = {(tuple(np.round(x, 9)), tuple(np.round(y, 9))) for x, y in expected}
     assert got == want
     texts = [t.get_text() for ax in fig.axes for t in ax.texts]
     assert any(t.startswith("ANOVA p = ") for t in texts)
+    assert any(t.startswith("drift test p = ") for t in texts)
+
+
+def test_outliers_are_drawn_in_every_panel(diag_outliers):
+    d = diag_outliers
+    fig = plot_residuals(d)
+    rb = 100 * (d.data.forces - d.predictions["before"]) / d.scales
+    along = along_sliding(d.data, rb)[list(d.outliers)]
+    ncol = len(fig.axes) // 4
+    for k, ax in enumerate(fig.axes):
+        marks = [c for c in ax.collections if (c.get_gid() or "").startswith("outliers")]
+        count = sum(len(c.get_offsets()) for c in marks)
+        # the along-sliding row (the last) has no value at pure spin
+        assert count == (np.isfinite(along).sum() if k >= 3 * ncol else len(d.outliers)), count
+    axes = plot_predicted_vs_measured(d)
+    for ax in axes:
+        marks = [c for c in ax.collections if c.get_gid() == "outliers"]
+        assert sum(len(c.get_offsets()) for c in marks) == len(d.outliers)
+
+
+def _overlap(a, b, pad=0.5) -> bool:
+    return a.x0 < b.x1 - pad and b.x0 < a.x1 - pad and a.y0 < b.y1 - pad and b.y0 < a.y1 - pad
+
+
+@pytest.mark.parametrize("which", ["diag", "diag_outliers"])
+def test_tick_labels_never_collide(which, request):
+    fig = plot_residuals(request.getfixturevalue(which))
+    renderer = _drawn_figure(fig)
+    checked = 0
+    for ax in fig.axes:
+        for ticks in (ax.get_xticklabels(), ax.get_yticklabels()):
+            boxes = [t.get_window_extent(renderer) for t in ticks if t.get_visible() and t.get_text()]
+            checked += len(boxes)
+            for a, b in itertools.combinations(boxes, 2):
+                assert not _overlap(a, b), f"{ax.get_xlabel()!r}: tick labels overlap"
+    assert checked > 50
+
+
+@pytest.mark.parametrize("which", ["diag", "diag_outliers"])
+def test_legend_covers_no_text_and_no_panel(which, request):
+    fig = plot_residuals(request.getfixturevalue(which))
+    renderer = _drawn_figure(fig)
+    legend = fig.legends[0].get_window_extent(renderer)
+    texts = [t for ax in fig.axes for t in ax.texts] + [ax.title for ax in fig.axes]
+    texts += [ax.xaxis.label for ax in fig.axes] + [ax.yaxis.label for ax in fig.axes]
+    texts += [t for ax in fig.axes for t in ax.get_xticklabels() + ax.get_yticklabels()]
+    texts = [t for t in texts if t.get_visible() and t.get_text()]
+    assert any(t.get_text().startswith("ANOVA p") for t in texts)
+    for t in texts:
+        assert not _overlap(legend, t.get_window_extent(renderer)), f"legend over {t.get_text()!r}"
+    for ax in fig.axes:
+        assert not _overlap(legend, ax.get_window_extent(renderer)), "legend over a panel"
+    # and the p-value boxes stay inside their own panel
+    for ax in fig.axes:
+        for t in ax.texts:
+            box = t.get_window_extent(renderer)
+            frame = ax.get_window_extent(renderer)
+            assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
 
 
 def test_direction_groups_sit_at_their_sector_centres():

@@ -94,24 +94,15 @@ def test_cli_reference_lists_every_command_and_option(site):
                         assert f"<code>{opt}" in html, (name, opt)
 
 
-#: Files of fepost/ still allowed to name THEORY.md or INTERFACE.md (files users do not have):
-#: the diagnosis, being rewritten at the time. Remove entries as they are cleaned.
-OUTSIDE_REFERENCES_ALLOWED = ("fepost/diagnose/", "fepost/cli/diagnose.py")
-
-
 def test_no_references_to_files_outside_the_repository():
     """README, docs and the package stand alone: no ../shared anywhere, and no THEORY.md or
-    INTERFACE.md in the README, the docs or the package (help texts, docstrings, templates),
-    except in the files of OUTSIDE_REFERENCES_ALLOWED."""
+    INTERFACE.md in the README, the docs or the package (help texts, docstrings, templates)."""
     package = [p for p in (REPO / "fepost").rglob("*") if p.is_file() and p.suffix in (".py", ".j2", ".css")]
     texts = {p: p.read_text(encoding="utf-8") for p in [REPO / "README.md", *DOCS.rglob("*.md"), *package]}
     assert len(package) > 100
     for path, text in texts.items():
         assert "shared/" not in text, path
-        rel = path.relative_to(REPO).as_posix()
-        if rel.startswith(OUTSIDE_REFERENCES_ALLOWED):
-            continue
-        assert "THEORY.md" not in text and "INTERFACE.md" not in text, rel
+        assert "THEORY.md" not in text and "INTERFACE.md" not in text, path.relative_to(REPO).as_posix()
 
 
 # ---------------------------------------------------------------- the tutorial runs

@@ -108,7 +108,7 @@ def bad_csvs(good: Path) -> dict[str, tuple[str | bytes, str]]:
     }
 
 
-#: Cases that fail today in files owned elsewhere; each must pass once that owner's fix lands.
+#: Cases that failed in files owned elsewhere (now fixed on the diagnose branch): each must pass.
 DIAGNOSE_OWNED = {
     "huge-cell": "fepost/diagnose/measured.py: a cell over 128 kB is csv's field-size limit: "
     "internal error (csv.Error), not a one-line DataError naming the file",
@@ -166,8 +166,7 @@ def test_bad_measured_csv(capsys, data, case):
 @pytest.mark.parametrize(
     "case",
     [
-        pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=f"owner: diagnose engineer, {why}"))
-        for name, why in DIAGNOSE_OWNED.items()
+        name for name in DIAGNOSE_OWNED
     ],
 )
 def test_bad_measured_csv_owned_elsewhere(capsys, data, case):
@@ -320,7 +319,7 @@ def test_hostile_option_values(capsys, data, command, monkeypatch):
             errors = [x for x in err.splitlines() if not x.startswith("fepost: warning")]
             assert "Traceback" not in err and len(errors) == 1, (argv[-1][:80], err[:500])
             if command == "sweep" and code == 1:
-                continue  # a table written with the missing input's row failed (INTERFACE)
+                continue  # a table written with the missing input's row failed (see docs/formats.md)
             assert code == 2, (argv[-1][:80], err[:500])
             # a path option's error names the value given
             named = (opt, str(missing), "--out", f"fepost: error: {value[:100]}")

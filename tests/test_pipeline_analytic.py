@@ -1,4 +1,4 @@
-"""Analytic pressure maps written as unstructured FE meshes reproduce THEORY.md §5.
+"""Analytic pressure maps written as unstructured FE meshes reproduce the reference values of docs/theory.md.
 
 Tolerances (issue 2): N, F0, M0 within 1e-3 relative on fine meshes, aR² and
 m/R² within 2e-3, k_x within 1e-2 relative; N (polar) and N_fe (FE faces) agree

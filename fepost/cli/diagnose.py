@@ -1,9 +1,13 @@
 """``fepost diagnose --simulation SIM [--rolling ROLLING] --measured CSV [--friction F] --out DIR``.
 
 Compares rig data with the simulation's exact friction integrals, names the most
-likely cause of the misfit, fits it and writes ``DIR/diagnosis.json``,
+likely cause(s) of the misfit, fits them and writes ``DIR/diagnosis.json``,
 ``DIR/summary.txt`` and PNG figures (atomically; ``--force`` replaces a
 non-empty DIR). The summary is also printed.
+
+``fepost diagnose --make-example CSV --simulation SIM [--cause NAME] [--seed S]``
+writes example measured data instead: the project's generator over SIM with one
+documented cause hidden in it (:mod:`fepost.diagnose.example`).
 """
 
 from __future__ import annotations
@@ -15,6 +19,18 @@ from ..errors import ArgumentError, OutputError
 from . import _validate as v
 from ._common import add_friction_option, add_input_options, analysis_kwargs
 
+#: Mirrors fepost.diagnose.causes.CAUSES (kept here so that --help imports nothing heavy).
+CAUSE_NAMES = (
+    "none",
+    "friction_level",
+    "pressure_dependent_friction",
+    "speed_dependent_friction",
+    "elliptic_patch",
+    "anisotropic_friction",
+    "pressure_shift",
+    "sensor_offset",
+)
+
 
 def add_parser(sub) -> None:
     p = sub.add_parser(
@@ -23,7 +39,12 @@ def add_parser(sub) -> None:
         description=(
             "Fit every candidate cause (friction level, pressure- or speed-dependent friction, "
             "elliptic patch, anisotropic friction, pressure shift, sensor offsets) through the exact "
-            "friction integrals, choose by BIC with nesting tests and a held-out check, and report the gain."
+            "friction integrals, robustly (gross outliers are flagged and left out) and under a noise "
+            "model chosen per channel (constant, proportional to |F|, or both); choose by BIC with "
+            "nesting tests and a held-out check, try a second cause on top, test for lack of fit "
+            "(replicates, drift along the run order or a time column) and report the gain. "
+            "With --make-example CSV, write example measured data over SIM instead. "
+            "Formats and every output key: docs/diagnose.md."
         ),
     )
     p.add_argument(
@@ -38,17 +59,20 @@ def add_parser(sub) -> None:
         help="rolling FE contact map (needed for rows with roll = +-1)",
     )
     p.add_argument(
-        "--measured", required=True, metavar="CSV", help="measured friction data (INTERFACE.md CSV)"
+        "--measured",
+        metavar="CSV",
+        help="measured friction data (CSV: vx, vy, wz, Fx, Fy, Mz [, N, roll, time]; docs/diagnose.md)",
     )
     add_friction_option(p, "nominal friction coefficient")
-    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--out", metavar="DIR", help="output folder")
     p.add_argument("--force", action="store_true", help="replace a non-empty output folder")
     p.add_argument(
         "--seed",
         type=v.seed,
-        default=0,
+        default=None,
         metavar="S",
-        help="seed of the cross-validation folds (default 0)",
+        help="seed of the cross-validation folds (default 0); "
+        "with --make-example, of the generator (default 1)",
     )
     p.add_argument(
         "--folds",
@@ -57,16 +81,66 @@ def add_parser(sub) -> None:
         metavar="K",
         help="cross-validation folds (default %(default)s)",
     )
+    p.add_argument(
+        "--make-example",
+        metavar="CSV",
+        help="write example measured data over SIM to CSV (a hidden cause, see --cause) and stop",
+    )
+    p.add_argument(
+        "--cause",
+        choices=CAUSE_NAMES,
+        default="pressure_dependent_friction",
+        metavar="NAME",
+        help="with --make-example: the cause hidden in the data (default pressure_dependent_friction; "
+        f"one of {', '.join(CAUSE_NAMES)})",
+    )
     add_input_options(p)
     p.set_defaults(func=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..diagnose import diagnose
-    from ..diagnose.writer import write_diagnosis
+def _make_example(args: argparse.Namespace) -> int:
+    from ..diagnose.example import EXAMPLE_SEED, make_example
+    from ..output import check_replaceable
 
+    if args.measured or args.out:
+        raise ArgumentError(
+            "--make-example writes data and stops: do not combine it with --measured or --out"
+        )
+    target = Path(args.make_example)
+    check_replaceable(target, [args.simulation, args.rolling])
+    if target.is_dir():
+        raise OutputError(f"{target}: is a folder; --make-example needs a CSV file name")
+    if target.exists() and not args.force:
+        raise OutputError(f"{target}: file exists (use --force to replace it)")
+    if not (target.parent if str(target.parent) else Path(".")).is_dir():
+        raise OutputError(f"{target}: folder {target.parent} does not exist")
+    seed = EXAMPLE_SEED if args.seed is None else args.seed
+    syn = make_example(
+        args.simulation,
+        target,
+        cause=args.cause,
+        seed=seed,
+        friction=args.friction,
+        rolling=args.rolling,
+        analyse_kwargs=analysis_kwargs(args),
+    )
+    print(
+        f"written: {target} ({len(syn.data)} test points, hidden cause {args.cause}, seed {seed}; "
+        f"gross errors in rows {', '.join(map(str, syn.outliers)) or 'none'})"
+    )
+    return 0
+
+
+def run(args: argparse.Namespace) -> int:
     if not args.friction > 0:
         raise ArgumentError(f"--friction must be positive, got {args.friction!r}")
+    if args.seed is not None and args.seed < 0:
+        raise ArgumentError(f"--seed must be a non-negative integer, got {args.seed!r}")
+    if args.make_example:
+        return _make_example(args)
+    missing = [name for name, value in (("--measured", args.measured), ("--out", args.out)) if not value]
+    if missing:
+        raise ArgumentError(f"{' and '.join(missing)} required (or --make-example CSV to write example data)")
     if args.folds < 2:
         raise ArgumentError(f"--folds must be at least 2, got {args.folds!r}")
     out = Path(args.out)
@@ -74,12 +148,15 @@ def run(args: argparse.Namespace) -> int:
         raise OutputError(f"{out}: folder exists and is not empty (use --force to replace it)")
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: exists and is not a folder")
+    from ..diagnose import diagnose
+    from ..diagnose.writer import write_diagnosis
+
     result = diagnose(
         args.simulation,
         args.measured,
         rolling=args.rolling,
         friction=args.friction,
-        seed=args.seed,
+        seed=0 if args.seed is None else args.seed,
         n_folds=args.folds,
         analyse_kwargs=analysis_kwargs(args),
     )

@@ -5,13 +5,14 @@
   measurement, with the identity line.
 * :func:`plot_residuals` — residuals in % of the channel scale (f₀N, f₀NR)
   against sliding speed, speed ratio, sliding direction, spin sign and (when
-  they vary) load and roll, with the group means the ANOVA test compares
-  (± their 95 % interval) and its p-value per panel: structure shows as a
-  trend or a step of the means, noise as a flat band around zero. A fourth
-  row shows the force residual along the sliding direction (positive: less
-  friction than simulated), where a change of friction level with speed,
+  they vary) load and roll, and against the run order (or the ``time``
+  column), with the group means the ANOVA test compares (± their 95 %
+  interval) and its p-value per panel: structure shows as a trend or a step of
+  the means, noise as a flat band around zero, drift as a trend along the run.
+  A fourth row shows the force residual along the sliding direction (positive:
+  less friction than simulated), where a change of friction level with speed,
   load or pressure shows as a trend of the means even when the signed Fx, Fy
-  residuals only fan out.
+  residuals only fan out. Outliers are drawn in red.
 * :func:`plot_candidates` — ΔBIC of every candidate against the simulation.
 
 Each function takes an optional figure or axes and returns it; none calls show().
@@ -36,23 +37,30 @@ def plot_predicted_vs_measured(diag: Diagnosis, axes=None):
     if axes is None:
         fig = Figure(figsize=(12, 4.2), layout="constrained")
         axes = fig.subplots(1, 3)
+    keep = np.ones(len(diag.data), bool)
+    keep[list(diag.outliers)] = False
     meas = diag.data.forces
     before = diag.predictions["before"]
     after = diag.predictions["after_heldout"]
     for c, ax in enumerate(axes):
         ch = CHANNELS[c]
-        rb = np.sqrt(np.mean(((meas[:, c] - before[:, c]) / diag.scales[c]) ** 2))
-        ra = np.sqrt(np.mean(((meas[:, c] - after[:, c]) / diag.scales[c]) ** 2))
-        ax.scatter(meas[:, c], before[:, c], s=9, c=BEFORE, label=f"simulation (rmse {rb:.3g})")
+        rb = np.sqrt(np.mean(((meas[keep, c] - before[keep, c]) / diag.scales[c]) ** 2))
+        ra = np.sqrt(np.mean(((meas[keep, c] - after[keep, c]) / diag.scales[c]) ** 2))
+        ax.scatter(meas[keep, c], before[keep, c], s=9, c=BEFORE, label=f"simulation (rmse {rb:.3g})")
         if diag.cause != "none":
             ax.scatter(
-                meas[:, c],
-                after[:, c],
+                meas[keep, c],
+                after[keep, c],
                 s=9,
                 c=AFTER,
                 alpha=0.7,
-                label=f"{diag.cause}, held-out (rmse {ra:.3g})",
+                label=f"{'+'.join(diag.causes)}, held-out (rmse {ra:.3g})",
             )
+        if not keep.all():
+            ax.scatter(
+                meas[~keep, c], before[~keep, c], s=22, c=OUTLIER, marker="x", zorder=5,
+                label="outlier (left out)", gid="outliers",
+            )  # fmt: skip
         lo = min(meas[:, c].min(), before[:, c].min())
         hi = max(meas[:, c].max(), before[:, c].max())
         ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
@@ -60,8 +68,16 @@ def plot_predicted_vs_measured(diag: Diagnosis, axes=None):
         ax.set_ylabel(f"predicted {ch} ({UNITS[ch]})")
         ax.set_title(ch)
         ax.legend(fontsize=7, loc="upper left")
-    axes[0].figure.suptitle(f"predicted vs measured — cause: {diag.cause} (rmse in scaled units)")
+    axes[0].figure.suptitle(
+        f"predicted vs measured — cause: {'+'.join(diag.causes)} (rmse in scaled units, outliers left out)"
+    )
     return axes
+
+
+#: Colour and marker of outliers (rows left out of every fit).
+OUTLIER = "tab:red"
+#: Largest number of x tick labels per panel (narrow panels: fewer, so they never touch).
+XTICKS = 4
 
 
 def _columns(diag: Diagnosis) -> list[str]:
@@ -80,12 +96,54 @@ def along_sliding(data, res: np.ndarray) -> np.ndarray:
     return np.divide(along, v, out=np.full(v.shape, np.nan), where=v > 0)
 
 
+def run_order(diag: Diagnosis) -> tuple[str, np.ndarray]:
+    """(label, position) of the run-order column: the ``time`` column when present, else the row."""
+    if diag.data.time is not None:
+        return "time (run order)", np.asarray(diag.data.time, float)
+    return "run order (data row)", np.arange(len(diag.data), dtype=float)
+
+
+def _limits(values: list[np.ndarray]) -> tuple[float, float]:
+    """y-limits holding every kept value with a 10 % margin (outliers may fall outside)."""
+    v = np.concatenate([np.asarray(x, float)[np.isfinite(x)] for x in values])
+    if not v.size:
+        return -1.0, 1.0
+    lo, hi = float(v.min()), float(v.max())
+    pad = 0.1 * (hi - lo) or 1.0
+    return lo - pad, hi + pad
+
+
+def _draw_outliers(ax, x, y, ylim) -> None:
+    """Outliers as red crosses; those beyond ``ylim`` as red triangles on the edge."""
+    ok = np.isfinite(y)
+    x, y = x[ok], y[ok]
+    inside = (y >= ylim[0]) & (y <= ylim[1])
+    span = ylim[1] - ylim[0]
+    kw = {"c": OUTLIER, "s": 22, "zorder": 5}
+    ax.scatter(x[inside], y[inside], marker="x", gid="outliers", label="outlier (left out)", **kw)
+    above, below = y > ylim[1], y < ylim[0]
+    top, bottom = ylim[1] - 0.02 * span, ylim[0] + 0.02 * span
+    ax.scatter(x[above], np.full(above.sum(), top), marker="^", gid="outliers-clipped", **kw)
+    ax.scatter(x[below], np.full(below.sum(), bottom), marker="v", gid="outliers-clipped", **kw)
+
+
 def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
-    """Residuals (% of scale) against the kinematic variables; returns the figure."""
+    """Residuals (% of scale) against the kinematic variables and the run order; returns the figure.
+
+    Outliers (left out of every fit) are red crosses, or red triangles on the
+    panel's edge when they lie beyond the kept rows' range; the group means and
+    y-limits use the kept rows only. The p-value of each kinematic panel is its
+    ANOVA test on the standardised residuals; the run-order column shows the
+    lack-of-fit run-order test. The legend sits below the panels.
+    """
+    from matplotlib.ticker import MaxNLocator
+
     cols = _columns(diag)
+    order_label, order_x = run_order(diag)
+    ncol = len(cols) + 1
     if fig is None:
-        fig = Figure(figsize=(3.0 * len(cols) + 1, 10.5), layout="constrained")
-    axes = np.atleast_2d(fig.subplots(4, len(cols), sharey="row", squeeze=False))
+        fig = Figure(figsize=(2.9 * ncol + 1.2, 11.0), layout="constrained")
+    axes = np.atleast_2d(fig.subplots(4, ncol, sharey="row", squeeze=False))
     meas = diag.data.forces
     rb = 100 * (meas - diag.predictions["before"]) / diag.scales
     ra = 100 * (meas - diag.predictions["after_heldout"]) / diag.scales
@@ -99,50 +157,76 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
             "along sliding (% of f0N)\n+ = less friction than simulated",
         )
     )
+    out = np.zeros(len(diag.data), bool)
+    out[list(diag.outliers)] = True
+    keep = ~out
+    shown = "+".join(diag.causes)
     rng = np.random.default_rng(0)
-    for j, name in enumerate(cols):
-        x0 = np.array(diag.variables[name], float)
-        x = x0
-        if np.unique(x0[np.isfinite(x0)]).size <= 3:  # categorical: jitter the points only
-            x = x0 + rng.uniform(-0.15, 0.15, x0.size)
-        for c, (before, after, label) in enumerate(rows):
+    lof = diag.lack_of_fit.get("tests", {})
+    trend_key = "trend_time" if diag.data.time is not None else "trend_file"
+    for c, (before, after, label) in enumerate(rows):
+        ylim = _limits([before[keep], after[keep]] if diag.cause != "none" else [before[keep]])
+        for j, name in enumerate([*cols, order_label]):
             ax = axes[c, j]
+            if name == order_label:
+                x0 = order_x
+                x = x0
+            else:
+                x0 = np.array(diag.variables[name], float)
+                x = x0
+                if np.unique(x0[np.isfinite(x0)]).size <= 3:  # categorical: jitter the points only
+                    x = x0 + rng.uniform(-0.15, 0.15, x0.size)
+            if name.startswith("load N"):
+                x0, x = x0 / 1e3, x / 1e3
             ax.axhline(0.0, color="k", lw=0.6)
-            ax.scatter(x, before, s=6, c=BEFORE, alpha=0.6, label="simulation")
+            ax.scatter(x[keep], before[keep], s=6, c=BEFORE, alpha=0.6, label="simulation")
             if diag.cause != "none":
-                ax.scatter(x, after, s=6, c=AFTER, alpha=0.5, label=diag.cause)
-            ok = np.isfinite(before)
-            groups = binned_means(before[ok], name, x0[ok])
+                ax.scatter(x[keep], after[keep], s=6, c=AFTER, alpha=0.5, label=f"{shown}, held-out")
+            if out.any():
+                _draw_outliers(ax, x[out], before[out], ylim)
+            ok = np.isfinite(before) & keep
+            groups = binned_means(before[ok], "run order" if name == order_label else name, x0[ok])
             if groups is not None:
                 bars = ax.errorbar(
-                    *groups[:2],
-                    yerr=groups[2],
-                    fmt="o-",
-                    color="k",
-                    ms=3,
-                    lw=1.0,
-                    capsize=2,
+                    *groups[:2], yerr=groups[2], fmt="o-", color="k", ms=3, lw=1.0, capsize=2,
                     label="simulation: group mean ± 95 %",
-                )
+                )  # fmt: skip
                 bars.lines[0].set_gid("group-means")
-            if c < 3:
+            ax.set_ylim(*ylim)
+            text = None
+            if c < 3 and name != order_label:
                 p = diag.residuals["before"][CHANNELS[c]]["p_values"].get(name)
                 if p is not None:
-                    ax.text(0.02, 0.97, f"ANOVA p = {p:.2g}", transform=ax.transAxes, fontsize=7, va="top")
+                    text = f"ANOVA p = {p:.2g}"
+            elif c == 0 and name == order_label and trend_key in lof:
+                text = f"drift test p = {lof[trend_key]['p']:.2g}\n(chosen model)"
+            if text:
+                ax.text(0.03, 0.97, text, transform=ax.transAxes, fontsize=7, va="top", gid="p-value",
+                        bbox={"fc": "white", "ec": "none", "alpha": 0.7, "pad": 1.0})  # fmt: skip
+            if name in ("spin sign", "roll"):
+                ax.set_xticks([-1, 0, 1])
+            else:
+                ax.xaxis.set_major_locator(MaxNLocator(nbins=XTICKS, min_n_ticks=2))
+            ax.tick_params(labelsize=8)
             if c == len(rows) - 1:
-                ax.set_xlabel(name)
+                ax.set_xlabel("load N (kN)" if name.startswith("load N") else name, fontsize=9)
             if j == 0:
-                ax.set_ylabel(label)
+                ax.set_ylabel(label, fontsize=9)
             if j == 0 and c < 3:
                 st = diag.residuals["before"][CHANNELS[c]]
                 ax.set_title(
-                    f"{CHANNELS[c]}: {st['verdict']} (p={st['p_adjusted']:.2g})",
-                    fontsize=8,
-                    loc="left",
+                    f"{CHANNELS[c]}: {st['verdict']} (p={st['p_adjusted']:.2g})", fontsize=8, loc="left"
                 )
-    axes[0, -1].legend(fontsize=7, loc="upper right")
+    handles, labels = [], []
+    for ax in axes.ravel():
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(len(labels), 4), fontsize=8)
     fig.suptitle(
-        "residuals (measured − predicted) vs kinematics: flat band = noise, trend or step = structure"
+        "residuals (measured − predicted) vs kinematics and run order: "
+        "flat band = noise, trend or step = structure"
     )
     return fig
 

@@ -1,4 +1,4 @@
-"""Measured rig data: the friction CSV of INTERFACE.md, read and validated.
+"""Measured rig data: the friction CSV (docs/diagnose.md), read and validated.
 
 Columns (SI, header row, one row per test point; other columns are ignored):
 
@@ -9,14 +9,24 @@ Columns (SI, header row, one row per test point; other columns are ignored):
 ``Mz``      friction torque on the tire about the patch origin, N·m
 ``N``       optional normal load of the point, N (default: the simulation's)
 ``roll``    optional −1, 0 or +1 (default 0): which pressure map applies
+``time``    optional: when the point was measured (s, or any increasing run
+            index); the run-order test uses it besides the row order
 =========== ==========================================================
 
 Blank lines and lines whose first non-blank character is ``#`` are skipped
 (before and after the header). Every problem is a one-line
 :class:`~fepost.errors.DataError` naming the file, the line and the column.
 
+Limits: at most :data:`MAX_ROWS` test points (a rig programme has hundreds;
+diagnose takes 1–4 ms per point on a 2-core machine, 7 s for 5000 points, see
+``benchmarks/bench_diagnose.py``) and
+files of at most :data:`MAX_BYTES`; both are refused before the rows are parsed,
+so a file of a million rows is turned away in a second rather than diagnosed for
+an hour. A cell longer than :data:`MAX_CELL` characters is an error.
+
 :func:`check_plausible` compares the data with the simulation (units, dead
-channels, rolling rows without a rolling map) once f, N and R are known.
+channels, a test programme in which nothing varies, rolling rows without a
+rolling map) once f, N and R are known.
 """
 
 from __future__ import annotations
@@ -31,15 +41,25 @@ import numpy as np
 
 from .._arrays import frozen
 from ..errors import DataError, FepostWarning
+from ..output import write_text_atomic
 
 REQUIRED = ("vx", "vy", "wz", "Fx", "Fy", "Mz")
-OPTIONAL = ("N", "roll")
+OPTIONAL = ("N", "roll", "time")
 CHANNELS = ("Fx", "Fy", "Mz")
 
 #: Fewest test points diagnose accepts: 5-fold cross-validation keeps ≥ 4 points
 #: per held-out fold, and the richest candidate (f + 3 offsets + 3 channel
 #: variances = 7 parameters) is then fitted to ≥ 48 observations (16 rows × 3).
 MIN_ROWS = 20
+#: Fewest distinct test points (vx, vy, wz, N, roll): the joint models of two
+#: causes have up to 6 parameters of the mean.
+MIN_DISTINCT = 6
+#: Most test points diagnose accepts (see the module docstring).
+MAX_ROWS = 5000
+#: Largest measured-data file read (bytes): 5000 rows of a dozen numbers are ~1 MB.
+MAX_BYTES = 64 * 1024 * 1024
+#: Longest cell (characters): the csv module's default field limit, 128 kB.
+MAX_CELL = 131072
 
 #: |F|/(f·N) above this is not a friction force in N (kN given as N, or N·m in
 #: a force column): error. The largest physical value is about 1 (α ≤ 2 allows 2).
@@ -56,7 +76,8 @@ class UnitsWarning(FepostWarning):
 class MeasuredData:
     """Rig test points (SI). Arrays have one entry per row; ``N`` is None when absent.
 
-    ``lines`` are the 1-based line numbers of the rows in the source file.
+    ``lines`` are the 1-based line numbers of the rows in the source file;
+    ``time`` (optional) when each point was measured.
     """
 
     vx: np.ndarray
@@ -69,10 +90,11 @@ class MeasuredData:
     roll: np.ndarray | None = None
     lines: np.ndarray | None = None
     source: str = ""
+    time: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = np.size(self.vx)
-        for name in ("vx", "vy", "wz", "Fx", "Fy", "Mz", "N"):
+        for name in ("vx", "vy", "wz", "Fx", "Fy", "Mz", "N", "time"):
             value = getattr(self, name)
             if value is None:
                 continue
@@ -116,6 +138,7 @@ class MeasuredData:
     def to_dict(self) -> dict:
         d = {name: getattr(self, name).tolist() for name in ("vx", "vy", "wz", "Fx", "Fy", "Mz", "roll")}
         d["N"] = None if self.N is None else self.N.tolist()
+        d["time"] = None if self.time is None else self.time.tolist()
         d["source"] = self.source
         return d
 
@@ -135,12 +158,27 @@ def _number(text: str, where: str, column: str) -> float:
 def parse_csv(text: str, source: str = "") -> MeasuredData:
     """Parse the CSV ``text`` (see the module docstring); ``source`` names it in messages."""
     src = f"{source}: " if source else ""
+    lines_all = text.splitlines()
+    count = sum(1 for line in lines_all if line.strip() and not line.lstrip().startswith("#"))
+    if count - 1 > MAX_ROWS:
+        raise DataError(
+            f"{src}{count - 1} data rows: diagnose takes at most {MAX_ROWS} test points "
+            "(a rig programme has hundreds; average replicates or split the file)"
+        )
     rows: list[tuple[int, list[str]]] = []
-    for lineno, line in enumerate(io.StringIO(text), start=1):
+    for lineno, line in enumerate(lines_all, start=1):
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
             continue
-        fields = next(csv.reader([line.rstrip("\r\n")]))
+        try:
+            fields = next(csv.reader([line]))
+        except csv.Error as exc:
+            if "field limit" in str(exc):
+                raise DataError(f"{src}line {lineno}: a cell is longer than {MAX_CELL} characters") from None
+            raise DataError(f"{src}line {lineno}: not a CSV line ({exc})") from None
+        long = [j for j, c in enumerate(fields) if len(c) > MAX_CELL]
+        if long:
+            raise DataError(f"{src}line {lineno}: a cell is longer than {MAX_CELL} characters")
         rows.append((lineno, fields))
     if not rows:
         raise DataError(f"{src}no header row: the file is empty or only comments")
@@ -179,13 +217,26 @@ def parse_csv(text: str, source: str = "") -> MeasuredData:
     return MeasuredData(
         vx=arr["vx"], vy=arr["vy"], wz=arr["wz"],
         Fx=arr["Fx"], Fy=arr["Fy"], Mz=arr["Mz"],
-        N=arr.get("N"), roll=roll, lines=np.asarray(lines, int), source=source,
+        N=arr.get("N"), roll=roll, lines=np.asarray(lines, int), source=source, time=arr.get("time"),
     )  # fmt: skip
 
 
 def read_measured(path) -> MeasuredData:
     """Read a measured-friction CSV file (see the module docstring)."""
     path = Path(path)
+    try:
+        size = path.stat().st_size
+    except FileNotFoundError:
+        raise DataError(f"{path}: no such file") from None
+    except OSError as exc:
+        raise DataError(f"{path}: cannot read the measured data ({exc.__class__.__name__})") from None
+    if path.is_dir():
+        raise DataError(f"{path}: is a folder, not a measured-data CSV file")
+    if size > MAX_BYTES:
+        raise DataError(
+            f"{path}: {size / 2**20:.0f} MB is too large for measured data "
+            f"(at most {MAX_BYTES // 2**20} MB and {MAX_ROWS} test points)"
+        )
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
@@ -196,12 +247,13 @@ def read_measured(path) -> MeasuredData:
 
 
 def write_csv(data: MeasuredData, path, comment: str = "") -> None:
-    """Write ``data`` in the INTERFACE CSV format (``#`` comment lines first)."""
+    """Write ``data`` in the measured-data CSV format (``#`` comment lines first), atomically."""
     path = Path(path)
     out = io.StringIO()
     for line in comment.splitlines():
         out.write(f"# {line}\n")
     cols = ["vx", "vy", "wz", "Fx", "Fy", "Mz"] + (["N"] if data.N is not None else []) + ["roll"]
+    cols += ["time"] if data.time is not None else []
     out.write(",".join(cols) + "\n")
     arrays = [getattr(data, c) for c in cols]
     for i in range(len(data)):
@@ -211,7 +263,22 @@ def write_csv(data: MeasuredData, path, comment: str = "") -> None:
             )
             + "\n"
         )
-    path.write_text(out.getvalue(), encoding="utf-8")
+    write_text_atomic(path, out.getvalue())
+
+
+def point_keys(data: MeasuredData) -> np.ndarray:
+    """One integer label per row: rows with equal vx, vy, wz, N and roll share it."""
+    cols = [data.vx, data.vy, data.wz, np.asarray(data.roll, float)]
+    if data.N is not None:
+        cols.append(data.N)
+    table = np.column_stack(cols)
+    _, labels = np.unique(table, axis=0, return_inverse=True)
+    return np.asarray(labels).ravel()
+
+
+def distinct_points(data: MeasuredData) -> int:
+    """Number of distinct test points (vx, vy, wz, N, roll) in ``data``."""
+    return int(np.unique(point_keys(data)).size)
 
 
 def check_plausible(
@@ -220,12 +287,15 @@ def check_plausible(
     """Reject or flag data that cannot be compared with the simulation.
 
     ``friction`` is the nominal f, ``load`` the simulation's N (N), ``radius``
-    its R (m). Errors (:class:`DataError`): fewer than :data:`MIN_ROWS` rows;
-    a channel that is zero in every row (dead sensor); roll = ±1 rows when no
-    rolling map was given (the static map would silently stand in for it);
-    |Fx|, |Fy| above ``UNITS_ERROR_RATIO``·f·N or |Mz| above that times f·N·R
-    in any row (wrong units). Warning (:class:`UnitsWarning`): the largest force
-    of the sliding rows is below ``UNITS_SMALL_RATIO``·f·N (kN given as N?).
+    its R (m). Errors (:class:`DataError`), in this order: fewer than
+    :data:`MIN_ROWS` rows; no row that slides or spins; fewer than
+    :data:`MIN_DISTINCT` distinct test points (nothing varies); a channel that is
+    zero in every row (dead sensor); roll = ±1 rows when no rolling map was given
+    (the static map would silently stand in for it); |Fx|, |Fy| above
+    ``UNITS_ERROR_RATIO``·f·N or |Mz| above that times f·N·R in any row (wrong
+    units); a channel with one value in every row (dead sensor). Warning
+    (:class:`UnitsWarning`): the largest force of the sliding rows is below
+    ``UNITS_SMALL_RATIO``·f·N (kN given as N?).
     """
     src = f"{data.source}: " if data.source else ""
     n = len(data)
@@ -233,6 +303,15 @@ def check_plausible(
         raise DataError(
             f"{src}{n} test points are too few: the candidate models and the 5-fold check "
             f"need at least {MIN_ROWS}"
+        )
+    if not np.any((data.vx != 0) | (data.vy != 0) | (data.wz != 0)):
+        raise DataError(f"{src}columns vx, vy, wz are zero in every row: nothing slides or spins")
+    points = distinct_points(data)
+    if points < MIN_DISTINCT:
+        what = "every row is the same test point" if points == 1 else f"only {points} distinct test points"
+        raise DataError(
+            f"{src}columns vx, vy, wz: {what}; nothing varies enough to tell causes apart "
+            f"(at least {MIN_DISTINCT} are needed)"
         )
     for c in CHANNELS:
         if np.all(getattr(data, c) == 0.0):
@@ -252,6 +331,12 @@ def check_plausible(
             raise DataError(
                 f"{src}line {line}, column {c}: |{c}| is {ratio[i]:.3g} x {unit} "
                 f"(f = {friction:g}, N = {loads[i]:.6g} N, R = {radius:.4g} m): wrong units?"
+            )
+    for c in CHANNELS:
+        values = getattr(data, c)
+        if np.all(values == values[0]):
+            raise DataError(
+                f"{src}column {c} has the same value in every row: a dead channel cannot be diagnosed"
             )
     sliding = np.hypot(data.vx, data.vy) > 0
     if np.any(sliding):

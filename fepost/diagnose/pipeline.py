@@ -1,17 +1,25 @@
-"""``diagnose``: measured rig data against the simulation, the cause and the gain.
+"""``diagnose``: measured rig data against the simulation, the cause(s) and the gain.
 
 The steps (each a module of this package):
 
 1. :mod:`~fepost.diagnose.measured` reads and checks the CSV;
    :mod:`~fepost.diagnose.simulation` puts the FE maps on the fit grid.
 2. :mod:`~fepost.diagnose.causes` builds every candidate cause as a model over
-   the exact integrals; :mod:`~fepost.diagnose.fitting` fits each to all points
-   and, for the held-out check, to each training fold.
-3. :mod:`~fepost.diagnose.selection` scores them (BIC, nesting tests, held-out
-   log density) and names the cause.
-4. :mod:`~fepost.diagnose.residuals` says whether the misfit before and after
-   is noise or structure; the paper's closed forms (THEORY.md §4) are compared
-   with the data and with the exact integrals.
+   the exact integrals (:mod:`~fepost.diagnose.models`).
+3. :mod:`~fepost.diagnose.robust` fits every candidate with Huber's loss, flags
+   the rows no candidate explains (outliers, left out from here on) and picks
+   the reference prediction of the noise model; each channel's noise structure
+   (constant, proportional, combined) is chosen by BIC (:mod:`~fepost.diagnose.noise`).
+4. :mod:`~fepost.diagnose.fitting` fits each candidate by maximum likelihood
+   under that noise model, to all kept rows and, for the held-out check, to each
+   training fold; :mod:`~fepost.diagnose.selection` scores them (BIC, nesting
+   tests, held-out log density) and names the primary cause.
+5. :mod:`~fepost.diagnose.pairs` tries a second cause on top of it by the same
+   rules, and a friction level other than nominal.
+6. :mod:`~fepost.diagnose.lackfit` asks whether the chosen model leaves
+   structure (pure error, run-order drift); :mod:`~fepost.diagnose.residuals`
+   tests the residuals against the kinematics; the paper's closed forms are
+   compared with the data and with the exact integrals.
 """
 
 from __future__ import annotations
@@ -20,12 +28,17 @@ import time
 
 import numpy as np
 
+from ..errors import ArgumentError
 from ..friction.closed_form import components
-from .causes import Predictor, build_candidates
+from .causes import EXTENSIONS, Predictor, build_candidates, extension_parameters, joint_candidate
 from .fitting import fit
+from .lackfit import lack_of_fit
 from .measured import MeasuredData, check_plausible, read_measured
+from .noise import Noise, select_structure
+from .pairs import correlated_parameters, friction_test, search_pairs
 from .residuals import kinematic_variables, residual_structure
 from .result import Diagnosis, ParameterEstimate
+from .robust import robust_pass
 from .selection import (
     FOLDS,
     crossvalidate,
@@ -42,9 +55,9 @@ def _rmse(res: np.ndarray) -> float:
 
 
 def closed_form_prediction(sim: Simulation, data: MeasuredData) -> np.ndarray:
-    """The paper's closed forms (THEORY.md §4) at the data's points, (n, 3) in SI.
+    """The paper's closed forms (docs/theory.md) at the data's points, (n, 3) in SI.
 
-    F0, M0, a, m from the static map's moments (THEORY.md §2) with the nominal
+    F0, M0, a, m from the static map's moments (docs/theory.md) with the nominal
     f; k_x from the rolling map (its sign flipped for roll = −1, 0 for roll = 0);
     F0 and M0 scale with the row's load N/N_sim.
     """
@@ -72,6 +85,30 @@ def closed_form_prediction(sim: Simulation, data: MeasuredData) -> np.ndarray:
     return out
 
 
+def screen(cands: dict, Y: np.ndarray):
+    """Step 3: the robust pass, the rows kept and the noise model (with its selection tables)."""
+    g0 = np.abs(cands["none"].predict(np.empty(0)))
+    rob = robust_pass(cands, Y, g0)
+    rows = np.setdiff1d(np.arange(Y.shape[0]), rob.outliers)
+    noise, tables = _noise_model(rob, cands, Y, rows)
+    return rob, rows, noise, tables
+
+
+def _noise_model(rob, cands, Y, rows) -> tuple[Noise, dict]:
+    """The noise model of every Gaussian fit: reference magnitudes and per-channel structure."""
+    ref = rob.fits[rob.reference]
+    g = np.abs(ref.model.predict(ref.values))
+    res = (Y - ref.model.predict(ref.values))[rows]
+    structure, tables = [], {}
+    from .measured import CHANNELS
+
+    for c, ch in enumerate(CHANNELS):
+        best, table = select_structure(res[:, c], g[rows, c])
+        structure.append(best)
+        tables[ch] = table
+    return Noise.start(tuple(structure), g), tables
+
+
 def diagnose(
     simulation,
     measured,
@@ -82,18 +119,24 @@ def diagnose(
     n_folds: int = FOLDS,
     nr: int = FIT_NR,
     nphi: int = FIT_NPHI,
+    pairs: bool = True,
     analyse_kwargs: dict | None = None,
 ) -> Diagnosis:
-    """Compare measured friction data with the simulation and name the cause of the misfit.
+    """Compare measured friction data with the simulation and name the cause(s) of the misfit.
 
     ``simulation``/``rolling``: FE exports (paths or ContactFields, through
     :func:`fepost.analysis.analyse`), polar maps in the patch frame, or a ready
     :class:`~fepost.diagnose.simulation.Simulation`. ``measured``: a CSV path or
     :class:`~fepost.diagnose.measured.MeasuredData`. ``friction``: nominal f.
     ``seed`` shuffles the cross-validation folds. ``nr``/``nphi``: the fit grid.
+    ``pairs``: look for a second cause (module docstring, step 5).
     Raises :class:`~fepost.errors.DataError` on unusable data.
     """
     t0 = time.perf_counter()
+    if isinstance(seed, bool) or int(seed) != seed or seed < 0:
+        raise ArgumentError(f"seed must be a non-negative integer, got {seed!r}")
+    if isinstance(n_folds, bool) or int(n_folds) != n_folds or n_folds < 2:
+        raise ArgumentError(f"n_folds must be an integer of at least 2, got {n_folds!r}")
     sim = load_simulation(simulation, rolling, friction=friction, nr=nr, nphi=nphi, **(analyse_kwargs or {}))
     data = measured if isinstance(measured, MeasuredData) else read_measured(measured)
     check_plausible(
@@ -106,61 +149,145 @@ def diagnose(
 
     pred = Predictor(sim, data)
     cands = build_candidates(pred)
-    Y = data.forces / pred.scale
-    fits = {name: fit(c, Y) for name, c in cands.items()}
-    parts = folds(len(data), n_folds, seed)
+    table = extension_parameters(pred)
+    scale = pred.scale
+    Y = data.forces / scale
+
+    # 3. robust fits, outliers, noise model
+    rob, rows, noise, noise_tables = screen(cands, Y)
+    t_robust = time.perf_counter() - t0
+
+    # 4. Gaussian fits on the kept rows, held-out check, the primary cause
+    fits = {
+        name: fit(c, Y, rows, start=rob.fits[name].values if c.n_params else None, noise=noise)
+        for name, c in cands.items()
+    }
+    parts = folds(rows, n_folds, seed)
     cvs = {name: crossvalidate(c, Y, parts, fits[name]) for name, c in cands.items()}
     scores = score_candidates(cands, fits, cvs)
-    best = scores[0]
-    cause = best.name
-    cand = cands[cause]
-    bf = fits[cause]
+    primary = scores[0].name
+    t_single = time.perf_counter() - t0
+
+    # 5. a second cause
+    search = None
+    final_cand, final_fit, final_cv = cands[primary], fits[primary], cvs[primary]
+    causes = [primary]
+    if pairs and primary in EXTENSIONS:
+        search = search_pairs(pred, cands, fits, cvs, primary, Y, parts, table)
+        chosen = search.chosen
+        if chosen is not None and chosen.fit is not None and chosen.cv is not None:
+            final_cand = joint_candidate(pred, (primary, chosen.second), table)
+            final_fit, final_cv = chosen.fit, chosen.cv
+            causes.append(chosen.second)
+        ft = friction_test(final_cand, final_fit, final_cv, Y, parts, sim.friction)
+        search = type(search)(search.primary, search.trials, search.chosen, ft, search.indistinguishable)
+        if ft.get("admissible"):
+            causes.append("friction_level")
+    t_pairs = time.perf_counter() - t0
+
+    model = final_fit.model if final_fit.model is not None else final_cand
+    owner = {}
+    for ext in final_cand.extensions:
+        for p in table[ext]:
+            owner[p.name] = ext
     params = {
-        p.name: ParameterEstimate(p.name, float(v), (float(lo), float(hi)), p.unit, p.description)
-        for p, v, (lo, hi) in zip(cand.parameters, bf.values, bf.ci95, strict=True)
+        p.name: ParameterEstimate(
+            p.name,
+            float(v),
+            (float(lo), float(hi)),
+            p.unit,
+            p.description,
+            owner.get(p.name, "friction_level"),
+        )  # fmt: skip
+        for p, v, (lo, hi) in zip(final_cand.parameters, final_fit.values, final_fit.ci95, strict=True)
     }
 
-    scale = pred.scale
     before = cands["none"].predict(np.empty(0)) * scale
-    after = cand.predict(bf.values) * scale
-    heldout = data.forces - cvs[cause].residuals * scale
+    after = model.predict(final_fit.values) * scale
+    heldout = after.copy()
+    heldout[final_cv.rows] = data.forces[final_cv.rows] - final_cv.residuals * scale
     closed = closed_form_prediction(sim, data)
     meas = data.forces
+    none_cv = cvs["none"]
+    sigma = final_fit.noise.sigma()
 
     gain = {
-        "rmse_before": cvs["none"].rmse,
-        "rmse_after": cvs[cause].rmse,
-        "delta_bic": best.delta_bic,
-        "delta_aicc": best.delta_aicc,
-        "rmse_before_channels": cvs["none"].rmse_channels.tolist(),
-        "rmse_after_channels": cvs[cause].rmse_channels.tolist(),
+        "rmse_before": none_cv.rmse,
+        "rmse_after": final_cv.rmse,
+        "delta_bic": final_fit.bic - fits["none"].bic,
+        "delta_aicc": final_fit.aicc - fits["none"].aicc,
+        "rmse_before_channels": none_cv.rmse_channels.tolist(),
+        "rmse_after_channels": final_cv.rmse_channels.tolist(),
         "rmse_units": "scaled: Fx, Fy by f0 N; Mz by f0 N R",
-        "heldout": f"{n_folds}-fold cross-validation (folds shuffled with seed {seed})",
-        "delta": "score(cause) - score(none); negative favours the cause",
+        "heldout": f"{n_folds}-fold cross-validation (folds shuffled with seed {seed}), outliers left out",
+        "delta": "score(chosen model) - score(none); negative favours the model",
+        "model": final_cand.name,
     }
     variables = kinematic_variables(data.vx, data.vy, data.wz, sim.radius, data.loads(sim.load), data.roll)
-    residuals = {
-        "before": residual_structure((meas - before) / scale, variables),
-        "after": residual_structure((meas - heldout) / scale, variables),
+    kept_vars = {k: np.asarray(v)[rows] for k, v in variables.items()}
+    residuals: dict = {
+        "before": residual_structure(((meas - before) / scale / sigma)[rows], kept_vars),
+        "after": residual_structure(((meas - heldout) / scale / sigma)[rows], kept_vars),
+        "units": "standardised: residual / noise SD of the chosen model (outliers left out)",
     }
+    for key in ("before", "after"):
+        for c, ch in enumerate(("Fx", "Fy", "Mz")):
+            r = ((meas - (before if key == "before" else heldout)) / scale)[rows, c]
+            residuals[key][ch]["rmse"] = _rmse(r)
+            residuals[key][ch]["mean"] = float(np.mean(r))
+    lof = lack_of_fit(
+        data,
+        rows,
+        (Y - model.predict(final_fit.values))[rows],
+        model.predict(final_fit.values)[rows],
+        sigma[rows],
+        final_fit.jacobian,
+    )
     closed_form = {
-        "rmse_vs_data": _rmse((meas - closed) / scale),
+        "rmse_vs_data": _rmse(((meas - closed) / scale)[rows]),
         "rmse_vs_exact": _rmse((closed - before) / scale),
-        "exact_rmse_vs_data": _rmse((meas - before) / scale),
+        "exact_rmse_vs_data": _rmse(((meas - before) / scale)[rows]),
         "max_abs_vs_exact": np.max(np.abs(closed - before) / scale, axis=0).tolist(),
         "coefficients": {k: sim.coefficients.to_dict()[k] for k in ("F0", "M0", "a", "m", "R")}
         | {"k_x": sim.coefficients.k_x},
-        "note": "F0, M0, a, m from the static map's moments (THEORY.md §2); scaled RMSEs",
+        "note": "F0, M0, a, m from the static map's moments; scaled RMSEs",
     }
     notes = design_notes(data.vx, data.vy, data.wz, sim.radius, data.N)
+    separation = []
+    if len(final_cand.extensions) > 1:
+        first, second = (tuple(q.name for q in table[e]) for e in final_cand.extensions[:2])
+        for a, b, r in correlated_parameters(final_fit, first, second):
+            separation.append(
+                f"{a} ({final_cand.extensions[0]}) and {b} ({final_cand.extensions[1]}) are correlated "
+                f"(r = {r:+.2f}) on this programme: other test points would separate them better"
+            )
+    if "friction_level" in causes[1:]:
+        for _f, b, r in correlated_parameters(final_fit, ("f",), tuple(owner)):
+            separation.append(
+                f"f and {b} ({owner[b]}) are correlated (r = {r:+.2f}): the friction level is "
+                "partly confounded with it on this programme"
+            )
+    noise_info = final_fit.noise.to_dict()
+    for ch, table_c in noise_tables.items():
+        noise_info[ch]["bic"] = {k: v["bic"] for k, v in table_c.items()}
+    noise_info["criterion"] = (
+        "per channel, lowest BIC among constant, proportional and combined on the residuals of the "
+        f"reference fit ({rob.reference}); |F_ref| = its predicted magnitude"
+    )
     elapsed = time.perf_counter() - t0
+    indist = (
+        tuple(indistinguishable(scores, cands)) if search is None or search.chosen is None
+        else search.indistinguishable
+    )  # fmt: skip
     return Diagnosis(
-        cause=cause,
+        cause=primary,
+        causes=tuple(causes),
         parameters=params,
         gain=gain,
         candidates=tuple(scores),
-        indistinguishable=tuple(indistinguishable(scores, cands)),
+        indistinguishable=indist,
         design_notes=tuple(notes),
+        separation=tuple(separation),
         residuals=residuals,
         closed_form=closed_form,
         simulation=sim.to_dict(),
@@ -173,10 +300,19 @@ def diagnose(
         },
         scales=scale,
         variables=variables,
+        outliers=tuple(int(i) for i in rob.outliers),
+        lack_of_fit=lof,
+        noise=noise_info,
+        sigma=sigma,
+        robust=rob.to_dict(),
+        pairs=None if search is None else search.to_dict(),
         info={
             "folds": n_folds,
             "seed": seed,
             "seconds": elapsed,
+            "seconds_robust": t_robust,
+            "seconds_single": t_single,
+            "seconds_pairs": t_pairs - t_single,
             "exact_evaluations": pred.evaluations,
         },
     )

@@ -1,4 +1,4 @@
-"""The diagnosis as an immutable result: cause, extension, gain, ranking, evidence."""
+"""The diagnosis as an immutable result: cause(s), extension, gain, ranking, evidence."""
 
 from __future__ import annotations
 
@@ -13,13 +13,14 @@ from .selection import Score
 
 @dataclass(frozen=True)
 class ParameterEstimate:
-    """A fitted parameter: ``value`` and 95 % interval ``ci95`` in ``unit``."""
+    """A fitted parameter: ``value`` and 95 % interval ``ci95`` in ``unit``; ``cause`` it belongs to."""
 
     name: str
     value: float
     ci95: tuple[float, float]
     unit: str
     description: str = ""
+    cause: str = ""
 
     def covers(self, truth: float) -> bool:
         return self.ci95[0] <= truth <= self.ci95[1]
@@ -30,6 +31,7 @@ class ParameterEstimate:
             "ci95": [self.ci95[0], self.ci95[1]],
             "unit": self.unit,
             "description": self.description,
+            "cause": self.cause,
         }
 
 
@@ -40,8 +42,15 @@ class Diagnosis:
     ``predictions`` hold (n, 3) arrays in SI (Fx, Fy in N, Mz in N·m):
     ``before`` (the simulation: exact integrals, nominal f), ``after`` (the named
     extension fitted to all points), ``after_heldout`` (each point predicted by the
-    fit without its fold) and ``closed_form`` (the paper's formulas, THEORY.md §4).
+    fit without its fold) and ``closed_form`` (the paper's formulas, docs/theory.md).
     ``scales`` are the channel scales (f₀N, f₀N, f₀NR) that make RMSEs dimensionless.
+
+    ``cause`` is the primary cause and ``causes`` every cause of the chosen model
+    (primary first); ``parameters`` and ``gain`` are the chosen model's.
+    ``outliers`` are 0-based data rows left out of every fit; ``sigma`` (n, 3)
+    the noise SD of every row under the chosen noise model (scaled units);
+    ``lack_of_fit`` the verdict of :func:`~fepost.diagnose.lackfit.lack_of_fit`;
+    ``separation`` what the test programme cannot separate within the chosen model.
     """
 
     cause: str
@@ -57,6 +66,14 @@ class Diagnosis:
     predictions: dict
     scales: np.ndarray
     variables: dict
+    causes: tuple[str, ...] = ()
+    separation: tuple[str, ...] = ()
+    outliers: tuple[int, ...] = ()
+    lack_of_fit: dict = field(default_factory=dict)
+    noise: dict = field(default_factory=dict)
+    sigma: np.ndarray | None = None
+    robust: dict = field(default_factory=dict)
+    pairs: dict | None = None
     info: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -64,6 +81,10 @@ class Diagnosis:
         object.__setattr__(self, "variables", {k: frozen(v) for k, v in self.variables.items()})
         object.__setattr__(self, "scales", frozen(self.scales))
         object.__setattr__(self, "candidates", tuple(self.candidates))
+        object.__setattr__(self, "causes", tuple(self.causes) or (self.cause,))
+        object.__setattr__(self, "outliers", tuple(int(i) for i in self.outliers))
+        if self.sigma is not None:
+            object.__setattr__(self, "sigma", frozen(self.sigma))
 
     @property
     def confident(self) -> bool:
@@ -77,12 +98,21 @@ class Diagnosis:
         raise KeyError(name)
 
     def to_dict(self) -> dict:
-        """The diagnosis JSON of INTERFACE.md, with the evidence under extra keys."""
+        """The diagnosis JSON (keys in docs/diagnose.md), with the evidence under extra keys."""
+        lines = self.data.lines
         return {
             "cause": self.cause,
+            "causes": list(self.causes),
             "parameters": {k: p.to_dict() for k, p in self.parameters.items()},
             "gain": dict(self.gain),
             "candidates": [s.to_dict() for s in self.candidates],
+            "lack_of_fit": dict(self.lack_of_fit),
+            "outliers": list(self.outliers),
+            "outlier_lines": [int(lines[i]) for i in self.outliers] if lines is not None else [],
+            "outlier_rule": dict(self.robust),
+            "noise_model": dict(self.noise),
+            "pairs": self.pairs,
+            "separation": list(self.separation),
             "criterion": "BIC",
             "confident": self.confident,
             "indistinguishable": list(self.indistinguishable),
@@ -104,57 +134,6 @@ class Diagnosis:
 
     def summary(self) -> str:
         """A short human-readable account (the ``summary.txt`` of ``fepost diagnose``)."""
-        g = self.gain
-        lines = [f"cause: {self.cause}"]
-        best = self.candidates[0]
-        if self.cause == "none":
-            lines.append("no extension earns its parameters: the misfit is within the noise")
-        else:
-            lines.append(f"  {best.fit.name}: {self._describe()}")
-            for name, p in self.parameters.items():
-                lines.append(
-                    f"  {name} = {p.value:.6g} {p.unit}  (95 % CI {p.ci95[0]:.6g} .. {p.ci95[1]:.6g})"
-                )
-        lines.append(
-            f"held-out RMSE (scaled, {self.info.get('folds', 5)}-fold): before {g['rmse_before']:.4g}, "
-            f"after {g['rmse_after']:.4g}; delta BIC vs the simulation {g['delta_bic']:.1f}"
-        )
-        if self.indistinguishable:
-            lines.append(
-                "indistinguishable on these data (delta BIC < 10, both pass the nesting tests): "
-                + ", ".join(self.indistinguishable)
-            )
-        for note in self.design_notes:
-            lines.append(f"design: {note}")
-        for key, title in (("before", "simulation"), ("after", "extended model")):
-            parts = []
-            for ch, st in self.residuals[key].items():
-                parts.append(
-                    f"{ch} {st['verdict']} (rmse {st['rmse']:.3g}, worst: {st['strongest']}, "
-                    f"p={st['p_adjusted']:.2g})"
-                )
-            lines.append(f"residuals of the {title}: " + "; ".join(parts))
-        cf = self.closed_form
-        lines.append(
-            f"paper closed forms: RMSE vs data {cf['rmse_vs_data']:.4g}, vs exact integrals "
-            f"{cf['rmse_vs_exact']:.4g} (exact vs data {cf['exact_rmse_vs_data']:.4g}), scaled"
-        )
-        lines.append("candidates (BIC, lower is better; admissible first):")
-        for s in self.candidates:
-            mark = "*" if s.admissible else " "
-            lines.append(
-                f" {mark} {s.name:<29} BIC {s.fit.bic:11.1f}  dBIC {s.delta_bic:9.1f}  "
-                f"cv-rmse {s.cv.rmse:.4g}"
-            )
-        return "\n".join(lines) + "\n"
+        from .summary import summary_text
 
-    def _describe(self) -> str:
-        return {
-            "friction_level": "one friction coefficient other than the nominal one",
-            "pressure_dependent_friction": "the local friction coefficient depends on the contact pressure",
-            "speed_dependent_friction": "the local friction coefficient depends on the sliding speed",
-            "elliptic_patch": "the real patch is elongated relative to the simulated one",
-            "anisotropic_friction": "friction differs along x and along y",
-            "pressure_shift": "the real centre of pressure lies elsewhere",
-            "sensor_offset": "constant offsets in the measured channels",
-        }.get(self.cause, "")
+        return summary_text(self)

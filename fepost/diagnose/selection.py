@@ -1,9 +1,11 @@
 """Choosing the cause: BIC, a nesting test and a held-out check.
 
-Every candidate is fitted to all points (:mod:`fepost.diagnose.fitting`) and
-scored by the Bayesian information criterion BIC = −2ℓ + k ln(n_obs), with ℓ
-the Gaussian log-likelihood with one noise variance per channel profiled out,
-k = model parameters + 3 variances, n_obs = 3 × test points.
+Every candidate is fitted to the rows kept (outliers left out,
+:mod:`fepost.diagnose.robust`) by maximum likelihood (:mod:`fepost.diagnose.fitting`)
+and scored by the Bayesian information criterion BIC = −2ℓ + k ln(n_obs), with ℓ
+the Gaussian log-likelihood under the noise model of
+:mod:`fepost.diagnose.noise` (its parameters estimated with the model's),
+k = model parameters + noise parameters, n_obs = 3 × rows.
 
 A candidate other than ``none`` is **admissible** when, against every model
 nested in it (``none`` and, for the extensions, ``friction_level``; see
@@ -16,8 +18,8 @@ nested in it (``none`` and, for the extensions, ``friction_level``; see
    stays below 5 %; without the nesting test the richer of two nested models
    wins on AIC about one time in six, P(χ²₁ > 2) = 0.157);
 3. its mean held-out log predictive density per observation under
-   :data:`FOLDS`-fold cross-validation (per-channel variances re-estimated on
-   each training set) is higher.
+   :data:`FOLDS`-fold cross-validation (noise parameters re-estimated on each
+   training set) is higher.
 
 ``none`` is always admissible. The cause is the admissible candidate of lowest
 BIC. Candidates are ranked admissible first, then by BIC.
@@ -37,8 +39,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from .causes import Candidate
 from .fitting import Fit, fit
+from .models import Candidate
 
 #: Folds of the held-out check.
 FOLDS = 5
@@ -50,10 +52,11 @@ INDISTINGUISHABLE_DBIC = 10.0
 
 @dataclass(frozen=True)
 class CrossValidation:
-    """Held-out predictions of one candidate: residuals (n, 3) and mean log density."""
+    """Held-out residuals (n_rows, 3) of ``rows`` and the mean log density per observation."""
 
     residuals: np.ndarray
     log_score: float
+    rows: np.ndarray
 
     @property
     def rmse(self) -> float:
@@ -64,9 +67,10 @@ class CrossValidation:
         return np.sqrt(np.mean(self.residuals**2, axis=0))
 
 
-def folds(n: int, k: int = FOLDS, seed: int = 0) -> list[np.ndarray]:
-    """``k`` disjoint held-out index sets covering ``range(n)``, shuffled by ``seed``."""
-    order = np.random.default_rng([seed, 11]).permutation(n)
+def folds(n, k: int = FOLDS, seed: int = 0) -> list[np.ndarray]:
+    """``k`` disjoint held-out index sets covering ``range(n)`` (or the rows ``n``), shuffled by ``seed``."""
+    rows = np.arange(n) if np.ndim(n) == 0 else np.asarray(n)
+    order = rows[np.random.default_rng([seed, 11]).permutation(rows.size)]
     return [np.sort(part) for part in np.array_split(order, k)]
 
 
@@ -78,23 +82,23 @@ def crossvalidate(cand: Candidate, Y: np.ndarray, parts: list[np.ndarray], full:
     by O(n^-1/2), so the Taylor error is third order in that difference.
     """
     cand = full.model if full.model is not None else cand
-    n = Y.shape[0]
-    res = np.empty_like(Y)
+    rows = np.sort(np.concatenate(parts))
+    res = np.full_like(Y, np.nan)
     logp = 0.0
     for held in parts:
-        train = np.setdiff1d(np.arange(n), held)
+        train = np.setdiff1d(rows, held)
         f = fit(
             cand,
             Y,
             train,
             start=full.values if cand.n_params else None,
-            sigma=full.sigma,
+            noise=full.noise,
             intervals=False,
         )
         r = Y[held] - cand.predict(f.values)[held]
         res[held] = r
-        logp += float(np.sum(stats.norm.logpdf(r, scale=f.sigma[None, :])))
-    return CrossValidation(res, logp / Y.size)
+        logp += float(np.sum(stats.norm.logpdf(r, scale=f.noise.sigma(held))))
+    return CrossValidation(res[rows], logp / (3 * rows.size), rows)
 
 
 @dataclass(frozen=True)

@@ -59,7 +59,7 @@ class Simulation:
 
     ``static``/``rolling``: maps on the fit grid (Pa, m); ``friction``: nominal f;
     ``coefficients``: the paper's coefficients of the input maps (for the closed
-    forms, THEORY.md §4); ``load`` N (N) and ``radius`` R (m) of the static map.
+    forms, docs/theory.md); ``load`` N (N) and ``radius`` R (m) of the static map.
     """
 
     static: PolarMap
@@ -89,7 +89,7 @@ class Simulation:
 
     @property
     def radius(self) -> float:
-        """R (m): the static map's radius (THEORY.md §1)."""
+        """R (m): the static map's radius (r_max about the static centre of pressure)."""
         return self.static.radius
 
     @property

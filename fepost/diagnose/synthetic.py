@@ -1,13 +1,17 @@
-"""Synthetic rig data with one hidden effect, made by the exact integrals.
+"""Synthetic rig data with hidden effects, made by the exact integrals.
 
 :func:`rig_programme` lays out a realistic rig programme: several sliding
 directions, several absolute speeds at the same speed ratios ε = |v|/(|ω|R),
 both spin signs, pure spin and pure sliding (optionally several loads and both
 rolling directions). :func:`synthesize` computes Fx, Fy, Mz at those points
 with :func:`~fepost.friction.exact.friction_resultants` on a fine quadrature of a
-pressure map (48 × 96 nodes, four times the fit grid's), with one effect of
-:data:`fepost.diagnose.causes.CAUSES` hidden in it, and adds Gaussian noise of
-``noise`` × (range of each clean channel).
+pressure map (48 × 96 nodes, four times the fit grid's), with one or several
+effects of :data:`fepost.diagnose.causes.CAUSES` hidden in it, and adds what rigs
+add: Gaussian noise in % of each channel's range and/or of the reading, gross
+errors on a few rows (sign flips, 2.5× spikes), a friction level drifting along
+the run order (with an optional ``time`` column and the file sorted by test
+condition). :class:`StribeckLaw` is a speed law fepost does not fit (an
+exponential fall of friction with sliding speed).
 
 The effects are applied here independently of the diagnosis's own models:
 through :class:`~fepost.friction.law.FrictionLaw` for the friction laws,
@@ -121,7 +125,13 @@ def rig_programme(
 
 @dataclass(frozen=True)
 class SyntheticData:
-    """Synthetic rig data: the CSV content (``data``), the hidden effect and its truth."""
+    """Synthetic rig data: the CSV content (``data``), the hidden effect(s) and the truth.
+
+    ``clean`` (n, 3) are the noise-free resultants (N, N, N·m) in file order,
+    ``noise_sd`` the noise SD per channel (3,) or per row and channel (n, 3),
+    ``outliers`` the 0-based rows given a gross error and ``glitch`` the factor
+    each row's forces were multiplied by (1, −1 for a sign flip, 2.5 for a spike).
+    """
 
     data: MeasuredData
     effect: str
@@ -130,10 +140,19 @@ class SyntheticData:
     noise_sd: np.ndarray
     friction: float
     meta: dict = field(default_factory=dict)
+    outliers: tuple[int, ...] = ()
+    glitch: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "clean", frozen(self.clean))
         object.__setattr__(self, "noise_sd", frozen(self.noise_sd))
+        glitch = np.ones(self.clean.shape[0]) if self.glitch is None else self.glitch
+        object.__setattr__(self, "glitch", frozen(glitch))
+        object.__setattr__(self, "outliers", tuple(int(i) for i in self.outliers))
+
+    @property
+    def effects(self) -> tuple[str, ...]:
+        return tuple(self.effect.split("+"))
 
     def to_dict(self) -> dict:
         return {
@@ -141,8 +160,50 @@ class SyntheticData:
             "truth": dict(self.truth),
             "noise_sd": self.noise_sd.tolist(),
             "friction": self.friction,
+            "outliers": list(self.outliers),
             **self.meta,
         }
+
+
+@dataclass(frozen=True)
+class StribeckLaw(FrictionLaw):
+    """A speed law fepost does not fit: μ = f · P(σ) · (r + (1 − r) exp(−|w|/v_s)).
+
+    ``ratio`` r = μ(∞)/μ(0) and ``speed_scale`` v_s (m/s): the exponential
+    (Stribeck-type) fall of friction with sliding speed, where fepost's
+    ``speed_dependent_friction`` is linear, μ = f (1 + c_v|w|). At |w| = 0 the
+    factor is 1, as the exact integrals' singularity subtraction assumes.
+    """
+
+    ratio: float = 1.0
+    speed_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name in ("ratio", "speed_scale"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise ArgumentError(f"{name} must be a positive number, got {value!r}")
+            object.__setattr__(self, name, float(value))
+
+    @property
+    def depends_on_speed(self) -> bool:
+        return self.ratio != 1.0
+
+    def speed_factor(self, speed) -> np.ndarray:
+        speed = np.asarray(speed, float)
+        return self.ratio + (1.0 - self.ratio) * np.exp(-speed / self.speed_scale)
+
+
+#: Other functional forms accepted in place of an effect's parameters.
+ALTERNATIVE_FORMS: dict[str, dict[str, float]] = {
+    "speed_dependent_friction": {"stribeck_ratio": 1.0, "stribeck_speed": 1.0},
+}
+#: Gross errors of :func:`synthesize` (``outliers``): the row's three forces
+#: multiplied by these, in turn (a sign flip, a 2.5× spike), as from a load-cell glitch.
+GLITCHES = (-1.0, 2.5)
+#: Seconds per test point of the ``time`` column (plus up to 5 s of jitter).
+SECONDS_PER_POINT = 20.0
 
 
 def _fine_quad(pmap: PolarMap) -> PressureQuadrature:
@@ -165,31 +226,55 @@ def _scaled(quad: PressureQuadrature, lam: float) -> PressureQuadrature:
 
 
 def _noisy(clean: np.ndarray, sd: np.ndarray, seed: int | None) -> np.ndarray:
-    """``clean`` plus independent Gaussian noise of SD ``sd`` per channel, drawn from ``seed``."""
+    """``clean`` plus independent Gaussian noise of SD ``sd`` (per channel or per entry), from ``seed``."""
     rng = np.random.default_rng(None if seed is None else [seed, 7])
     return clean + rng.normal(size=clean.shape) * sd
 
 
 def renoised(syn: SyntheticData, seed: int) -> SyntheticData:
-    """``syn`` with the same kinematics, effect and clean resultants but fresh noise from ``seed``.
+    """``syn`` with the same kinematics, effect, clean resultants and gross errors but fresh noise.
 
-    The noise SD per channel stays ``syn.noise_sd`` (N, N, N·m). Cheap (no
-    integrals): for Monte-Carlo studies of the intervals at a fixed test design.
+    The noise SD stays ``syn.noise_sd`` (N, N, N·m). Cheap (no integrals): for
+    Monte-Carlo studies of the intervals at a fixed test design.
     """
-    meas = _noisy(np.asarray(syn.clean), np.asarray(syn.noise_sd), seed)
+    glitch = np.ones(syn.clean.shape[0]) if syn.glitch is None else np.asarray(syn.glitch)
+    meas = _noisy(np.asarray(syn.clean), np.asarray(syn.noise_sd), seed) * glitch[:, None]
     data = replace(syn.data, Fx=meas[:, 0], Fy=meas[:, 1], Mz=meas[:, 2])
     return replace(syn, data=data, meta={**syn.meta, "noise_seed": seed})
 
 
+def _check_params(effects: tuple[str, ...], params: dict) -> None:
+    for effect in effects:
+        if effect not in CAUSES:
+            raise ArgumentError(f"effect must be one of {', '.join(CAUSES)}, got {effect!r}")
+    known = {k for e in effects for k in EFFECT_PARAMETERS[e]}
+    alt = {k for e in effects for k in ALTERNATIVE_FORMS.get(e, {})}
+    unknown = set(params) - known - alt
+    if unknown:
+        raise ArgumentError(
+            f"unknown parameter(s) {sorted(unknown)} for effect {'+'.join(effects)!r}; "
+            f"expected {sorted(known)}"
+        )
+    for e in effects:
+        need = [k for k in EFFECT_PARAMETERS[e] if k not in params]
+        other = ALTERNATIVE_FORMS.get(e)
+        if need and not (other and all(k in params for k in other)):
+            raise ArgumentError(f"effect {e!r} needs parameter(s) {need}")
+
+
 def synthesize(
     static: PolarMap,
-    effect: str = "none",
+    effect: str | tuple[str, ...] = "none",
     params: dict | None = None,
     *,
     rolling: PolarMap | None = None,
     friction: float = 0.3,
     n: int = 400,
     noise: float = 0.015,
+    noise_proportional: float = 0.0,
+    outliers: int = 0,
+    drift: float = 0.0,
+    time_column: bool = False,
     seed: int = 0,
     rolls=None,
     loads=None,
@@ -197,27 +282,36 @@ def synthesize(
 ) -> SyntheticData:
     """Rig data over ``static`` (and ``rolling``) maps with ``effect`` hidden in it.
 
-    ``params`` gives the effect's parameters (names as in
-    :data:`EFFECT_PARAMETERS`; the friction level of every effect but
-    ``friction_level`` is ``friction``). ``noise`` is the Gaussian noise SD as a
-    fraction of each clean channel's range (max − min). ``rolls`` defaults to
-    (−1, 0, 1) when a rolling map is given, else (0,); ``loads`` are load factors
-    (default: every row at the simulation's N, and no ``N`` column).
+    ``effect``: one name of :data:`~fepost.diagnose.causes.CAUSES` or several
+    (a tuple, or names joined by ``+``); ``params`` gives their parameters (names
+    as in :data:`EFFECT_PARAMETERS`, or for ``speed_dependent_friction`` the
+    exponential form ``stribeck_ratio``, ``stribeck_speed`` of
+    :class:`StribeckLaw`; the friction level of every effect but
+    ``friction_level`` is ``friction``).
+
+    Noise: Gaussian, independent, with SD² = (``noise`` × range of the clean
+    channel)² + (``noise_proportional`` × |clean value|)² (a load cell's error
+    in % of full scale and in % of reading). ``outliers``: that many rows,
+    chosen at random, get a gross error (:data:`GLITCHES` in turn, on all three
+    forces). ``drift``: the friction level changes by this fraction from the
+    first measured point to the last, linearly in the run order (−0.1: it falls
+    by 10 % as the tread warms). ``time_column``: the data get a ``time`` column
+    (:data:`SECONDS_PER_POINT` per point, in run order) and the rows are written
+    sorted by test condition instead of in run order, so only ``time`` shows the
+    run order.
+
+    ``rolls`` defaults to (−1, 0, 1) when a rolling map is given, else (0,);
+    ``loads`` are load factors (default: every row at the simulation's N, and no
+    ``N`` column).
     """
-    if effect not in CAUSES:
-        raise ArgumentError(f"effect must be one of {', '.join(CAUSES)}, got {effect!r}")
+    effects = tuple(effect.split("+")) if isinstance(effect, str) else tuple(effect)
     params = dict(params or {})
-    known = EFFECT_PARAMETERS[effect]
-    unknown = set(params) - set(known)
-    if unknown:
-        raise ArgumentError(
-            f"unknown parameter(s) {sorted(unknown)} for effect {effect!r}; expected {sorted(known)}"
-        )
-    missing = [k for k in known if k not in params]
-    if missing:
-        raise ArgumentError(f"effect {effect!r} needs parameter(s) {missing}")
-    if not (np.isfinite(noise) and noise >= 0):
-        raise ArgumentError(f"noise must be a non-negative fraction, got {noise!r}")
+    _check_params(effects, params)
+    for name, value in (("noise", noise), ("noise_proportional", noise_proportional)):
+        if not (np.isfinite(value) and value >= 0):
+            raise ArgumentError(f"{name} must be a non-negative fraction, got {value!r}")
+    if not np.isfinite(drift) or drift <= -1.0:
+        raise ArgumentError(f"drift must be a fraction above -1, got {drift!r}")
     if rolls is None:
         rolls = (-1, 0, 1) if rolling is not None else (0,)
     if rolling is None and any(r != 0 for r in rolls):
@@ -228,14 +322,21 @@ def synthesize(
     N_sim = quads[0].load
     R = static.radius
     kin = kinematics or rig_programme(R, n, seed=seed, rolls=rolls, loads=loads)
+    if not 0 <= int(outliers) <= kin.vx.size:
+        raise ArgumentError(f"outliers must be between 0 and the number of rows, got {outliers!r}")
     f = float(params.get("f", friction))
-    law = FrictionLaw(
-        f=f,
-        pressure_coef=float(params.get("c_p", 0.0)),
-        speed_coef=float(params.get("c_v", 0.0)),
-        anisotropy=float(params.get("alpha", 1.0)),
-        pressure_ref=quads[0].mean_pressure,
-    )
+    common = {
+        "f": f,
+        "pressure_coef": float(params.get("c_p", 0.0)),
+        "anisotropy": float(params.get("alpha", 1.0)),
+        "pressure_ref": quads[0].mean_pressure,
+    }
+    if "stribeck_ratio" in params:
+        law: FrictionLaw = StribeckLaw(
+            **common, ratio=float(params["stribeck_ratio"]), speed_scale=float(params["stribeck_speed"])
+        )
+    else:
+        law = FrictionLaw(**common, speed_coef=float(params.get("c_v", 0.0)))
     s = float(params.get("s", 1.0))
     dx, dy = float(params.get("dx", 0.0)), float(params.get("dy", 0.0))
     clean = np.empty((kin.vx.size, 3))
@@ -254,18 +355,46 @@ def synthesize(
                 quad = quad.shifted(sx * dx, dy)  # mirrored kinematics: the shift mirrors too
             res = friction_resultants(quad, sx * kin.vx[idx], kin.vy[idx], sx * kin.wz[idx], law)
             clean[idx] = np.column_stack([sx * res.Fx, res.Fy, sx * res.Mz])
-    if effect == "sensor_offset":
+    m = kin.vx.size
+    if drift:
+        clean *= 1.0 + drift * (np.arange(m) / max(m - 1, 1))[:, None]
+    if "sensor_offset" in effects:
         clean = clean + np.array([params["offset_Fx"], params["offset_Fy"], params["offset_Mz"]])
     sd = noise * (clean.max(axis=0) - clean.min(axis=0))
+    if noise_proportional:
+        sd = np.sqrt(sd[None, :] ** 2 + (noise_proportional * clean) ** 2)
     meas = _noisy(clean, sd, seed)
+    rng = np.random.default_rng([seed, 13])
+    glitch = np.ones(m)
+    bad = np.sort(rng.choice(m, size=int(outliers), replace=False)) if outliers else np.zeros(0, int)
+    glitch[bad] = np.resize(GLITCHES, bad.size)
+    meas = meas * glitch[:, None]
+    time = None
+    order = np.arange(m)
+    if time_column:
+        time = SECONDS_PER_POINT * np.arange(m) + rng.uniform(0.0, 5.0, m)
+        direction = np.round(np.degrees(np.arctan2(kin.vy, kin.vx)), 6)
+        speed = np.round(np.hypot(kin.vx, kin.vy), 9)
+        order = np.lexsort((speed, direction, kin.wz, kin.roll))  # the file sorted by test condition
     loads_col = None if loads is None else kin.load_factor * N_sim
     data = MeasuredData(
-        vx=kin.vx, vy=kin.vy, wz=kin.wz, Fx=meas[:, 0], Fy=meas[:, 1], Mz=meas[:, 2],
-        N=loads_col, roll=kin.roll, source=f"synthetic:{effect}",
+        vx=kin.vx[order], vy=kin.vy[order], wz=kin.wz[order],
+        Fx=meas[order, 0], Fy=meas[order, 1], Mz=meas[order, 2],
+        N=None if loads_col is None else loads_col[order], roll=kin.roll[order],
+        source=f"synthetic:{'+'.join(effects)}", time=None if time is None else time[order],
     )  # fmt: skip
     truth = {"f": f, **{k: float(v) for k, v in params.items() if k != "f"}}
-    meta = {"N": N_sim, "R": R, "n": int(kin.vx.size), "seed": seed, "noise": noise}
-    return SyntheticData(data, effect, truth, clean, sd, friction, meta)
+    meta = {
+        "N": N_sim, "R": R, "n": int(m), "seed": seed, "noise": noise,
+        "noise_proportional": noise_proportional, "drift": drift, "time_column": bool(time_column),
+    }  # fmt: skip
+    where = np.empty(m, int)
+    where[order] = np.arange(m)  # run position -> file row
+    sd_rows = sd[order] if sd.ndim == 2 else sd
+    return SyntheticData(
+        data, "+".join(effects), truth, clean[order], sd_rows, friction, meta,
+        tuple(sorted(int(where[i]) for i in bad)), glitch[order],
+    )  # fmt: skip
 
 
 #: Validation cases (hidden effect, true parameters) shared by the detection
