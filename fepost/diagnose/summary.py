@@ -16,8 +16,9 @@ def _cause_lines(diag) -> list[str]:
     for c in diag.causes:
         lines.append(f"  {c}: {MEANING.get(c, '')}")
     for name, p in diag.parameters.items():
+        unit = "" if p.unit in ("", "1") else f" {p.unit}"  # dimensionless: no unit written
         lines.append(
-            f"  {name} = {p.value:.6g} {p.unit}  (95 % CI {p.ci95[0]:.6g} .. {p.ci95[1]:.6g})"
+            f"  {name} = {p.value:.6g}{unit}  (95 % CI {p.ci95[0]:.6g} .. {p.ci95[1]:.6g})"
             + (f"  [{p.cause}]" if len(diag.causes) > 1 else "")
         )
     return lines
