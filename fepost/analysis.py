@@ -16,6 +16,7 @@ from functools import cached_property
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .coefficients import Coefficients, coefficients_from_moments
 from .errors import PatchWarning, ScaleWarning
@@ -197,7 +198,10 @@ def analyse(
         if rolling is not None:
             pending.append(_start(rolling, field, step, displacement, units, surface))
         warm_up()
-        return _pipeline(pending, rolling is not None, friction, grid, threshold, rolling_axis)
+        # one BLAS thread: the patch step's products are thin (n × 3, chunk-long dots), where
+        # BLAS threads only spin, and on a busy machine they stall it (2-5x slower)
+        with threadpool_limits(limits=1, user_api="blas"):
+            return _pipeline(pending, rolling is not None, friction, grid, threshold, rolling_axis)
     finally:
         for p in pending:
             p.cancel()

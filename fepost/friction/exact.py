@@ -173,7 +173,14 @@ def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.
     np.subtract(vx[:, None], wx, out=wx)
     wy = np.multiply(wz[:, None], nodes.x[None, :])
     np.add(vy[:, None], wy, out=wy)
-    speed = np.hypot(wx, wy)
+    # |w| as √(wx² + wy²), 6x cheaper than np.hypot (the bulk of a model build); hypot
+    # only where the squares could underflow or overflow
+    speed = np.multiply(wx, wx)
+    speed += wy * wy
+    np.sqrt(speed, out=speed)
+    odd = ~((speed > 1e-150) & (speed < 1e150))
+    if odd.any():
+        speed[odd] = np.hypot(wx[odd], wy[odd])
     inv = np.divide(1.0, speed, out=np.zeros_like(speed), where=speed > 0)
     wx *= inv
     wy *= inv
