@@ -24,7 +24,7 @@ def _rasters():
     yield np.zeros((5, 7), bool)
     yield np.ones((6, 4), bool)
     yield np.ones((1, 1), bool)
-    snake = np.zeros((41, 37), bool)  # one region of the longest path: every other row, joined at alternate ends
+    snake = np.zeros((41, 37), bool)  # one region, the longest path: rows joined at alternate ends
     snake[::2] = True
     snake[1::4, -1] = True
     snake[3::4, 0] = True
