@@ -26,7 +26,6 @@ from .patch import DEFAULT_THRESHOLD, Patch, build_patch
 from .polar import PolarGrid, PolarMap
 from .reader import isolate, start_reading
 from .reader.units import describe, unit_system
-from .regions import warm_up
 from .resample import resample
 
 
@@ -157,6 +156,12 @@ def _check_resampling(patch: Patch, mom: Moments) -> None:
         )
 
 
+def _warm_up() -> None:
+    """Import, while the files are read, what the results need later: the generalised model
+    (:attr:`Analysis.model_summary`, in :meth:`Analysis.to_dict` by default)."""
+    from .friction import summary  # noqa: F401
+
+
 def _start(src, field, step, displacement, units, surface) -> isolate.Pending:
     """The reading of ``src`` under way (a :class:`ContactField` is taken as it is)."""
     if isinstance(src, ContactField):
@@ -197,7 +202,8 @@ def analyse(
     try:
         if rolling is not None:
             pending.append(_start(rolling, field, step, displacement, units, surface))
-        warm_up()
+        if any(p.running for p in pending):
+            _warm_up()
         # one BLAS thread: the patch step's products are thin (n × 3, chunk-long dots), where
         # BLAS threads only spin, and on a busy machine they stall it (2-5x slower)
         with threadpool_limits(limits=1, user_api="blas"):

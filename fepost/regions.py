@@ -25,10 +25,6 @@ RASTER_MAX = 2048
 FRAGMENT_SHARE = 0.01
 
 
-def warm_up() -> None:
-    """Import what the patch step needs beyond numpy, e.g. while a file is read (nothing today)."""
-
-
 def dilate(occupied: np.ndarray) -> np.ndarray:
     """Binary dilation of a 2-D boolean raster by a 3 × 3 square (cells beyond the border are empty)."""
     rows = occupied.copy()

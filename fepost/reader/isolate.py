@@ -26,7 +26,8 @@ How
   (the caller's arrays are views of it: one copy in the child, none in the
   caller, no files); what does not fit goes through the pipe.
 * The parent waits with a deadline (:func:`timeout_for`); a child that misses
-  it is killed.
+  it is killed. A child that has sent its whole answer is reaped in the
+  background: its exit (freeing its memory) is not waited for.
 * Warnings the child issues are recorded and re-issued in the caller (fepost
   warnings only); exceptions are re-raised (fepost errors as they are, anything
   else as a one-line :class:`~fepost.errors.InputFileError` whose cause holds
@@ -131,6 +132,11 @@ class Pending:
     def __init__(self, what: str, value: Any = None, error: BaseException | None = None, child=None):
         self.what = what
         self._value, self._error, self._child = value, error, child
+
+    @property
+    def running(self) -> bool:
+        """True while a child computes the value (False once :meth:`result` has collected it)."""
+        return self._child is not None
 
     def result(self) -> Any:
         """The function's value (raises what it raised, or the child's failure)."""
@@ -379,6 +385,18 @@ def _reap(pid: int, kill: bool) -> int:
             continue
 
 
+def _reap_soon(pid: int) -> None:
+    """Reap a child that has sent its answer and is exiting: now if it is gone, else in a thread."""
+    try:
+        done, _ = os.waitpid(pid, os.WNOHANG)
+    except ChildProcessError:
+        return
+    if not done:
+        import threading
+
+        threading.Thread(target=_reap, args=(pid, False), name="fepost-reap", daemon=True).start()
+
+
 def _shared(nbytes: int) -> mmap.mmap | None:
     size = min(SHARED_CAP, SHARED_FLOOR + SHARED_FACTOR * nbytes)
     try:
@@ -445,7 +463,13 @@ def _finish(pid: int, reader: _Reader, what: str, timeout: float, shm: mmap.mmap
         _reap(pid, kill=True)
         reader.close()
         raise
-    status = _reap(pid, kill=killed or received is None)
+    if received is not None:
+        # the answer is complete: the child's exit (freeing its memory, tens of ms for a large
+        # mesh) is reaped in the background instead of waited for
+        _reap_soon(pid)
+        status = 0
+    else:
+        status = _reap(pid, kill=True)
     reader.close()
     if killed:
         raise InputFileError(
