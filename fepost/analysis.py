@@ -163,7 +163,9 @@ def _warm_up() -> None:
 
 
 def _start(src, field, step, displacement, units, surface) -> isolate.Pending:
-    """The reading of ``src`` under way (a :class:`ContactField` is taken as it is)."""
+    """The reading of ``src`` under way (a :class:`ContactField` or a started read is taken as it is)."""
+    if isinstance(src, isolate.Pending):
+        return src
     if isinstance(src, ContactField):
         return isolate.Pending(str(src.source), value=src)
     return start_reading(
@@ -187,6 +189,8 @@ def analyse(
 ) -> Analysis:
     """Run the pipeline on a static map (path or :class:`ContactField`) and an optional rolling map.
 
+    A map may also be a read already under way (:func:`fepost.reader.start_reading`,
+    with its own reading options): a caller can start it before importing this module.
     The rolling map is placed in the static patch's frame; its polar grid is
     centred on the static centre of pressure with a radius large enough to
     hold its own loaded region. ``units`` (a name of

@@ -290,6 +290,8 @@ def _child_main(wfd: int, func, args, kwargs, nbytes: int, shm: mmap.mmap | None
     faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
     signal.signal(signal.SIGINT, signal.SIG_DFL)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent around the fork
     cap = _capture_fd()
     sys.stdout.flush()
     sys.stderr.flush()
@@ -417,6 +419,9 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
             pass
     sys.stdout.flush()
     sys.stderr.flush()
+    # Termination signals wait until the fork is over: a handler that raises inside the
+    # interpreter's at-fork hooks would be ignored there (and the signal lost).
+    old_mask = _block_signals()
     with warnings.catch_warnings():
         # Python >= 3.12 warns about forking a multi-threaded process; the child
         # only reads a file and exits through os._exit, and a deadline guards it.
@@ -431,8 +436,29 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
             code = 70
         finally:
             os._exit(code)
-    os.close(wfd)
-    return pid, _Reader(rfd, time.monotonic() + timeout), what, timeout, shm
+    try:
+        os.close(wfd)
+        reader = _Reader(rfd, time.monotonic() + timeout)
+        _restore_signals(old_mask)  # a signal that came meanwhile is handled here
+    except BaseException:
+        _reap(pid, kill=True)
+        os.close(rfd)
+        raise
+    return pid, reader, what, timeout, shm
+
+
+_SIGNALS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+
+def _block_signals():
+    if not hasattr(signal, "pthread_sigmask"):
+        return None
+    return signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+
+
+def _restore_signals(old_mask) -> None:
+    if old_mask is not None:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
 
 
 def _finish(pid: int, reader: _Reader, what: str, timeout: float, shm: mmap.mmap | None):
