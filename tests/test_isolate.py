@@ -100,6 +100,57 @@ def test_errors_warnings_and_results_cross_the_process_boundary():
     np.testing.assert_array_equal(got["b"], np.eye(3))
 
 
+def _mixed_arrays():
+    return {
+        "points": np.arange(300_000, dtype=float).reshape(-1, 3),
+        "triangles": np.arange(600_000, dtype=np.int64).reshape(-1, 3)[::-1],  # not contiguous
+        "empty": np.empty((0, 3)),
+        "flags": np.arange(1001) % 3 == 0,
+        "small": np.float32([1.5, -2.0]),
+    }
+
+
+def test_arrays_arrive_intact_as_views_of_one_receiving_map():
+    got = isolate.call(_mixed_arrays, what="big")
+    want = _mixed_arrays()
+    for name, arr in want.items():
+        assert got[name].dtype == arr.dtype and got[name].shape == arr.shape, name
+        np.testing.assert_array_equal(got[name], arr)
+    # the large contiguous arrays share one buffer, each aligned for vector loads
+    base = got["points"].base
+    assert base is not None
+    for name in ("points", "flags"):
+        assert got[name].ctypes.data % 64 == 0
+
+
+def _lying_send(fd, payload):
+    # a header that declares far more than a reading child can hold (a compromised child)
+    os.write(fd, isolate._LEN.pack(10) + isolate._LEN.pack(1) + isolate._LEN.pack(1 << 62))
+
+
+def _short_send(fd, payload):
+    # the header of a real answer, then the child stops (killed mid-transfer)
+    buffers = []
+    head = __import__("pickle").dumps(payload, protocol=5, buffer_callback=buffers.append)
+    raws = [b.raw() for b in buffers]
+    table = b"".join(isolate._LEN.pack(r.nbytes) for r in raws)
+    os.write(fd, isolate._LEN.pack(len(head)) + isolate._LEN.pack(len(raws)) + table + head)
+    os.write(fd, bytes(raws[0][:1000]))
+
+
+@pytest.mark.parametrize(
+    "send,pattern",
+    [
+        (_lying_send, r"^f\.vtu: the file reader sent a malformed answer: corrupt or malformed file$"),
+        (_short_send, r"^f\.vtu: the file reader failed \(exit status 0\): corrupt or malformed file$"),
+    ],
+)
+def test_a_malformed_or_cut_answer_is_one_line_error(monkeypatch, send, pattern):
+    monkeypatch.setattr(isolate, "_send", send)  # inherited by the forked child
+    with pytest.raises(InputFileError, match=pattern):
+        isolate.call(_array, what="f.vtu")
+
+
 def _read_in_daemon(path, queue):
     try:
         fld = read_contact(path)
