@@ -123,19 +123,49 @@ def test_arrays_arrive_intact_as_views_of_one_receiving_map():
         assert got[name].ctypes.data % 64 == 0
 
 
-def _lying_send(fd, payload):
+def _lying_send(fd, payload, ack):
     # a header that declares far more than a reading child can hold (a compromised child)
-    os.write(fd, isolate._LEN.pack(10) + isolate._LEN.pack(1) + isolate._LEN.pack(1 << 62))
+    os.write(fd, isolate._LEN.pack(10) + isolate._LEN.pack(1) + isolate._LEN.pack(1 << 62) + bytes(8))
 
 
-def _short_send(fd, payload):
-    # the header of a real answer, then the child stops (killed mid-transfer)
+def _short_send(fd, payload, ack):
+    # the header of a real answer (with addresses the caller cannot copy from), then the
+    # child stops after a little of its buffers (killed mid-transfer)
     buffers = []
     head = __import__("pickle").dumps(payload, protocol=5, buffer_callback=buffers.append)
     raws = [b.raw() for b in buffers]
-    table = b"".join(isolate._LEN.pack(r.nbytes) for r in raws)
+    table = b"".join(isolate._LEN.pack(r.nbytes) + isolate._LEN.pack(8) for r in raws)
     os.write(fd, isolate._LEN.pack(len(head)) + isolate._LEN.pack(len(raws)) + table + head)
+    assert os.read(ack, 1) == b"p"
     os.write(fd, bytes(raws[0][:1000]))
+
+
+def _copy_refused(*args):
+    return False
+
+
+def test_buffers_are_copied_straight_from_the_child_where_allowed(monkeypatch):
+    if isolate._vm_readv() is None:
+        pytest.skip("no process_vm_readv on this platform")
+    copies = []
+    real = isolate._copy_from
+
+    def spy(*args):
+        copies.append(real(*args))
+        return copies[-1]
+
+    monkeypatch.setattr(isolate, "_copy_from", spy)
+    got = isolate.call(_array, what="big")
+    np.testing.assert_array_equal(got["a"], np.arange(3_000_000, dtype=float))
+    if copies != [True]:
+        pytest.skip("process_vm_readv is not permitted here (the pipe carried the arrays)")
+
+
+def test_buffers_come_through_the_pipe_where_the_caller_cannot_copy_them(monkeypatch):
+    monkeypatch.setattr(isolate, "_copy_from", _copy_refused)
+    got = isolate.call(_mixed_arrays, what="big")
+    for name, arr in _mixed_arrays().items():
+        np.testing.assert_array_equal(got[name], arr)
 
 
 @pytest.mark.parametrize(
