@@ -9,9 +9,14 @@ Two comparisons, each against reading the same file with pyvista alone:
   included (target: ratio <= 1.5).
 
 Each measurement runs in a fresh process; the two sides alternate so that a
-change of machine load hits both; medians are reported. ``--baseline REPO``
-also times another checkout's fepost (e.g. the main branch) in-process on the
-same file, side by side.
+change of machine load hits both; medians are reported, with the load average.
+``--baseline REPO`` also times another checkout's fepost (e.g. the main branch)
+in-process on the same file, side by side.
+
+Before the whole-process runs, fepost's bytecode is compiled (``compileall``),
+as an installed package has it: with ``PYTHONDONTWRITEBYTECODE`` set, every run
+would otherwise compile fepost's modules from source (~0.2 s), while pyvista's
+come compiled from its wheel.
 
     .venv/bin/python benchmarks/bench_coefficients.py [--nodes 1000000] [--repeat 5] [--keep big.vtu]
         [--mode both|inprocess|process] [--baseline ../main]
@@ -124,6 +129,11 @@ def main() -> None:
                 f"N/N_exact - 1 = {f['N'] / N_ref - 1:+.2e}, N_fe/N_exact - 1 = {f['N_fe'] / N_ref - 1:+.2e}"
             )
         if args.mode in ("both", "process"):
+            import compileall
+
+            import fepost
+
+            compileall.compile_dir(Path(fepost.__file__).parent, quiet=2)
             bare = [sys.executable, "-c", f"import pyvista; pyvista.read({str(path)!r})"]
             ours = [sys.executable, "-m", "fepost", "coefficients", str(path)]
             tb, to = [], []
@@ -139,6 +149,7 @@ def main() -> None:
             ):
                 print(f"whole process, {label:<28} median {med:.2f} s (min {min(runs):.2f})")
             print(f"whole-process ratio (medians): {mo / mb:.2f} (target <= 1.5); peak RSS {rss:.0f} MB")
+        print("load average (1, 5, 15 min) at the end: " + ", ".join(f"{v:.1f}" for v in os.getloadavg()))
 
 
 if __name__ == "__main__":

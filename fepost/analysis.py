@@ -16,6 +16,7 @@ from functools import cached_property
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .coefficients import Coefficients, coefficients_from_moments
 from .errors import PatchWarning, ScaleWarning
@@ -25,7 +26,6 @@ from .patch import DEFAULT_THRESHOLD, Patch, build_patch
 from .polar import PolarGrid, PolarMap
 from .reader import isolate, start_reading
 from .reader.units import describe, unit_system
-from .regions import warm_up
 from .resample import resample
 
 
@@ -156,8 +156,16 @@ def _check_resampling(patch: Patch, mom: Moments) -> None:
         )
 
 
+def _warm_up() -> None:
+    """Import, while the files are read, what the results need later: the generalised model
+    (:attr:`Analysis.model_summary`, in :meth:`Analysis.to_dict` by default)."""
+    from .friction import summary  # noqa: F401
+
+
 def _start(src, field, step, displacement, units, surface) -> isolate.Pending:
-    """The reading of ``src`` under way (a :class:`ContactField` is taken as it is)."""
+    """The reading of ``src`` under way (a :class:`ContactField` or a started read is taken as it is)."""
+    if isinstance(src, isolate.Pending):
+        return src
     if isinstance(src, ContactField):
         return isolate.Pending(str(src.source), value=src)
     return start_reading(
@@ -181,6 +189,8 @@ def analyse(
 ) -> Analysis:
     """Run the pipeline on a static map (path or :class:`ContactField`) and an optional rolling map.
 
+    A map may also be a read already under way (:func:`fepost.reader.start_reading`,
+    with its own reading options): a caller can start it before importing this module.
     The rolling map is placed in the static patch's frame; its polar grid is
     centred on the static centre of pressure with a radius large enough to
     hold its own loaded region. ``units`` (a name of
@@ -196,8 +206,12 @@ def analyse(
     try:
         if rolling is not None:
             pending.append(_start(rolling, field, step, displacement, units, surface))
-        warm_up()
-        return _pipeline(pending, rolling is not None, friction, grid, threshold, rolling_axis)
+        if any(p.running for p in pending):
+            _warm_up()
+        # one BLAS thread: the patch step's products are thin (n × 3, chunk-long dots), where
+        # BLAS threads only spin, and on a busy machine they stall it (2-5x slower)
+        with threadpool_limits(limits=1, user_api="blas"):
+            return _pipeline(pending, rolling is not None, friction, grid, threshold, rolling_axis)
     finally:
         for p in pending:
             p.cancel()

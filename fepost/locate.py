@@ -37,7 +37,7 @@ RASTER_MAX = 2048
 #: Raster cell size in typical mesh edges: a cell holds a few triangles.
 CELL_EDGES = 1.0
 #: Triangles per chunk of the candidate pass.
-CHUNK = 1 << 16
+CHUNK = 1 << 14
 #: Cells per batch when the candidates' boxes are expanded (bounds their arrays).
 EXPAND_MAX = 1 << 22
 #: Query points per block of the exact test (bounds the pair arrays).
@@ -92,7 +92,7 @@ def _candidates(X, Y, tri, origin, h, shape, sat) -> tuple[np.ndarray, np.ndarra
     width = sat.shape[1]
     found, boxes = [], []
     for start in range(0, len(tri), CHUNK):
-        k = packed[tri[start : start + CHUNK].T]
+        k = packed.take(np.ascontiguousarray(tri[start : start + CHUNK].T))
         i, j = k >> 16, k & 0xFFFF
         i0 = np.minimum(np.minimum(i[0], i[1]), i[2])
         i1 = np.maximum(np.maximum(i[0], i[1]), i[2])

@@ -179,14 +179,15 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
     """The pressure values checked and, where allowed, repaired (a new array only then)."""
     v = fld.values
     finite = np.isfinite(v)
-    if not finite.any():
+    all_finite = bool(finite.all())
+    if v.size == 0 or (not all_finite and not finite.any()):
         raise PressureError(f"{fld.source}: pressure array {fld.field!r} holds no finite values")
-    peak = float(np.max(v[finite]))
+    peak = float(np.max(v) if all_finite else np.max(v[finite]))
     if peak <= 0.0:
         raise PressureError(
             f"{fld.source}: pressure array {fld.field!r} is zero or negative everywhere (no contact)"
         )
-    if not finite.all():
+    if not all_finite:
         bad = ~finite
         vz = np.where(finite, v, 0.0)
         if fld.location == "point":

@@ -1,4 +1,11 @@
-"""How many contact patches the loaded faces make: side by side in the plane, or on different surfaces."""
+"""How many contact patches the loaded faces make: side by side in the plane, or on different surfaces.
+
+The regions side by side are counted on a small raster (:func:`_components`),
+dilated and labelled here with numpy (:func:`dilate`, :func:`label`) rather
+than with ``scipy.ndimage``, whose import alone (~0.3-0.6 s) would be a quarter
+of a million-node ``fepost coefficients`` run; the two agree cell for cell
+(tests/test_regions.py).
+"""
 
 from __future__ import annotations
 
@@ -18,9 +25,68 @@ RASTER_MAX = 2048
 FRAGMENT_SHARE = 0.01
 
 
-def warm_up() -> None:
-    """Import what the patch step needs beyond numpy (scipy.ndimage, ~0.3 s), e.g. while a file is read."""
-    from scipy import ndimage  # noqa: F401
+def dilate(occupied: np.ndarray) -> np.ndarray:
+    """Binary dilation of a 2-D boolean raster by a 3 × 3 square (cells beyond the border are empty)."""
+    rows = occupied.copy()
+    rows[1:] |= occupied[:-1]
+    rows[:-1] |= occupied[1:]
+    out = rows.copy()
+    out[:, 1:] |= rows[:, :-1]
+    out[:, :-1] |= rows[:, 1:]
+    return out
+
+
+def label(occupied: np.ndarray) -> tuple[np.ndarray, int]:
+    """8-connected regions of a 2-D boolean raster: (labels, count), numbered as ``scipy.ndimage.label``.
+
+    Labels are 1..count in the order each region first appears in a row-major
+    scan (0: empty cells). Runs of cells along a row start joined; the runs are
+    then merged across the rows by hooking each tree's root under the smaller
+    root of a neighbouring tree and halving paths until nothing changes: every
+    round at least halves the number of trees that still have a neighbour, and
+    the root left in each region is its first cell.
+    """
+    shape = occupied.shape
+    flat = occupied.ravel()
+    cells = np.flatnonzero(flat)
+    k = cells.size
+    labels = np.zeros(shape, np.int32)
+    if k == 0:
+        return labels, 0
+    ny = shape[1]
+    index = np.full(flat.size, -1, np.int32)  # a raster holds at most RASTER_MAX² cells
+    rank = np.arange(k, dtype=np.int32)
+    index[cells] = rank
+    grid = index.reshape(shape)
+    # a run along a row: a cell whose left neighbour is occupied joins its run's first cell
+    starts = np.ones(k, bool)
+    starts[1:] = (cells[1:] != cells[:-1] + 1) | (cells[1:] % ny == 0)
+    parent = np.maximum.accumulate(np.where(starts, rank, 0))
+    a_parts, b_parts = [], []
+    for dj in (-1, 0, 1):  # the row below: down-left, down, down-right
+        lo, hi = max(0, -dj), ny - max(0, dj)
+        a = grid[:-1, lo:hi]
+        b = grid[1:, lo + dj : hi + dj]
+        both = (a >= 0) & (b >= 0)
+        a_parts.append(a[both])
+        b_parts.append(b[both])
+    a, b = np.concatenate(a_parts), np.concatenate(b_parts)
+    while True:
+        ra, rb = parent[a], parent[b]
+        differ = ra != rb
+        if not differ.any():
+            break
+        a, b, ra, rb = a[differ], b[differ], ra[differ], rb[differ]
+        np.minimum.at(parent, np.maximum(ra, rb), np.minimum(ra, rb))
+        while True:  # every cell straight to its root
+            up = parent[parent]
+            if np.array_equal(up, parent):
+                break
+            parent = up
+    is_root = parent == rank
+    number = np.cumsum(is_root, dtype=np.int32)  # roots are first cells: numbered in scan order
+    labels.ravel()[cells] = number[parent]
+    return labels, int(number[-1])
 
 
 def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
@@ -32,8 +98,6 @@ def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -
     h = max(GAP_FRACTION·√area, longest loaded edge), so faces that share a node
     always fall in touching cells; one dilation closes gaps narrower than ~h.
     """
-    from scipy import ndimage
-
     h = max(GAP_FRACTION * np.sqrt(sums.A), sums.max_edge)
     lo = np.array([x.min(), y.min()])
     ext = np.array([x.max(), y.max()]) - lo
@@ -45,9 +109,8 @@ def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -
     i = ((x - lo[0]) * (1.0 / h)).astype(np.int32) + 1
     j = ((y - lo[1]) * (1.0 / h)).astype(np.int32) + 1
     occupied = np.zeros(tuple(n), bool)
-    occupied[i, j] = True
-    occupied = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), bool))
-    labels, count = ndimage.label(occupied, structure=np.ones((3, 3), bool))
+    occupied.ravel()[i * int(n[1]) + j] = True  # a flat index: 2-D fancy assignment is slower
+    labels, count = label(dilate(occupied))
     if count == 1:
         return 1, np.zeros(len(tri), np.int64)
     first = tri[:, 0]

@@ -100,6 +100,87 @@ def test_errors_warnings_and_results_cross_the_process_boundary():
     np.testing.assert_array_equal(got["b"], np.eye(3))
 
 
+def _mixed_arrays():
+    return {
+        "points": np.arange(300_000, dtype=float).reshape(-1, 3),
+        "triangles": np.arange(600_000, dtype=np.int64).reshape(-1, 3)[::-1],  # not contiguous
+        "empty": np.empty((0, 3)),
+        "flags": np.arange(1001) % 3 == 0,
+        "small": np.float32([1.5, -2.0]),
+    }
+
+
+def test_arrays_arrive_intact_as_views_of_one_receiving_map():
+    got = isolate.call(_mixed_arrays, what="big")
+    want = _mixed_arrays()
+    for name, arr in want.items():
+        assert got[name].dtype == arr.dtype and got[name].shape == arr.shape, name
+        np.testing.assert_array_equal(got[name], arr)
+    # the large contiguous arrays share one buffer, each aligned for vector loads
+    base = got["points"].base
+    assert base is not None
+    for name in ("points", "flags"):
+        assert got[name].ctypes.data % 64 == 0
+
+
+def _lying_send(fd, payload, ack):
+    # a header that declares far more than a reading child can hold (a compromised child)
+    os.write(fd, isolate._LEN.pack(10) + isolate._LEN.pack(1) + isolate._LEN.pack(1 << 62) + bytes(8))
+
+
+def _short_send(fd, payload, ack):
+    # the header of a real answer (with addresses the caller cannot copy from), then the
+    # child stops after a little of its buffers (killed mid-transfer)
+    buffers = []
+    head = __import__("pickle").dumps(payload, protocol=5, buffer_callback=buffers.append)
+    raws = [b.raw() for b in buffers]
+    table = b"".join(isolate._LEN.pack(r.nbytes) + isolate._LEN.pack(8) for r in raws)
+    os.write(fd, isolate._LEN.pack(len(head)) + isolate._LEN.pack(len(raws)) + table + head)
+    assert os.read(ack, 1) == b"p"
+    os.write(fd, bytes(raws[0][:1000]))
+
+
+def _copy_refused(*args):
+    return False
+
+
+def test_buffers_are_copied_straight_from_the_child_where_allowed(monkeypatch):
+    if isolate._vm_readv() is None:
+        pytest.skip("no process_vm_readv on this platform")
+    copies = []
+    real = isolate._copy_from
+
+    def spy(*args):
+        copies.append(real(*args))
+        return copies[-1]
+
+    monkeypatch.setattr(isolate, "_copy_from", spy)
+    got = isolate.call(_array, what="big")
+    np.testing.assert_array_equal(got["a"], np.arange(3_000_000, dtype=float))
+    if copies != [True]:
+        pytest.skip("process_vm_readv is not permitted here (the pipe carried the arrays)")
+
+
+def test_buffers_come_through_the_pipe_where_the_caller_cannot_copy_them(monkeypatch):
+    monkeypatch.setattr(isolate, "_copy_from", _copy_refused)
+    got = isolate.call(_mixed_arrays, what="big")
+    for name, arr in _mixed_arrays().items():
+        np.testing.assert_array_equal(got[name], arr)
+
+
+@pytest.mark.parametrize(
+    "send,pattern",
+    [
+        (_lying_send, r"^f\.vtu: the file reader sent a malformed answer: corrupt or malformed file$"),
+        (_short_send, r"^f\.vtu: the file reader failed \(exit status 0\): corrupt or malformed file$"),
+    ],
+)
+def test_a_malformed_or_cut_answer_is_one_line_error(monkeypatch, send, pattern):
+    monkeypatch.setattr(isolate, "_send", send)  # inherited by the forked child
+    with pytest.raises(InputFileError, match=pattern):
+        isolate.call(_array, what="f.vtu")
+
+
 def _read_in_daemon(path, queue):
     try:
         fld = read_contact(path)
@@ -181,6 +262,10 @@ def test_started_reads_run_side_by_side_and_leave_no_child(analytic_mesh):
     hung = isolate.start(_hang, what="h.vtu", timeout=30)
     assert _children() - before  # the hung child runs
     hung.cancel()
-    assert _children() == before  # killed and reaped: no zombie left
+    # killed and reaped; the finished readers are reaped in the background: no zombie left
+    deadline = time.monotonic() + 5.0
+    while _children() != before and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert _children() == before
     with pytest.raises(FieldError, match=r"x\.vtu: no array named 'P'"):
         isolate.start(_field_error, what="x.vtu").result()

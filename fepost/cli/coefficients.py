@@ -86,11 +86,28 @@ def format_analysis(a: Analysis) -> str:
     return "\n".join(lines)
 
 
+#: The options of :func:`fepost.reader.start_reading` among :func:`analysis_kwargs`.
+READING = ("field", "step", "displacement", "units", "surface")
+
+
 def run(args: argparse.Namespace) -> int:
-    from ..analysis import analyse
+    from ..reader import start_reading
+
+    kwargs = analysis_kwargs(args)
+    reading = {k: kwargs[k] for k in READING}
+    # the files are read in their children while the pipeline's modules are imported
+    pending = [start_reading(args.static, **reading)]
+    try:
+        if args.rolling:
+            pending.append(start_reading(args.rolling, **reading))
+        from ..analysis import analyse
+
+        result = analyse(*pending, friction=args.friction, **kwargs)
+    finally:
+        for p in pending:
+            p.cancel()
     from ..output import write_json_atomic
 
-    result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
     print(format_analysis(result))
     if args.json:
         write_json_atomic(args.json, result.to_dict())

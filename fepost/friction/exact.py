@@ -43,9 +43,9 @@ from ..errors import ArgumentError
 from .law import FrictionLaw
 from .quadrature import Ellipse, PressureQuadrature
 
-#: Elements (kinematic points × nodes) per chunk: 2^20 doubles = 8 MB per array,
-#: a handful of arrays per worker thread.
-CHUNK_ELEMENTS = 1 << 20
+#: Elements (kinematic points × nodes) per chunk: 2^17 doubles = 1 MB per array, a
+#: handful of arrays per worker thread that stay in cache (8 MB arrays ran 1.4x slower).
+CHUNK_ELEMENTS = 1 << 17
 
 #: Trapezoid nodes in θ: at least this many ...
 THETA_MIN = 64
@@ -173,7 +173,14 @@ def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.
     np.subtract(vx[:, None], wx, out=wx)
     wy = np.multiply(wz[:, None], nodes.x[None, :])
     np.add(vy[:, None], wy, out=wy)
-    speed = np.hypot(wx, wy)
+    # |w| as √(wx² + wy²), 6x cheaper than np.hypot (the bulk of a model build); hypot
+    # only where the squares could underflow or overflow
+    speed = np.multiply(wx, wx)
+    speed += wy * wy
+    np.sqrt(speed, out=speed)
+    odd = ~((speed > 1e-150) & (speed < 1e150))
+    if odd.any():
+        speed[odd] = np.hypot(wx[odd], wy[odd])
     inv = np.divide(1.0, speed, out=np.zeros_like(speed), where=speed > 0)
     wx *= inv
     wy *= inv

@@ -22,11 +22,16 @@ How
 * The child's address space is limited (:data:`MEMORY_BUDGET` beyond what it
   holds at the fork), so a header declaring 10¹² points fails fast.
 * The result travels back as a pickle (protocol 5) whose large numpy buffers
-  go out of band into an anonymous shared memory map made before the fork
-  (the caller's arrays are views of it: one copy in the child, none in the
-  caller, no files); what does not fit goes through the pipe.
+  go out of band into one anonymous private map in the caller, backed by
+  transparent huge pages where the system offers them (the caller's arrays are
+  views of it). The caller copies them straight out of the waiting child with
+  ``process_vm_readv`` (Linux; one copy, no scheduling round trips) or, where
+  that is not allowed, reads them through the pipe. (A shared map made before
+  the fork cost 2-3x as much: its pages fault one by one in both processes and
+  are slow to free.)
 * The parent waits with a deadline (:func:`timeout_for`); a child that misses
-  it is killed.
+  it is killed. A child that has sent its whole answer is reaped in the
+  background: its exit (freeing its memory) is not waited for.
 * Warnings the child issues are recorded and re-issued in the caller (fepost
   warnings only); exceptions are re-raised (fepost errors as they are, anything
   else as a one-line :class:`~fepost.errors.InputFileError` whose cause holds
@@ -65,13 +70,11 @@ TIMEOUT_PER_MB = 2.0
 MEMORY_BUDGET = 6 << 30
 #: Pipe size asked for on Linux (fewer wake-ups on large results).
 _PIPE_SIZE = 1 << 20
-#: Shared memory mapped for the results: this many times the file size, plus a floor (virtual
-#: memory: pages cost only when written).
-SHARED_FACTOR = 16
-SHARED_FLOOR = 64 << 20
-SHARED_CAP = 8 << 30
 _LEN = struct.Struct("<Q")
+#: Alignment (bytes) of each array in the caller's receiving map.
 _ALIGN = 64
+#: Huge-page size the receiving map is rounded to (2 MB on x86-64 and most arm64 systems).
+_HUGE = 2 << 20
 
 
 class ChildTraceback(Exception):
@@ -131,6 +134,11 @@ class Pending:
     def __init__(self, what: str, value: Any = None, error: BaseException | None = None, child=None):
         self.what = what
         self._value, self._error, self._child = value, error, child
+
+    @property
+    def running(self) -> bool:
+        """True while a child computes the value (False once :meth:`result` has collected it)."""
+        return self._child is not None
 
     def result(self) -> Any:
         """The function's value (raises what it raised, or the child's failure)."""
@@ -254,36 +262,41 @@ def _write_all(fd: int, data) -> None:
         view = view[n:]
 
 
-def _send(fd: int, payload: Any, shm: mmap.mmap | None) -> None:
-    """Write the payload: header, then per buffer its place (shared-memory offset, or 2⁶⁴−1: the pipe)."""
+def _send(fd: int, payload: Any, ack: int | None = None) -> None:
+    """Write the payload: its header (size and address of each out-of-band buffer), the pickle,
+    then wait for the caller's word on ``ack``: it has copied the buffers itself (``v``), or they
+    follow through the pipe (``p``)."""
     buffers: list[pickle.PickleBuffer] = []
     head = pickle.dumps(payload, protocol=5, buffer_callback=buffers.append)
     raws = [b.raw() for b in buffers]
-    places, pos = [], 0
-    for r in raws:
-        if shm is not None and pos + r.nbytes <= len(shm):
-            shm[pos : pos + r.nbytes] = r
-            places.append(pos)
-            pos += -(-r.nbytes // _ALIGN) * _ALIGN
-        else:
-            places.append(_PIPE)
-    table = b"".join(_LEN.pack(r.nbytes) + _LEN.pack(at) for r, at in zip(raws, places, strict=True))
+    table = b"".join(_LEN.pack(r.nbytes) + _LEN.pack(_address(r)) for r in raws)
     _write_all(fd, _LEN.pack(len(head)) + _LEN.pack(len(raws)) + table)
     _write_all(fd, head)
-    for r, at in zip(raws, places, strict=True):
-        if at == _PIPE:
+    if not raws:
+        return
+    how = os.read(ack, 1) if ack is not None else b"p"
+    if how == b"p":
+        for r in raws:
             _write_all(fd, r)
 
 
-_PIPE = (1 << 64) - 1
+def _address(raw: memoryview) -> int:
+    """The address of a contiguous buffer's first byte (0 when empty)."""
+    if not raw.nbytes:
+        return 0
+    import numpy as np
+
+    return int(np.frombuffer(raw, np.uint8).ctypes.data)
 
 
-def _child_main(wfd: int, func, args, kwargs, nbytes: int, shm: mmap.mmap | None) -> None:
+def _child_main(wfd: int, ack: int, func, args, kwargs, nbytes: int) -> None:
     import faulthandler
 
     faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
     signal.signal(signal.SIGINT, signal.SIG_DFL)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent around the fork
     cap = _capture_fd()
     sys.stdout.flush()
     sys.stderr.flush()
@@ -304,10 +317,10 @@ def _child_main(wfd: int, func, args, kwargs, nbytes: int, shm: mmap.mmap | None
     caught = [(w.category, str(w.message)) for w in rec if issubclass(w.category, FepostWarning)]
     text = _chatter(cap)
     try:
-        _send(wfd, (payload, caught, text), shm)
+        _send(wfd, (payload, caught, text), ack)
     except Exception as exc:  # the result itself could not be pickled: say so
         other = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
-        _send(wfd, (other, caught, text), None)
+        _send(wfd, (other, caught, text), ack)
 
 
 # ----------------------------------------------------------------------------- parent side
@@ -318,9 +331,18 @@ class _Deadline(Exception):
 
 
 class _Reader:
-    def __init__(self, fd: int, deadline: float):
+    def __init__(self, fd: int, deadline: float, ack: int | None = None):
         self.f = io.FileIO(fd, "rb", closefd=True)
         self.deadline = deadline
+        self.ack = ack  # the write end of the caller's reply to the child
+
+    def reply(self, word: bytes) -> None:
+        """Tell the child how its buffers travel (it waits for this once its header is sent)."""
+        if self.ack is not None:
+            try:
+                os.write(self.ack, word)
+            except OSError:
+                pass  # the child is gone: the pipe's end of file says so
 
     def _wait(self) -> None:
         left = self.deadline - time.monotonic()
@@ -332,18 +354,24 @@ class _Reader:
 
     def exact(self, n: int) -> bytearray:
         buf = bytearray(n)
-        view = memoryview(buf)
-        pos = 0
+        self.into(memoryview(buf))
+        return buf
+
+    def into(self, view: memoryview) -> None:
+        """Fill ``view`` from the pipe (EOFError if the child stops short)."""
+        pos, n = 0, view.nbytes
         while pos < n:
             self._wait()
             got = self.f.readinto(view[pos:])
             if not got:
                 raise EOFError
             pos += got
-        return buf
 
     def close(self) -> None:
         self.f.close()
+        if self.ack is not None:
+            os.close(self.ack)
+            self.ack = None
 
 
 def _signal_name(sig: int) -> str:
@@ -379,19 +407,104 @@ def _reap(pid: int, kill: bool) -> int:
             continue
 
 
-def _shared(nbytes: int) -> mmap.mmap | None:
-    size = min(SHARED_CAP, SHARED_FLOOR + SHARED_FACTOR * nbytes)
+def _reap_soon(pid: int) -> None:
+    """Reap a child that has sent its answer and is exiting: now if it is gone, else in a thread."""
     try:
-        return mmap.mmap(-1, size)  # anonymous and shared with the child
-    except (OSError, ValueError, OverflowError):
-        return None  # no room for the map: everything goes through the pipe
+        done, _ = os.waitpid(pid, os.WNOHANG)
+    except ChildProcessError:
+        return
+    if not done:
+        import threading
+
+        threading.Thread(target=_reap, args=(pid, False), name="fepost-reap", daemon=True).start()
+
+
+def _copy_from(pid: int, buf: mmap.mmap, offsets: list[int], sizes: list[int], addresses: list[int]) -> bool:
+    """Copy the child's buffers into ``buf`` with ``process_vm_readv``; False where not possible.
+
+    Linux only, and only where the caller may trace its child (the usual default); a
+    short or failed copy also gives False: the buffers then come through the pipe.
+    """
+    found = _vm_readv()
+    if found is None or len(sizes) > 1024:  # IOV_MAX
+        return False
+    import ctypes
+
+    call, iovec = found
+    holder = ctypes.c_char.from_buffer(buf)
+    try:
+        base = ctypes.addressof(holder)
+        n = len(sizes)
+        local, remote = (iovec * n)(), (iovec * n)()
+        for i, (at, size, where) in enumerate(zip(offsets, sizes, addresses, strict=True)):
+            local[i].base, local[i].len = base + at, size
+            remote[i].base, remote[i].len = where, size
+        return call(pid, local, n, remote, n, 0) == sum(sizes)
+    finally:
+        del holder
+
+
+_VM_READV: list = []
+
+
+def _vm_readv():
+    """(libc's process_vm_readv, its iovec type) through ctypes, or None where there is none."""
+    if not _VM_READV:
+        _VM_READV.append(_load_vm_readv())
+    return _VM_READV[0]
+
+
+def _load_vm_readv():
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        import ctypes
+
+        class Iovec(ctypes.Structure):
+            _fields_ = [("base", ctypes.c_void_p), ("len", ctypes.c_size_t)]
+
+        fn = ctypes.CDLL(None, use_errno=True).process_vm_readv
+    except (OSError, AttributeError, ImportError):
+        return None
+    fn.restype = ctypes.c_ssize_t
+    iov = ctypes.POINTER(Iovec)
+    fn.argtypes = [ctypes.c_int, iov, ctypes.c_ulong, iov, ctypes.c_ulong, ctypes.c_ulong]
+    return fn, Iovec
+
+
+def _answer_limit(nbytes: int) -> int:
+    """The most bytes a child reading a file of ``nbytes`` can answer with (its memory budget)."""
+    return max(MEMORY_BUDGET, 64 * nbytes)
+
+
+def _receiving_map(sizes: list[int]) -> tuple[mmap.mmap | None, list[int]]:
+    """A private anonymous map for buffers of ``sizes`` (bytes), and the offset of each.
+
+    Backed by transparent huge pages where the system allows it (one page fault per
+    2 MB instead of per 4 kB). None when there is nothing to receive.
+    """
+    offsets, pos = [], 0
+    for n in sizes:
+        offsets.append(pos)
+        pos += -(-n // _ALIGN) * _ALIGN
+    if pos == 0:
+        return None, offsets
+    size = -(-pos // _HUGE) * _HUGE
+    private = getattr(mmap, "MAP_PRIVATE", 0) | getattr(mmap, "MAP_ANONYMOUS", 0)
+    buf = mmap.mmap(-1, size, flags=private) if private else mmap.mmap(-1, size)
+    if hasattr(mmap, "MADV_HUGEPAGE"):
+        try:
+            buf.madvise(mmap.MADV_HUGEPAGE)
+        except OSError:
+            pass  # no transparent huge pages here: ordinary pages
+    return buf, offsets
 
 
 def _fork(func, args, kwargs, what, nbytes, timeout):
     import fcntl
 
-    shm = _shared(nbytes)
     rfd, wfd = os.pipe()
+    ack_r, ack_w = os.pipe()
     if hasattr(fcntl, "F_SETPIPE_SZ"):
         try:
             fcntl.fcntl(wfd, fcntl.F_SETPIPE_SZ, _PIPE_SIZE)
@@ -399,6 +512,9 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
             pass
     sys.stdout.flush()
     sys.stderr.flush()
+    # Termination signals wait until the fork is over: a handler that raises inside the
+    # interpreter's at-fork hooks would be ignored there (and the signal lost).
+    old_mask = _block_signals()
     with warnings.catch_warnings():
         # Python >= 3.12 warns about forking a multi-threaded process; the child
         # only reads a file and exits through os._exit, and a deadline guards it.
@@ -408,50 +524,94 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
         code = 0
         try:
             os.close(rfd)
-            _child_main(wfd, func, args, kwargs, nbytes, shm)
+            os.close(ack_w)
+            _child_main(wfd, ack_r, func, args, kwargs, nbytes)
         except BaseException:
             code = 70
         finally:
             os._exit(code)
-    os.close(wfd)
-    return pid, _Reader(rfd, time.monotonic() + timeout), what, timeout, shm
+    try:
+        os.close(wfd)
+        os.close(ack_r)
+        reader = _Reader(rfd, time.monotonic() + timeout, ack_w)
+        _restore_signals(old_mask)  # a signal that came meanwhile is handled here
+    except BaseException:
+        _reap(pid, kill=True)
+        for fd in (rfd, ack_w):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+        raise
+    return pid, reader, what, timeout, nbytes
 
 
-def _finish(pid: int, reader: _Reader, what: str, timeout: float, shm: mmap.mmap | None):
+_SIGNALS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+
+def _block_signals():
+    if not hasattr(signal, "pthread_sigmask"):
+        return None
+    return signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+
+
+def _restore_signals(old_mask) -> None:
+    if old_mask is not None:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
+
+
+def _finish(pid: int, reader: _Reader, what: str, timeout: float, nbytes: int):
     received = None
-    killed = False
+    killed = malformed = False
     try:
         try:
             sizes = reader.exact(16)
             nhead, nbuf = _LEN.unpack_from(sizes, 0)[0], _LEN.unpack_from(sizes, 8)[0]
+            if nbuf > 1 << 20:
+                raise ValueError("too many buffers")
             table = reader.exact(16 * nbuf)
+            lengths = [_LEN.unpack_from(table, 16 * i)[0] for i in range(nbuf)]
+            addresses = [_LEN.unpack_from(table, 16 * i + 8)[0] for i in range(nbuf)]
+            if nhead > _answer_limit(nbytes) or sum(lengths) > _answer_limit(nbytes):
+                raise ValueError("the child declares more than it could hold")
             head = reader.exact(nhead)
-            bufs: list = []
-            view = memoryview(shm) if shm is not None else None
-            for i in range(nbuf):
-                n, at = _LEN.unpack_from(table, 16 * i)[0], _LEN.unpack_from(table, 16 * i + 8)[0]
-                if at == _PIPE or view is None:
-                    bufs.append(reader.exact(n))
-                elif at + n <= len(view):
-                    bufs.append(view[at : at + n])  # the arrays are views of the shared map: no copy
+            buf, offsets = _receiving_map(lengths)
+            view = memoryview(buf) if buf is not None else memoryview(bytearray(0))
+            # the arrays are views of the receiving map: no further copy
+            bufs = [view[at : at + n] for n, at in zip(lengths, offsets, strict=True)]
+            if bufs:
+                if buf is not None and _copy_from(pid, buf, offsets, lengths, addresses):
+                    reader.reply(b"v")
                 else:
-                    raise ValueError("shared-memory place out of range")
+                    reader.reply(b"p")
+                    for part in bufs:
+                        reader.into(part)
             received = pickle.loads(head, buffers=bufs)
         except _Deadline:
             killed = True
-        except (EOFError, pickle.UnpicklingError, struct.error, ValueError):
+        except EOFError:  # the child stopped short: its exit status says why
             received = None
+        except (pickle.UnpicklingError, struct.error, ValueError):
+            malformed = True
     except BaseException:  # KeyboardInterrupt in the parent: do not leave the child behind
         _reap(pid, kill=True)
         reader.close()
         raise
-    status = _reap(pid, kill=killed or received is None)
+    if received is not None:
+        # the answer is complete: the child's exit (freeing its memory, tens of ms for a large
+        # mesh) is reaped in the background instead of waited for
+        _reap_soon(pid)
+        status = 0
+    else:
+        status = _reap(pid, kill=True)
     reader.close()
     if killed:
         raise InputFileError(
             f"{what}: reading did not finish within {timeout:.0f} s (malformed or hostile file?); "
             f"set {TIMEOUT_ENV} to allow more time"
         )
+    if malformed:
+        raise InputFileError(f"{what}: the file reader sent a malformed answer: corrupt or malformed file")
     if received is None:
         if os.WIFSIGNALED(status):
             sig = os.WTERMSIG(status)
