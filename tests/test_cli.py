@@ -119,6 +119,26 @@ def test_defaults_resolved_before_the_command_runs(monkeypatch, small_map, capsy
     assert (seen["seed"], seen["amplitude"], seen["nr"]) == (DEFAULT_SEED, DEFAULT_AMPLITUDE, DEFAULT_NR)
 
 
+def test_table1_without_inputs_uses_the_reports_sample_pair(monkeypatch, tmp_path, capsys):
+    """`fepost table1` and `fepost report` without inputs read the same maps (the aircraft
+    tire at rated load), so the two show the same table."""
+    import fepost.analysis
+    from fepost.report.samples import sample_inputs
+
+    seen = []
+
+    def fake_analyse(static, rolling, **kwargs):
+        seen.append((Path(static), None if rolling is None else Path(rolling)))
+        raise KeyboardInterrupt  # stop here: the command's own interrupt path, exit 130
+
+    monkeypatch.setattr(fepost.analysis, "analyse", fake_analyse)
+    assert main(["table1"]) == 130
+    static, rolling = sample_inputs()
+    assert seen == [(static, rolling)]
+    assert static.name == "static_100.vtu" and static.parent.name == "aircraft"
+    assert rolling is not None and rolling.name == "rolling_100.vtu"
+
+
 # --- light start -------------------------------------------------------------------------
 
 _PROBE = """

@@ -132,3 +132,31 @@ def test_section_renders_figures_fits_and_escaped_table(tmp_path):
     # one load, one row: no load figure, no fit, the section still renders; no heading on request
     one = sweep_section(rows[:1], tmp_path / "one", title=None)
     assert "load_trends" not in one and "1 row " in one and "<h2>" not in one and "<h3>" in one
+
+
+def test_figures_and_page_write_symbols_and_units_in_the_reports_style(tmp_path):
+    """Subscripts rendered (M₀, k_x as mathtext / <sub>), torques in N·m, areas in m⁻²,
+    no unit for dimensionless quantities: never the literal column names."""
+    import matplotlib.pyplot as plt
+
+    from fepost.sweep.figures import plot_load_trends, plot_time_trends
+
+    rows = hertz_rows([1e4, 2e4, 4e4, 8e4])
+    for k, r in enumerate(rows):
+        r["k_x"] = 0.1 + 0.01 * k
+    fig = plot_load_trends(rows, load_trends(rows))
+    labels = {ax.get_ylabel() for ax in fig.axes if ax.get_visible()}
+    titles = {ax.get_title() for ax in fig.axes if ax.get_visible()}
+    plt.close(fig)
+    assert labels == {"$R$ (m)", "$M_0$ (N·m)", r"$a\,R^2$ (m²)", "$m/R^2$ (m⁻²)", "$k_x$"}
+    assert not any("k_x " in t or t.startswith("M0") for t in titles)
+    series = {"ramp.e": [{**r, "step": k, "time": 0.1 * k} for k, r in enumerate(rows)]}
+    fig = plot_time_trends(series)
+    labels = [ax.get_ylabel() for ax in fig.axes]
+    plt.close(fig)
+    assert "$M_0$ (N·m)" in labels and "aspect" in labels and "$m/R^2$ (m⁻²)" in labels
+    html = sweep_section(rows, tmp_path / "figs")
+    assert "<th>M<sub>0</sub> (N·m)</th>" in html and "<th>k<sub>x</sub></th>" in html
+    assert "<td>M<sub>0</sub> (N·m)</td>" in html and "<td>k<sub>x</sub></td>" in html
+    assert "<td>m / R² (m⁻²)</td>" in html
+    assert "N m" not in html and "k_x" not in html and "(1)" not in html

@@ -1,10 +1,12 @@
 """``fepost table1 [--static S] [--rolling R] [--seed N] [--json PATH] [--source SRC] ...``.
 
-Without ``--static`` and ``--rolling`` the sample meshes ``meshes/static.vtu`` and
-``meshes/rolling.vtu`` beside the package are used (a one-line error names the
-missing file). With ``--static`` alone no rolling map is used (the sample rolling
-map belongs to another tire): k_x is then assumed (``--k-x``, default the paper's
-0.130) and the table says so.
+Without ``--static`` and ``--rolling`` the report's sample pair is used: the
+aircraft tire at its rated load, ``meshes/aircraft/static_100.vtu`` and
+``meshes/aircraft/rolling_100.vtu`` (a one-line error names a missing file), so
+that ``fepost table1`` and ``fepost report`` show the same table. With
+``--static`` alone no rolling map is used (the sample rolling map belongs to
+another tire): k_x is then assumed (``--k-x``, default the paper's 0.130) and the
+table says so.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from __future__ import annotations
 import argparse
 
 from . import _validate as v
-from ._common import add_friction_option, add_input_options, analysis_kwargs, sample_mesh
+from ._common import add_friction_option, add_input_options, analysis_kwargs
 
 #: The committed seed of ``fepost table1`` (:data:`fepost.table1.DEFAULT_SEED`).
 SEED = v.LibraryDefault("fepost.table1", "DEFAULT_SEED")
@@ -28,11 +30,15 @@ def add_parser(sub) -> None:
             "95 % bounds | the paper's values."
         ),
     )
-    p.add_argument("--static", metavar="STATIC", help="static contact map (default: meshes/static.vtu)")
+    p.add_argument(
+        "--static",
+        metavar="STATIC",
+        help="static contact map (default: the sample aircraft tire, meshes/aircraft/static_100.vtu)",
+    )
     p.add_argument(
         "--rolling",
         metavar="ROLLING",
-        help="rolling contact map (default: meshes/rolling.vtu when --static is not given either)",
+        help="rolling contact map (default: meshes/aircraft/rolling_100.vtu when --static is not given)",
     )
     p.add_argument("--seed", type=v.seed, default=SEED, metavar="S", help="noise seed (default %(default)s)")
     p.add_argument("--json", metavar="PATH", help="write the table as JSON")
@@ -78,11 +84,12 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis import analyse
     from ..output import write_json_atomic
+    from ..report.samples import sample_inputs
     from ..table1 import format_table, table1
 
     if args.static is None:
-        static = sample_mesh("static.vtu")
-        rolling = args.rolling if args.rolling is not None else sample_mesh("rolling.vtu")
+        static, sample_rolling = sample_inputs()
+        rolling = args.rolling if args.rolling is not None else sample_rolling
     else:
         static, rolling = args.static, args.rolling
     result = analyse(static, rolling, friction=args.friction, **analysis_kwargs(args))

@@ -10,6 +10,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from ..report.units import display_unit
 from .trends import QUANTITIES, PowerLaw, groups
 
 #: Panels of the time-step figure: column, label, unit.
@@ -21,9 +22,27 @@ TIME_PANELS = (
     ("aR2", "a R²", "m²"),
     ("m_over_R2", "m / R²", "1/m²"),
 )
+#: How the figures write each quantity (matplotlib mathtext: subscripts, powers).
+MATH_LABELS = {
+    "N": "$N$",
+    "R": "$R$",
+    "M0": "$M_0$",
+    "aR2": r"$a\,R^2$",
+    "m_over_R2": "$m/R^2$",
+    "k_x": "$k_x$",
+    "aspect": "aspect",
+}
 #: Most transient runs drawn in one figure (the legend stays readable).
 MAX_SERIES = 8
 _COLOURS = ("#1f4e99", "#c0392b", "#2ca02c", "#e67e22", "#8e44ad", "#16a085", "#7f7f7f", "#b8860b")
+
+
+def axis_label(quantity: str, unit: str) -> str:
+    """Axis label of a column: its symbol with subscripts, the unit in the report's style
+    ("N·m", "m⁻²") in parentheses, none for a dimensionless quantity."""
+    shown = display_unit(unit)
+    name = MATH_LABELS.get(quantity, quantity)
+    return f"{name} ({shown})" if shown else name
 
 
 def _values(rows: Sequence[Mapping], key: str) -> np.ndarray:
@@ -76,9 +95,10 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
                 axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
                 axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
                 axis.set_minor_locator(NullLocator())
-            ax.set_xlabel("N (N)")
-            ax.set_ylabel(f"{label} ({unit})")
-            title = label if hertz is None else rf"{label}   (Hertz: $N^{{{hertz:.3g}}}$)"
+            ax.set_xlabel(axis_label("N", "N"))
+            ax.set_ylabel(axis_label(q, unit))
+            symbol = MATH_LABELS.get(q, label)
+            title = symbol if hertz is None else rf"{symbol}   (Hertz: $\propto N^{{{hertz:.3g}}}$)"
             ax.set_title(title, fontsize=10)
             if ax.get_legend_handles_labels()[0]:
                 ax.legend(loc="best")
@@ -111,9 +131,9 @@ def plot_time_trends(series: Mapping[str, Sequence[Mapping]]):
                 t = _values(members, "step")
             for ax, (q, _label, _unit) in zip(axes.flat, TIME_PANELS, strict=True):
                 ax.plot(t, _values(members, q), ".-", color=_COLOURS[k], lw=1, ms=3, label=source)
-        for ax, (_q, label, unit) in zip(axes.flat, TIME_PANELS, strict=True):
+        for ax, (q, _label, unit) in zip(axes.flat, TIME_PANELS, strict=True):
             ax.set_xlabel("time (s) or step")
-            ax.set_ylabel(f"{label} ({unit})")
+            ax.set_ylabel(axis_label(q, unit))
         axes[0, 0].legend(loc="best")
         fig.tight_layout()
     return fig

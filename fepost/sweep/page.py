@@ -15,14 +15,18 @@ import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+import markupsafe
+
 from ..output import write_json_atomic, write_text_atomic
-from .figures import plot_load_trends, plot_time_trends, transient_series
+from .figures import MAX_SERIES, plot_load_trends, plot_time_trends, transient_series
 from .table import normalise
 from .trends import PowerLaw, load_trends
 
 #: Most rows listed in the HTML table (the CSV and Parquet files hold them all).
 MAX_TABLE_ROWS = 200
-#: Columns of the HTML table: column, heading.
+#: How the page writes a fitted quantity (HTML; subscripts as <sub>).
+HTML_LABELS = {"M0": "M<sub>0</sub>", "aR2": "a R²", "m_over_R2": "m / R²", "k_x": "k<sub>x</sub>"}
+#: Columns of the HTML table: column, heading (HTML).
 TABLE_COLUMNS = (
     ("source", "source"),
     ("step", "step"),
@@ -30,12 +34,12 @@ TABLE_COLUMNS = (
     ("load", "load (N)"),
     ("N", "N (N)"),
     ("R", "R (m)"),
-    ("M0", "M0 (N m)"),
+    ("M0", "M<sub>0</sub> (N·m)"),
     ("a", "a"),
     ("m", "m"),
     ("aspect", "aspect"),
     ("circular", "circular"),
-    ("k_x", "k_x"),
+    ("k_x", "k<sub>x</sub>"),
     ("error", "error"),
 )
 
@@ -51,7 +55,19 @@ def _environment():
         lstrip_blocks=True,
     )
     env.filters["num"] = _num
+    env.filters["quantity"] = _quantity
+    env.filters["html"] = markupsafe.Markup
     return env
+
+
+def _quantity(fit: PowerLaw):
+    """A fit's quantity as the page writes it: symbol with subscripts, unit in the report's
+    style in parentheses (none for a dimensionless quantity)."""
+    from ..report.units import display_unit
+
+    name = markupsafe.Markup(HTML_LABELS.get(fit.quantity, markupsafe.escape(fit.label)))
+    unit = display_unit(fit.unit)
+    return name + markupsafe.Markup(" (") + unit + markupsafe.Markup(")") if unit else name
 
 
 def _num(v, digits: int = 4) -> str:
@@ -100,7 +116,7 @@ def draw_figures(rows: Sequence[Mapping], fits: Sequence[PowerLaw], folder: Path
                 "png": "time_trends.png",
                 "svg": "time_trends.svg",
                 "caption": "Coefficients against time for the runs with several time steps"
-                + (f" (the first {8} of {len(series)})" if len(series) > 8 else "")
+                + (f" (the first {MAX_SERIES} of {len(series)})" if len(series) > MAX_SERIES else "")
                 + ".",
             }
         )

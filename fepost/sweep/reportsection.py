@@ -150,6 +150,7 @@ def sweep_provider(
         from .run import run_sweep
         from .store import WORK, WorkFolder
         from .trends import load_trends
+
         options = RowOptions.from_analysis_kwargs(_analysis_kwargs(data), friction=float(data.friction))
         out = Path(folder) / FOLDER
         if own is not None and same:
