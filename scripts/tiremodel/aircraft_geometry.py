@@ -30,24 +30,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .meshing import (
-    TireProfile,
-    face_lookup,
-    gmsh_hexes,
-    gmsh_model,
-    gmsh_quads,
-    orient_outward,
-    revolved_blocks,
-    structured_patch,
-    volume_mesh,
-)
+from . import meshing as mg
 
 REGIONS = ("crown", "shoulder", "side")
 LAYERS = ("rubber", "carcass")
 
 
 @dataclass(frozen=True)
-class AircraftParams(TireProfile):
+class AircraftParams(mg.TireProfile):
     """Dimensions (m) and mesh counts of the aircraft tire model."""
 
     outer_radius: float = 0.584  # D = 46 in = 1.168 m
@@ -138,7 +128,7 @@ def _offset_curve(geo, p: AircraftParams, k: int, depth: tuple[float, float], en
 
 def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMesh:
     """Mesh the half tire (y >= 0) with gmsh; return numpy arrays."""
-    with gmsh_model("aircraft_tire", verbose) as gmsh:
+    with mg.gmsh_model("aircraft_tire", verbose) as gmsh:
         geo = gmsh.model.geo
         counts = (p.n_crown, p.n_shoulder, p.n_side)
         arcs = p.arcs()
@@ -172,7 +162,7 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
             )
             for layer, (top, bot) in enumerate(((outer, mid), (mid, inner))):
                 corners = [p0[layer], p1[layer], p1[layer + 1], p0[layer + 1]]
-                s = structured_patch(geo, top, l1[layer], bot, l0[layer], corners, counts[k], 1)
+                s = mg.structured_patch(geo, top, l1[layer], bot, l0[layer], corners, counts[k], 1)
                 surfaces.append((s, k, layer))
             prev = (p1, l1)
 
@@ -204,7 +194,7 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
                     recombine=True,
                 )
                 tops = []
-                for (_, k, layer), (top, vol, lat) in zip(surfaces, revolved_blocks(out), strict=True):
+                for (_, k, layer), (top, vol, lat) in zip(surfaces, mg.revolved_blocks(out), strict=True):
                     tops.append(top)
                     vol_kind[vol] = (k, layer, part == "fine")
                     if layer == 0:
@@ -224,20 +214,20 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
         coords = coords.reshape(-1, 3)
         hex_list, reg_list, lay_list, fine_list = [], [], [], []
         for vtag, (k, layer, is_fine) in vol_kind.items():
-            h = gmsh_hexes(gmsh, vtag)
+            h = mg.gmsh_hexes(gmsh, vtag)
             hex_list.append(h)
             reg_list.append(np.full(h.shape[0], k))
             lay_list.append(np.full(h.shape[0], layer))
             fine_list.append(np.full(h.shape[0], is_fine))
         hexes_t = np.vstack(hex_list)
-        q = {name: gmsh_quads(gmsh, groups[name]) for name in groups}
+        q = {name: mg.gmsh_quads(gmsh, groups[name]) for name in groups}
 
     # the two revolutions meet at +-180 deg: merge their coincident nodes
-    nodes, hexes, remap = volume_mesh(tags, coords, hexes_t, merge_tol=1e-7)
+    nodes, hexes, remap = mg.volume_mesh(tags, coords, hexes_t, merge_tol=1e-7)
     region = np.concatenate(reg_list)
     layer = np.concatenate(lay_list)
     meridian, circ = _material_axes(p, nodes, hexes, region)
-    table = face_lookup(hexes)
+    table = mg.face_lookup(hexes)
     mesh = AircraftMesh(
         params=p,
         nodes=nodes,
@@ -247,9 +237,9 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
         fine=np.concatenate(fine_list),
         meridian=meridian,
         circumferential=circ,
-        outer_quads=orient_outward(hexes, remap(q["outer"]), table),
-        contact_quads=orient_outward(hexes, remap(q["contact"]), table),
-        inner_quads=orient_outward(hexes, remap(q["inner"]), table),
+        outer_quads=mg.orient_outward(hexes, remap(q["outer"]), table),
+        contact_quads=mg.orient_outward(hexes, remap(q["contact"]), table),
+        inner_quads=mg.orient_outward(hexes, remap(q["inner"]), table),
         bead_nodes=np.unique(remap(q["bead"])),
         symmetry_nodes=np.unique(remap(q["sym"])),
     )

@@ -9,19 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .ccxdeck import (
-    ROAD_MATERIAL,
-    ROAD_SECTION,
-    build_road,
-    contact_pair,
-    contact_surfaces,
-    element_block,
-    node_block,
-    node_sets,
-    pressure_load,
-    road_elements,
-    tire_road_sets,
-)
+from . import ccxdeck as cx
 from .geometry import TireMesh
 from .meshing import face_lookup
 
@@ -65,24 +53,24 @@ def write_deck(
 ) -> dict:
     """Write the deck; ``rim_travel`` is the total downward rim displacement (m)."""
     p = mesh.params
-    road = build_road()
+    road = cx.build_road()
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
     out = []
     w = out.append
     w("*HEADING")
     w(f"fepost tire sector, case {case.name}")
-    out += node_block(mesh.nodes, road)
-    out += element_block("C3D8I", "TIRE", range(1, et + 1), mesh.hexes)
-    out += road_elements(road, nt, et)
-    out += node_sets({"BEAD": (int(n) + 1 for n in mesh.bead_nodes), **tire_road_sets(nt, road)})
+    out += cx.node_block(mesh.nodes, road)
+    out += cx.element_block("C3D8I", "TIRE", range(1, et + 1), mesh.hexes)
+    out += cx.road_elements(road, nt, et)
+    out += cx.node_sets({"BEAD": (int(n) + 1 for n in mesh.bead_nodes), **cx.tire_road_sets(nt, road)})
     table = face_lookup(mesh.hexes)
-    out += contact_surfaces(mesh.hexes, mesh.contact_quads, road, table)
+    out += cx.contact_surfaces(mesh.hexes, mesh.contact_quads, road, table)
     w("*MATERIAL, NAME=CORDRUBBER")
     w("*ELASTIC")
     w(f"{E_RUBBER:.6e}, {NU_RUBBER}")
-    out += ROAD_MATERIAL
+    out += cx.ROAD_MATERIAL
     w("*SOLID SECTION, ELSET=TIRE, MATERIAL=CORDRUBBER")
-    w(ROAD_SECTION)
+    w(cx.ROAD_SECTION)
     # sector cut faces: tangential displacement equals the rim's (rigid-rim
     # cyclic condition): t . u_node - t . u_ref = 0, t = circumferential direction
     bead = set(int(n) for n in mesh.bead_nodes)
@@ -105,7 +93,7 @@ def write_deck(
         w(f"{n + 1}, {d1}, {c1:.9f}, {n + 1}, {d2}, {c2:.9f}, ")
         out[-1] += f"{ref}, {d1}, {-c1:.9f}, {ref}, {d2}, {-c2:.9f}"
         n_eq += 1
-    out += contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE, CONTACT_TYPE)
+    out += cx.contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE, CONTACT_TYPE)
     w("*BOUNDARY")
     w("ROADN, 1, 3")
     w("BEAD, 1, 3")
@@ -125,7 +113,7 @@ def write_deck(
     w("*STATIC")
     w("0.25, 1.0, 1e-5, 0.5")
     w("*DLOAD")
-    out += pressure_load(mesh.hexes, mesh.inner_quads, PRESSURE, table)
+    out += cx.pressure_load(mesh.hexes, mesh.inner_quads, PRESSURE, table)
     outputs()
     w("*END STEP")
     if not inflation_only:

@@ -20,21 +20,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .meshing import (
-    TireProfile,
-    face_lookup,
-    gmsh_hexes,
-    gmsh_model,
-    gmsh_quads,
-    orient_outward,
-    revolved_blocks,
-    structured_patch,
-    volume_mesh,
-)
+from . import meshing as mg
 
 
 @dataclass(frozen=True)
-class TireParams(TireProfile):
+class TireParams(mg.TireProfile):
     outer_radius: float = 0.50  # m, crown radius about the axle (D = 1.0 m)
     crown_radius: float = 0.50  # m, lateral radius of the crown arc
     tread_half_width: float = 0.11  # m, lateral extent of the crown arc
@@ -82,7 +72,7 @@ def _point(geo, y: float, r: float, p: TireParams) -> int:
 
 def build_mesh(p: TireParams, verbose: bool = False) -> TireMesh:
     """Build and mesh the sector with gmsh; return numpy arrays."""
-    with gmsh_model("tire", verbose) as gmsh:
+    with mg.gmsh_model("tire", verbose) as gmsh:
         geo = gmsh.model.geo
         counts = [p.n_crown, p.n_shoulder, p.n_side]
         kinds: dict[int, str] = {}  # 2D section surface tag -> region name
@@ -110,7 +100,8 @@ def build_mesh(p: TireParams, verbose: bool = False) -> TireMesh:
                 arc_o = geo.addCircleArc(o0, cen, o1)
                 arc_i = geo.addCircleArc(i0, cen, i1)
                 line1 = geo.addLine(o1, i1)
-                s = structured_patch(geo, arc_o, line1, arc_i, line0, [o0, o1, i1, i0], counts[k], p.n_wall)
+                corners = [o0, o1, i1, i0]
+                s = mg.structured_patch(geo, arc_o, line1, arc_i, line0, corners, counts[k], p.n_wall)
                 kinds[s] = ("crown", "shoulder", "side")[k]
                 section_surfs.append((s, arc_o, k == 2))
                 prev_o, prev_i, prev_line = o1, i1, line1
@@ -128,7 +119,7 @@ def build_mesh(p: TireParams, verbose: bool = False) -> TireMesh:
         for sign in (1.0, -1.0):
             out1 = geo.revolve(base, 0, 0, zc, 0, 1, 0, sign * fine, [p.n_fine], recombine=True)
             tops = []
-            for (s, _, is_bead), (top, _, lat) in zip(section_surfs, revolved_blocks(out1), strict=True):
+            for (s, _, is_bead), (top, _, lat) in zip(section_surfs, mg.revolved_blocks(out1), strict=True):
                 tops.append(top)
                 groups["outer"].append(lat[0][1])
                 if kinds[s] in ("crown", "shoulder"):
@@ -137,7 +128,7 @@ def build_mesh(p: TireParams, verbose: bool = False) -> TireMesh:
                 if is_bead:
                     groups["bead"].append(lat[1][1])
             out2 = geo.revolve(tops, 0, 0, zc, 0, 1, 0, sign * coarse, [p.n_coarse], recombine=True)
-            for (_, _, is_bead), (top, _, lat) in zip(section_surfs, revolved_blocks(out2), strict=True):
+            for (_, _, is_bead), (top, _, lat) in zip(section_surfs, mg.revolved_blocks(out2), strict=True):
                 groups["cut"].append(top[1])
                 groups["outer"].append(lat[0][1])
                 groups["inner"].append(lat[2][1])
@@ -148,18 +139,18 @@ def build_mesh(p: TireParams, verbose: bool = False) -> TireMesh:
 
         tags, coords, _ = gmsh.model.mesh.getNodes()
         coords = coords.reshape(-1, 3)
-        hexes_t = gmsh_hexes(gmsh)
-        q = {name: gmsh_quads(gmsh, groups[name]) for name in groups}
+        hexes_t = mg.gmsh_hexes(gmsh)
+        q = {name: mg.gmsh_quads(gmsh, groups[name]) for name in groups}
 
-    nodes, hexes, remap = volume_mesh(tags, coords, hexes_t)
-    table = face_lookup(hexes)
+    nodes, hexes, remap = mg.volume_mesh(tags, coords, hexes_t)
+    table = mg.face_lookup(hexes)
     mesh = TireMesh(
         params=p,
         nodes=nodes,
         hexes=hexes,
-        outer_quads=orient_outward(hexes, remap(q["outer"]), table),
-        contact_quads=orient_outward(hexes, remap(q["contact"]), table),
-        inner_quads=orient_outward(hexes, remap(q["inner"]), table),
+        outer_quads=mg.orient_outward(hexes, remap(q["outer"]), table),
+        contact_quads=mg.orient_outward(hexes, remap(q["contact"]), table),
+        inner_quads=mg.orient_outward(hexes, remap(q["inner"]), table),
         bead_nodes=remap(np.unique(q["bead"])),
         cut_nodes=remap(np.unique(q["cut"])),
     )
