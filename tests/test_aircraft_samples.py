@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tire_samples import assert_exodus_matches_vtu, centre_of_pressure
 
 FOLDER = Path(__file__).resolve().parents[1] / "meshes" / "aircraft"
 STATIC = ("static_025", "static_050", "static_075", "static_100", "static_125", "static_150")
@@ -47,14 +48,6 @@ def _gauss_integral(points: np.ndarray, quads: np.ndarray, values: np.ndarray) -
             jac = np.cross(np.einsum("k,fkj->fj", da, x), np.einsum("k,fkj->fj", db, x))
             total += float(np.sum(np.linalg.norm(jac, axis=1) * (v @ n)))
     return total
-
-
-def _centre_of_pressure(points, quads, p):
-    x = points[quads]
-    d1, d2 = x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]
-    a = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-    w = a * p[quads].mean(axis=1)
-    return (w[:, None] * x.mean(axis=1)).sum(axis=0) / w.sum()
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -156,7 +149,7 @@ def test_patch_grows_with_load():
 @pytest.mark.parametrize("case", STATIC)
 def test_static_centre_of_pressure_under_the_axle(case):
     pts, quads, p, side = _load(case)
-    cop = _centre_of_pressure(pts, quads, p)
+    cop = centre_of_pressure(pts, quads, p)
     assert abs(cop[0]) < 0.02 * side["patch"]["length"]
     assert abs(cop[1]) < 1e-9  # mirrored half model
 
@@ -169,21 +162,14 @@ def test_rolling_standin():
     fx = roll["friction_force_on_road_x"]
     assert dx > 0 and fx < 0  # traction opposes the rim's motion
     assert abs(fx) <= 1.01 * s1["friction"] * s1["reaction_z"]
-    c0 = _centre_of_pressure(pts0, q0, p0)
-    c1 = _centre_of_pressure(pts1, q1, p1)
+    c0 = centre_of_pressure(pts0, q0, p0)
+    c1 = centre_of_pressure(pts1, q1, p1)
     assert c1[0] - c0[0] > 0.005 * s0["patch"]["length"]
 
 
 @pytest.mark.parametrize("case", ("static_025", "static_100", "rolling_100"))
 def test_exodus_and_vtu_agree(case):
-    import meshio
-
-    v = meshio.read(FOLDER / f"{case}.vtu")
-    e = meshio.read(FOLDER / f"{case}.e")
-    np.testing.assert_allclose(e.points, v.points, rtol=0, atol=1e-9)
-    np.testing.assert_array_equal(e.cells_dict["quad"], v.cells_dict["quad"])
-    np.testing.assert_allclose(e.point_data["CPRESS"], v.point_data["CPRESS"], rtol=1e-9, atol=1e-6)
-    np.testing.assert_allclose(e.point_data["displacement"], v.point_data["displacement"], atol=1e-12)
+    assert_exodus_matches_vtu(FOLDER / f"{case}.vtu", FOLDER / f"{case}.e")
 
 
 def test_samples_are_small():

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tire_samples import assert_exodus_matches_vtu, centre_of_pressure, face_stats
 
 MESHES = Path(__file__).resolve().parents[1] / "meshes"
 CASES = ("static", "rolling", "heavy")
@@ -32,21 +33,6 @@ def _load(case: str):
     return m.points + u, quads, m.point_data["CPRESS"], u, side
 
 
-def _face_stats(points, quads, p):
-    """Per-face area (projected on the road plane) and mean pressure; centroids."""
-    x = points[quads]
-    d1 = x[:, 2] - x[:, 0]
-    d2 = x[:, 3] - x[:, 1]
-    area_z = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-    return area_z, p[quads].mean(axis=1), x.mean(axis=1)
-
-
-def _centre_of_pressure(points, quads, p):
-    a, pm, c = _face_stats(points, quads, p)
-    w = a * pm
-    return (w[:, None] * c).sum(axis=0) / w.sum()
-
-
 def _patch_radius(points, p, centre):
     loaded = p > 0
     return float(np.max(np.hypot(points[loaded, 0] - centre[0], points[loaded, 1] - centre[1])))
@@ -54,7 +40,7 @@ def _patch_radius(points, p, centre):
 
 def _aspect(points, quads, p):
     """Best-fit ellipse aspect (length/width) from the area second moments of loaded faces."""
-    a, pm, c = _face_stats(points, quads, p)
+    a, pm, c = face_stats(points, quads, p)
     loaded = (p[quads] > 0).all(axis=1)
     a, c = a[loaded], c[loaded, :2]
     mu = (a[:, None] * c).sum(0) / a.sum()
@@ -115,7 +101,7 @@ def test_static_map_is_symmetric():
     from scipy.spatial import cKDTree
 
     pts, quads, p, u, side = _load("static")
-    centre = _centre_of_pressure(pts, quads, p)
+    centre = centre_of_pressure(pts, quads, p)
     radius = _patch_radius(pts, p, centre)
     assert np.hypot(centre[0], centre[1]) < 0.02 * radius
     ref = pts - u  # reference (undeformed) positions: exactly mirror-symmetric mesh
@@ -131,8 +117,8 @@ def test_rolling_centre_of_pressure_moves_with_the_rim():
     centre of pressure moves forward (+x) relative to the static map, as for a rolling tire."""
     pts0, q0, p0, _, s0 = _load("static")
     pts1, q1, p1, _, s1 = _load("rolling")
-    c0 = _centre_of_pressure(pts0, q0, p0)
-    c1 = _centre_of_pressure(pts1, q1, p1)
+    c0 = centre_of_pressure(pts0, q0, p0)
+    c1 = centre_of_pressure(pts1, q1, p1)
     dx = s1["rolling_standin"]["imposed_rim_displacement"][0]
     fx = s1["rolling_standin"]["friction_force_on_road_x"]
     radius = _patch_radius(pts0, p0, c0)
@@ -155,14 +141,7 @@ def test_heavy_patch_is_oblong():
 
 @pytest.mark.parametrize("case", CASES)
 def test_exodus_and_vtu_agree(case):
-    import meshio
-
-    v = meshio.read(MESHES / f"{case}.vtu")
-    e = meshio.read(MESHES / f"{case}.e")
-    np.testing.assert_allclose(e.points, v.points, rtol=0, atol=1e-9)
-    np.testing.assert_array_equal(e.cells_dict["quad"], v.cells_dict["quad"])
-    np.testing.assert_allclose(e.point_data["CPRESS"], v.point_data["CPRESS"], rtol=1e-9, atol=1e-6)
-    np.testing.assert_allclose(e.point_data["displacement"], v.point_data["displacement"], atol=1e-12)
+    assert_exodus_matches_vtu(MESHES / f"{case}.vtu", MESHES / f"{case}.e")
 
 
 def test_samples_are_small():

@@ -25,9 +25,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import ccxdeck as cx
 from .aircraft_geometry import AircraftMesh
-from .deck import _lines, build_road
-from .geometry import face_lookup
+from .meshing import face_lookup
 
 PRESSURE = 1.38e6  # Pa, rated inflation (200 psi)
 RATED_LOAD = 200.0e3  # N, rated load of the modelled tire (45,000 lbf)
@@ -127,11 +127,7 @@ def write_aircraft_deck(
     w = out.append
     w("*HEADING")
     w("fepost aircraft tire (46x17R20 class), half model y >= 0")
-    w("*NODE, NSET=NALL")
-    for i, (x, y, z) in enumerate(mesh.nodes):
-        w(f"{i + 1}, {x:.9e}, {y:.9e}, {z:.9e}")
-    for i, (x, y, z) in enumerate(road.nodes):
-        w(f"{nt + i + 1}, {x:.9e}, {y:.9e}, {z:.9e}")
+    out += cx.node_block(mesh.nodes, road)
     # tire elements, grouped by material
     # incompatible-mode hexahedra (good in bending) in the refined region around the
     # patch; plain C3D8 in the coarse upper part, which only carries the inflation, and
@@ -139,38 +135,22 @@ def write_aircraft_deck(
     # lateral patch edge oscillated without converging once the edge reached them
     incompatible = mesh.fine & ~((mesh.region == 1) & (mesh.layer == 0))
     for etype, sel in (("C3D8I", incompatible), ("C3D8", ~incompatible)):
-        w(f"*ELEMENT, TYPE={etype}, ELSET=TIRE")
-        for e in np.flatnonzero(sel):
-            w(f"{e + 1}, " + ", ".join(str(int(n) + 1) for n in mesh.hexes[e]))
-    w("*ELEMENT, TYPE=C3D8, ELSET=ROAD")
-    for e, h in enumerate(road.hexes):
-        w(f"{et + e + 1}, " + ", ".join(str(int(n) + nt + 1) for n in h))
+        out += cx.element_block(etype, "TIRE", np.flatnonzero(sel) + 1, mesh.hexes[sel])
+    out += cx.road_elements(road, nt, et)
     rubber = mesh.layer == 0
     tread = rubber & (mesh.region == 0)
     for name, sel in (("ETREAD", tread), ("ESIDEWALL", rubber & ~tread)):
         w(f"*ELSET, ELSET={name}")
-        w(_lines(int(e) + 1 for e in np.flatnonzero(sel)))
-    w("*NSET, NSET=BEAD")
-    w(_lines(int(n) + 1 for n in mesh.bead_nodes))
-    w("*NSET, NSET=SYMN")
-    w(_lines(int(n) + 1 for n in mesh.symmetry_nodes))
-    w("*NSET, NSET=ROADN")
-    w(_lines(range(nt + 1, nt + road.nodes.shape[0] + 1)))
-    w("*NSET, NSET=TIREN")
-    w(_lines(range(1, nt + 1)))
-    w("*NSET, NSET=ROADREF")
-    w(str(nt + 1))
+        w(cx.data_lines(int(e) + 1 for e in np.flatnonzero(sel)))
+    sets = {
+        "BEAD": (int(n) + 1 for n in mesh.bead_nodes),
+        "SYMN": (int(n) + 1 for n in mesh.symmetry_nodes),
+        **cx.tire_road_sets(nt, road),
+        "ROADREF": [nt + 1],
+    }
+    out += cx.node_sets(sets)
     table = face_lookup(mesh.hexes)
-
-    def faces(quads):
-        return [table[frozenset(int(i) for i in q)] for q in quads]
-
-    w("*SURFACE, NAME=STIRE, TYPE=ELEMENT")
-    for e, k in faces(mesh.contact_quads):
-        w(f"{e + 1}, S{k}")
-    w("*SURFACE, NAME=SROAD, TYPE=ELEMENT")
-    for e, k in road.top_faces:
-        w(f"{et + e + 1}, S{k}")
+    out += cx.contact_surfaces(mesh.hexes, mesh.contact_quads, road, table)
     # materials
     for name, r in RUBBER.items():
         w(f"*MATERIAL, NAME={name}")
@@ -181,12 +161,10 @@ def write_aircraft_deck(
         w("*ELASTIC, TYPE=ENGINEERING CONSTANTS")
         w(", ".join(f"{v:.6e}" for v in c[:8]))
         w(f"{c[8]:.6e}")
-    w("*MATERIAL, NAME=ROADMAT")
-    w("*ELASTIC")
-    w("2.1e11, 0.3")
+    out += cx.ROAD_MATERIAL
     w("*SOLID SECTION, ELSET=ETREAD, MATERIAL=TREAD")
     w("*SOLID SECTION, ELSET=ESIDEWALL, MATERIAL=SIDEWALL")
-    w("*SOLID SECTION, ELSET=ROAD, MATERIAL=ROADMAT")
+    w(cx.ROAD_SECTION)
     # carcass: one orientation per element (local 1 meridional, 2 circumferential)
     for e in np.flatnonzero(mesh.layer == 1):
         a, b = mesh.meridian[e], mesh.circumferential[e]
@@ -196,13 +174,7 @@ def write_aircraft_deck(
         w(f"*ELSET, ELSET=EC{e + 1}")
         w(str(e + 1))
         w(f"*SOLID SECTION, ELSET=EC{e + 1}, MATERIAL={mat}, ORIENTATION=OR{e + 1}")
-    w("*SURFACE INTERACTION, NAME=SI")
-    w("*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR")
-    w(f"{CONTACT_SLOPE:.6e}, {CONTACT_TENSION:.6e}")
-    w("*FRICTION")
-    w(f"{FRICTION}, {STICK_SLOPE:.6e}")
-    w("*CONTACT PAIR, INTERACTION=SI, TYPE=NODE TO SURFACE")
-    w("STIRE, SROAD")
+    out += cx.contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE)
     # time schedule: inflation over [0, t0], then stage k over [t0 + k - 1, t0 + k]
     t0 = INFLATION_TIME
     times, zs, xs = [0.0, t0], [0.0, 0.0], [0.0, 0.0]
@@ -221,10 +193,10 @@ def write_aircraft_deck(
     w(f"0.0, 0.0, {t0:.6f}, 1.0, {total:.6f}, 1.0")
     for name, vals in (("AROADZ", zs), ("AROADX", xs)):
         w(f"*AMPLITUDE, NAME={name}")
-        w(_lines((f"{t:.6f}, {v:.9e}" for t, v in zip(times, vals, strict=True)), per=4))
+        w(cx.data_lines((f"{t:.6f}, {v:.9e}" for t, v in zip(times, vals, strict=True)), per=4))
     w("*TIME POINTS, NAME=TOUT")
     # results (.frd and .dat alike: CalculiX writes both at these times only)
-    w(_lines(f"{t:.9f}" for t in sorted(set(round(t, 9) for t in output_times.values()))))
+    w(cx.data_lines(f"{t:.9f}" for t in sorted(set(round(t, 9) for t in output_times.values()))))
     w("*BOUNDARY")
     w("SYMN, 2, 2")
     w("BEAD, 1, 3")
@@ -245,8 +217,7 @@ def write_aircraft_deck(
     w("*BOUNDARY, AMPLITUDE=AROADX")
     w("ROADN, 1, 1, -1.0")
     w("*DLOAD, AMPLITUDE=APRESS")
-    for e, k in faces(mesh.inner_quads):
-        w(f"{e + 1}, P{k}, {PRESSURE:.6e}")
+    out += cx.pressure_load(mesh.hexes, mesh.inner_quads, PRESSURE, table)
     w("*NODE FILE, NSET=TIREN, TIME POINTS=TOUT")
     w("U")
     w("*CONTACT FILE, TIME POINTS=TOUT")
@@ -272,6 +243,6 @@ def write_aircraft_deck(
 
 def _half_road():
     """Road block on x in [-0.6, 0.6], y in [0, 0.3], top face z = 0, 25 mm faces."""
-    road = build_road(half_x=0.60, half_y=0.15, thick=0.02, size=0.025)
+    road = cx.build_road(half_x=0.60, half_y=0.15, thick=0.02, size=0.025)
     road.nodes[:, 1] += 0.15
     return road

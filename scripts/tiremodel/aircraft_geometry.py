@@ -30,14 +30,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .geometry import C3D8_FACES, face_lookup
+from . import meshing as mg
 
 REGIONS = ("crown", "shoulder", "side")
 LAYERS = ("rubber", "carcass")
 
 
 @dataclass(frozen=True)
-class AircraftParams:
+class AircraftParams(mg.TireProfile):
     """Dimensions (m) and mesh counts of the aircraft tire model."""
 
     outer_radius: float = 0.584  # D = 46 in = 1.168 m
@@ -61,38 +61,6 @@ class AircraftParams:
     growth: float = 1.02
     fine_deg: float = 55.0
     n_coarse: int = 22
-
-    @property
-    def axle_z(self) -> float:
-        return self.outer_radius + self.gap0
-
-    def arcs(self) -> list[tuple[float, float, float, float, float]]:
-        """Outer-profile arcs (y_c, r_c, R, beta0, beta1) of the y >= 0 half.
-
-        A point of an arc is (y_c + R sin b, r_c + R cos b); b is the angle of the
-        outward normal from the +r direction.
-        """
-        rc, rs, rw = self.crown_radius, self.shoulder_radius, self.sidewall_radius
-        b1 = math.asin(self.tread_half_width / rc)
-        c0 = (0.0, self.outer_radius - rc)
-        c1 = (c0[0] + (rc - rs) * math.sin(b1), c0[1] + (rc - rs) * math.cos(b1))
-        b2 = math.pi / 2
-        c2 = (c1[0] + (rs - rw) * math.sin(b2), c1[1] + (rs - rw) * math.cos(b2))
-        b3 = math.radians(self.sidewall_end_deg)
-        return [
-            (c0[0], c0[1], rc, 0.0, b1),
-            (c1[0], c1[1], rs, b1, b2),
-            (c2[0], c2[1], rw, b2, b3),
-        ]
-
-    def section_width(self) -> float:
-        y, _, r, _, _ = self.arcs()[1]
-        return 2 * (y + r)
-
-    def bead(self) -> tuple[float, float]:
-        """(y, r) of the outer bead point."""
-        yc, rc, r, _, b = self.arcs()[2]
-        return yc + r * math.sin(b), rc + r * math.cos(b)
 
     def fine_layers(self) -> list[float]:
         """Angular sizes (deg) of the circumferential layers from the bottom up to ``fine_deg``."""
@@ -160,12 +128,7 @@ def _offset_curve(geo, p: AircraftParams, k: int, depth: tuple[float, float], en
 
 def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMesh:
     """Mesh the half tire (y >= 0) with gmsh; return numpy arrays."""
-    import gmsh
-
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 1 if verbose else 0)
-        gmsh.model.add("aircraft_tire")
+    with mg.gmsh_model("aircraft_tire", verbose) as gmsh:
         geo = gmsh.model.geo
         counts = (p.n_crown, p.n_shoulder, p.n_side)
         arcs = p.arcs()
@@ -181,12 +144,10 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
 
         surfaces: list[tuple[int, int, int]] = []  # (surface tag, region, layer)
         prev = None  # (points, lines) at the start of the current arc
-        sym_lines: list[int] = []
         for k, (yc, rc, _, b0, b1) in enumerate(arcs):
             if prev is None:
                 p0 = profile_points(k, b0, 0)
                 l0 = [geo.addLine(p0[0], p0[1]), geo.addLine(p0[1], p0[2])]
-                sym_lines = list(l0)
             else:
                 p0, l0 = prev
             p1 = profile_points(k, b1, 1)
@@ -200,18 +161,10 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
                 geo, p, k, (p.total_thickness[k][0], p.total_thickness[k][1]), (p0[2], p1[2])
             )
             for layer, (top, bot) in enumerate(((outer, mid), (mid, inner))):
-                loop = geo.addCurveLoop([top, l1[layer], -bot, -l0[layer]])
-                s = geo.addPlaneSurface([loop])
-                for c in (top, bot):
-                    geo.mesh.setTransfiniteCurve(c, counts[k] + 1)
-                for c in (l0[layer], l1[layer]):
-                    geo.mesh.setTransfiniteCurve(c, 2)
                 corners = [p0[layer], p1[layer], p1[layer + 1], p0[layer + 1]]
-                geo.mesh.setTransfiniteSurface(s, cornerTags=corners)
-                geo.mesh.setRecombine(2, s)
+                s = mg.structured_patch(geo, top, l1[layer], bot, l0[layer], corners, counts[k], 1)
                 surfaces.append((s, k, layer))
             prev = (p1, l1)
-        del sym_lines
 
         zc = p.axle_z
         fine = p.fine_layers()
@@ -240,12 +193,10 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
                     heights(sizes),
                     recombine=True,
                 )
-                new_tops = []
-                for j, (_, k, layer) in enumerate(surfaces):
-                    blk = out[6 * j : 6 * j + 6]
-                    top, vol, lat = blk[0], blk[1], blk[2:]
-                    new_tops.append(top)
-                    vol_kind[vol[1]] = (k, layer, part == "fine")
+                tops = []
+                for (_, k, layer), (top, vol, lat) in zip(surfaces, mg.revolved_blocks(out), strict=True):
+                    tops.append(top)
+                    vol_kind[vol] = (k, layer, part == "fine")
                     if layer == 0:
                         groups["outer"].append(lat[0][1])
                         if part == "fine" and k in (0, 1):
@@ -256,7 +207,6 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
                         groups["bead"].append(lat[1][1])
                     if k == 0:
                         groups["sym"].append(lat[3][1])
-                tops = new_tops
         geo.synchronize()
         gmsh.model.mesh.generate(3)
 
@@ -264,59 +214,20 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
         coords = coords.reshape(-1, 3)
         hex_list, reg_list, lay_list, fine_list = [], [], [], []
         for vtag, (k, layer, is_fine) in vol_kind.items():
-            et, _, en = gmsh.model.mesh.getElements(3, vtag)
-            for t, nn in zip(et, en, strict=True):
-                if t != 5:
-                    raise RuntimeError(f"gmsh produced non-hex 3D elements (type {t})")
-                h = nn.reshape(-1, 8)
-                hex_list.append(h)
-                reg_list.append(np.full(h.shape[0], k))
-                lay_list.append(np.full(h.shape[0], layer))
-                fine_list.append(np.full(h.shape[0], is_fine))
+            h = mg.gmsh_hexes(gmsh, vtag)
+            hex_list.append(h)
+            reg_list.append(np.full(h.shape[0], k))
+            lay_list.append(np.full(h.shape[0], layer))
+            fine_list.append(np.full(h.shape[0], is_fine))
         hexes_t = np.vstack(hex_list)
+        q = {name: mg.gmsh_quads(gmsh, groups[name]) for name in groups}
 
-        def quads_of(surfs: list[int]) -> np.ndarray:
-            out = []
-            for s in surfs:
-                et, _, en = gmsh.model.mesh.getElements(2, s)
-                for t, nn in zip(et, en, strict=True):
-                    if t != 3:
-                        raise RuntimeError(f"non-quad face on surface {s}")
-                    out.append(nn.reshape(-1, 4))
-            return np.vstack(out)
-
-        q = {name: quads_of(groups[name]) for name in ("outer", "contact", "inner", "bead", "sym")}
-    finally:
-        gmsh.finalize()
-
-    # merge coincident nodes (the two revolutions meet at +-180 deg), renumber 0-based
-    order = np.argsort(tags)
-    tags_s, coords_s = tags[order], coords[order]
-    used = np.unique(hexes_t)
-    pos = np.searchsorted(tags_s, used)
-    pts = coords_s[pos]
-    key = np.round(pts / 1e-7).astype(np.int64)
-    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.ravel()
-    nodes = pts[first]
-    tag2idx = -np.ones(int(tags.max()) + 1, dtype=np.int64)
-    tag2idx[used] = inverse
-
-    def remap(a):
-        r = tag2idx[a]
-        if (r < 0).any():
-            raise RuntimeError("surface node not in volume mesh")
-        return r
-
-    hexes = remap(hexes_t)
-    x = nodes[hexes]
-    jac = np.einsum("ij,ij->i", np.cross(x[:, 1] - x[:, 0], x[:, 3] - x[:, 0]), x[:, 4] - x[:, 0])
-    neg = jac < 0
-    hexes[neg] = hexes[neg][:, [4, 5, 6, 7, 0, 1, 2, 3]]
+    # the two revolutions meet at +-180 deg: merge their coincident nodes
+    nodes, hexes, remap = mg.volume_mesh(tags, coords, hexes_t, merge_tol=1e-7)
     region = np.concatenate(reg_list)
     layer = np.concatenate(lay_list)
     meridian, circ = _material_axes(p, nodes, hexes, region)
-    table = face_lookup(hexes)
+    table = mg.face_lookup(hexes)
     mesh = AircraftMesh(
         params=p,
         nodes=nodes,
@@ -326,9 +237,9 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
         fine=np.concatenate(fine_list),
         meridian=meridian,
         circumferential=circ,
-        outer_quads=_orient_outward(hexes, table, remap(q["outer"])),
-        contact_quads=_orient_outward(hexes, table, remap(q["contact"])),
-        inner_quads=_orient_outward(hexes, table, remap(q["inner"])),
+        outer_quads=mg.orient_outward(hexes, remap(q["outer"]), table),
+        contact_quads=mg.orient_outward(hexes, remap(q["contact"]), table),
+        inner_quads=mg.orient_outward(hexes, remap(q["inner"]), table),
         bead_nodes=np.unique(remap(q["bead"])),
         symmetry_nodes=np.unique(remap(q["sym"])),
     )
@@ -361,12 +272,3 @@ def _material_axes(p: AircraftParams, nodes, hexes, region):
     b = np.arctan2(c[:, 1] - yc, r - rc)
     meridian = np.cos(b)[:, None] * e_y[None, :] - np.sin(b)[:, None] * e_r
     return meridian, e_c
-
-
-def _orient_outward(hexes: np.ndarray, table, quads: np.ndarray) -> np.ndarray:
-    """Reorder quads so their right-hand normal points out of the solid."""
-    out = quads.copy()
-    for n, qd in enumerate(quads):
-        e, k = table[frozenset(int(i) for i in qd)]
-        out[n] = hexes[e][list(C3D8_FACES[k - 1])][::-1]
-    return out

@@ -9,10 +9,7 @@ Runs are started ``nice``-d with one thread each, at most ``jobs`` at a time.
 
 from __future__ import annotations
 
-import os
-import subprocess
 import threading
-import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,7 +19,7 @@ import numpy as np
 from . import aircraft_deck as ad
 from .aircraft_geometry import AircraftMesh
 from .frd import read_dat_blocks, read_frd
-from .solve import ModelError, ccx_version, find_ccx
+from .solve import ModelError, ccx_version, find_ccx, run_ccx
 
 
 @dataclass(frozen=True)
@@ -54,30 +51,6 @@ class RunResult:
         raise KeyError(name)
 
 
-def _run(exe: str, inp: Path, timeout: float) -> float:
-    env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1")
-    log = inp.with_suffix(".log")
-    t0 = time.perf_counter()
-    try:
-        with open(log, "w") as fh:
-            proc = subprocess.run(
-                ["nice", "-n", "10", exe, "-i", inp.stem],
-                cwd=inp.parent,
-                stdout=fh,
-                stderr=subprocess.STDOUT,
-                env=env,
-                timeout=timeout,
-            )
-    except subprocess.TimeoutExpired as exc:
-        raise ModelError(f"ccx run {inp.stem} exceeded {timeout:.0f} s") from exc
-    dt = time.perf_counter() - t0
-    text = log.read_text(errors="replace")
-    if "*ERROR" in text or proc.returncode != 0 or "Job finished" not in text:
-        msg = next((ln.strip() for ln in text.splitlines() if "*ERROR" in ln), "")
-        raise ModelError(f"ccx run {inp.stem} failed (exit {proc.returncode}) {msg}; see {log}")
-    return dt
-
-
 _PARSE_LOCK = threading.Lock()
 
 
@@ -96,7 +69,7 @@ def _finished(workdir: Path, name: str, deck: str) -> float | None:
 
 
 def _solve(exe: str, workdir: Path, name: str, timeout: float) -> float:
-    seconds = _run(exe, workdir / f"{name}.inp", timeout)
+    seconds = run_ccx(exe, workdir / f"{name}.inp", threads=1, timeout=timeout, niceness=10)
     (workdir / f"{name}.runtime").write_text(f"{seconds:.1f}\n")
     return seconds
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
-from .geometry import TireMesh, quads_to_faces
+from . import ccxdeck as cx
+from .geometry import TireMesh
+from .meshing import face_lookup
 
 PRESSURE = 2.0e5  # Pa, inflation pressure (the paper's P*)
 FRICTION = 0.3
@@ -44,40 +44,6 @@ CASES = {
 }
 
 
-@dataclass
-class Road:
-    nodes: np.ndarray
-    hexes: np.ndarray  # 0-based in road-local numbering
-    top_faces: list[tuple[int, int]]  # (road element index, face number)
-
-
-def build_road(half_x=0.40, half_y=0.26, thick=0.02, size=0.025) -> Road:
-    nx, ny = int(round(2 * half_x / size)), int(round(2 * half_y / size))
-    xs = np.linspace(-half_x, half_x, nx + 1)
-    ys = np.linspace(-half_y, half_y, ny + 1)
-    zs = np.array([-thick, 0.0])
-    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
-    nodes = np.column_stack([X.ravel(), Y.ravel(), Z.ravel()])
-
-    def nid(i, j, k):
-        return (i * (ny + 1) + j) * 2 + k
-
-    hexes = []
-    for i in range(nx):
-        for j in range(ny):
-            b = [nid(i, j, 0), nid(i + 1, j, 0), nid(i + 1, j + 1, 0), nid(i, j + 1, 0)]
-            t = [nid(i, j, 1), nid(i + 1, j, 1), nid(i + 1, j + 1, 1), nid(i, j + 1, 1)]
-            hexes.append(b + t)
-    hexes = np.array(hexes)
-    # face 2 (nodes 5-8) is the top face z = 0
-    return Road(nodes, hexes, [(e, 2) for e in range(len(hexes))])
-
-
-def _lines(vals, per=8):
-    vals = list(vals)
-    return "\n".join(", ".join(str(v) for v in vals[i : i + per]) for i in range(0, len(vals), per))
-
-
 def write_deck(
     path,
     mesh: TireMesh,
@@ -87,43 +53,24 @@ def write_deck(
 ) -> dict:
     """Write the deck; ``rim_travel`` is the total downward rim displacement (m)."""
     p = mesh.params
-    road = build_road()
+    road = cx.build_road()
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
     out = []
     w = out.append
     w("*HEADING")
     w(f"fepost tire sector, case {case.name}")
-    w("*NODE, NSET=NALL")
-    for i, (x, y, z) in enumerate(mesh.nodes):
-        w(f"{i + 1}, {x:.9e}, {y:.9e}, {z:.9e}")
-    for i, (x, y, z) in enumerate(road.nodes):
-        w(f"{nt + i + 1}, {x:.9e}, {y:.9e}, {z:.9e}")
-    w("*ELEMENT, TYPE=C3D8I, ELSET=TIRE")
-    for e, h in enumerate(mesh.hexes):
-        w(f"{e + 1}, " + ", ".join(str(int(n) + 1) for n in h))
-    w("*ELEMENT, TYPE=C3D8, ELSET=ROAD")
-    for e, h in enumerate(road.hexes):
-        w(f"{et + e + 1}, " + ", ".join(str(int(n) + nt + 1) for n in h))
-    w("*NSET, NSET=BEAD")
-    w(_lines(int(n) + 1 for n in mesh.bead_nodes))
-    w("*NSET, NSET=ROADN")
-    w(_lines(range(nt + 1, nt + road.nodes.shape[0] + 1)))
-    w("*NSET, NSET=TIREN")
-    w(_lines(range(1, nt + 1)))
-    w("*SURFACE, NAME=STIRE, TYPE=ELEMENT")
-    for e, k in quads_to_faces(mesh, mesh.contact_quads):
-        w(f"{e + 1}, S{k}")
-    w("*SURFACE, NAME=SROAD, TYPE=ELEMENT")
-    for e, k in road.top_faces:
-        w(f"{et + e + 1}, S{k}")
+    out += cx.node_block(mesh.nodes, road)
+    out += cx.element_block("C3D8I", "TIRE", range(1, et + 1), mesh.hexes)
+    out += cx.road_elements(road, nt, et)
+    out += cx.node_sets({"BEAD": (int(n) + 1 for n in mesh.bead_nodes), **cx.tire_road_sets(nt, road)})
+    table = face_lookup(mesh.hexes)
+    out += cx.contact_surfaces(mesh.hexes, mesh.contact_quads, road, table)
     w("*MATERIAL, NAME=CORDRUBBER")
     w("*ELASTIC")
     w(f"{E_RUBBER:.6e}, {NU_RUBBER}")
-    w("*MATERIAL, NAME=ROADMAT")
-    w("*ELASTIC")
-    w("2.1e11, 0.3")
+    out += cx.ROAD_MATERIAL
     w("*SOLID SECTION, ELSET=TIRE, MATERIAL=CORDRUBBER")
-    w("*SOLID SECTION, ELSET=ROAD, MATERIAL=ROADMAT")
+    w(cx.ROAD_SECTION)
     # sector cut faces: tangential displacement equals the rim's (rigid-rim
     # cyclic condition): t . u_node - t . u_ref = 0, t = circumferential direction
     bead = set(int(n) for n in mesh.bead_nodes)
@@ -146,13 +93,7 @@ def write_deck(
         w(f"{n + 1}, {d1}, {c1:.9f}, {n + 1}, {d2}, {c2:.9f}, ")
         out[-1] += f"{ref}, {d1}, {-c1:.9f}, {ref}, {d2}, {-c2:.9f}"
         n_eq += 1
-    w("*SURFACE INTERACTION, NAME=SI")
-    w("*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR")
-    w(f"{CONTACT_SLOPE:.6e}, {CONTACT_TENSION:.6e}")
-    w("*FRICTION")
-    w(f"{FRICTION}, {STICK_SLOPE:.6e}")
-    w(f"*CONTACT PAIR, INTERACTION=SI, TYPE={CONTACT_TYPE}")
-    w("STIRE, SROAD")
+    out += cx.contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE, CONTACT_TYPE)
     w("*BOUNDARY")
     w("ROADN, 1, 3")
     w("BEAD, 1, 3")
@@ -172,8 +113,7 @@ def write_deck(
     w("*STATIC")
     w("0.25, 1.0, 1e-5, 0.5")
     w("*DLOAD")
-    for e, k in quads_to_faces(mesh, mesh.inner_quads):
-        w(f"{e + 1}, P{k}, {PRESSURE:.6e}")
+    out += cx.pressure_load(mesh.hexes, mesh.inner_quads, PRESSURE, table)
     outputs()
     w("*END STEP")
     if not inflation_only:

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .frd import read_frd
-from .solve import ModelError, find_ccx
+from .solve import ModelError, find_ccx, run_ccx
 
 LENGTH, DEPTH, WIDTH = 0.20, 0.02, 0.02  # m
 NX, NY, NZ = 20, 2, 2
@@ -87,23 +87,15 @@ def timoshenko_tip(bulk: float) -> float:
 
 def check(etype: str, bulk_ratio: float) -> tuple[float, float]:
     """(FE tip deflection, Timoshenko tip deflection), m."""
-    import subprocess
-
     exe = find_ccx()
     bulk = bulk_ratio * SHEAR
     with tempfile.TemporaryDirectory(prefix="tiremodel-check-") as tmp:
         inp = Path(tmp) / "beam.inp"
         node = _deck(inp, etype, bulk)
-        proc = subprocess.run(
-            ["nice", "-n", "10", exe, "-i", "beam"],
-            cwd=tmp,
-            capture_output=True,
-            text=True,
-            env={"OMP_NUM_THREADS": "1", "PATH": str(Path(exe).parent)},
-            timeout=600,
-        )
-        if proc.returncode != 0 or "Job finished" not in proc.stdout:
-            raise ModelError(f"ccx beam check ({etype}, K/G = {bulk_ratio:g}) failed")
+        try:
+            run_ccx(exe, inp, threads=1, timeout=600, niceness=10)
+        except ModelError as exc:
+            raise ModelError(f"ccx beam check ({etype}, K/G = {bulk_ratio:g}) failed: {exc}") from exc
         res = read_frd(inp.with_suffix(".frd"))
         _, u = res.field(max(res.last), "U")
         row = int(np.flatnonzero(res.node_ids == node)[0])

@@ -40,23 +40,25 @@ def ccx_version(exe: str) -> str:
     return "CalculiX (version unknown)"
 
 
-def run_ccx(exe: str, inp: Path, threads: int = 2, timeout: float = 1800.0) -> float:
-    """Run ``ccx -i <job>`` in the deck's folder; raise ModelError unless it converged."""
+def run_ccx(exe: str, inp: Path, threads: int = 2, timeout: float = 1800.0, niceness: int = 0) -> float:
+    """Run ``ccx -i <job>`` in the deck's folder; return the wall time (s).
+
+    ``threads``: OpenMP and equation-solver threads; ``niceness`` > 0 starts
+    ccx through ``nice -n``. The solver's output goes to ``<job>.log``; raises
+    ModelError on a timeout, a non-zero exit, an ``*ERROR`` line or a run that
+    did not finish.
+    """
     job = inp.with_suffix("")
-    env = dict(os.environ)
-    env["OMP_NUM_THREADS"] = str(threads)
-    env["CCX_NPROC_EQUATION_SOLVER"] = str(threads)
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads), CCX_NPROC_EQUATION_SOLVER=str(threads))
+    cmd = [exe, "-i", job.name]
+    if niceness > 0:
+        cmd = ["nice", "-n", str(niceness), *cmd]
     t0 = time.perf_counter()
     log = inp.with_suffix(".log")
     try:
         with open(log, "w") as fh:
             proc = subprocess.run(
-                [exe, "-i", job.name],
-                cwd=inp.parent,
-                stdout=fh,
-                stderr=subprocess.STDOUT,
-                env=env,
-                timeout=timeout,
+                cmd, cwd=inp.parent, stdout=fh, stderr=subprocess.STDOUT, env=env, timeout=timeout
             )
     except subprocess.TimeoutExpired as exc:
         raise ModelError(f"ccx run {job.name} exceeded {timeout:.0f} s") from exc
