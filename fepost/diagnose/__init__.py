@@ -15,9 +15,9 @@ errors and drift hidden in them; :mod:`.example` writes an example CSV.
 
 from __future__ import annotations
 
-from importlib import import_module
 from typing import TYPE_CHECKING
 
+from .._lazy import lazy_names
 from .causenames import CAUSES
 
 __all__ = ["CAUSES", "Diagnosis", "MeasuredData", "ParameterEstimate", "diagnose", "read_measured"]
@@ -37,14 +37,4 @@ if TYPE_CHECKING:
     from .pipeline import diagnose
     from .result import Diagnosis, ParameterEstimate
 
-
-def __getattr__(name: str):
-    if name in _LAZY:
-        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY, globals())
