@@ -21,6 +21,7 @@ import multiprocessing as mp
 import time
 
 import numpy as np
+from scipy.stats import binomtest
 
 from fepost.diagnose import diagnose
 from fepost.diagnose.synthetic import VALIDATION_SET_A, analytic_map, synthesize
@@ -30,11 +31,10 @@ NOISE = {"constant": {"noise": 0.015}, "proportional": {"noise": 0.0, "noise_pro
 _MAP: list = []
 
 
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return max(0.0, centre - half), min(1.0, centre + half)
+def wilson(k: int, n: int) -> tuple[float, float]:
+    """Wilson 95 % interval of the proportion k/n."""
+    ci = binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
+    return float(ci.low), float(ci.high)
 
 
 def _one(job):

@@ -28,6 +28,7 @@ import multiprocessing as mp
 import time
 
 import numpy as np
+from scipy.stats import binomtest
 
 from fepost.analytic import pressure_function
 from fepost.diagnose import diagnose
@@ -42,11 +43,10 @@ NOISE_MODELS = {
 }
 
 
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return max(0.0, centre - half), min(1.0, centre + half)
+def wilson(k: int, n: int) -> tuple[float, float]:
+    """Wilson 95 % interval of the proportion k/n."""
+    ci = binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
+    return float(ci.low), float(ci.high)
 
 
 _MAPS: list = []

@@ -14,8 +14,9 @@ pipeline (numpy, scipy, VTK) on first use, so the command line starts quickly.
 
 from __future__ import annotations
 
-from importlib import import_module
 from typing import TYPE_CHECKING
+
+from ._lazy import lazy_names
 
 __all__ = ["Analysis", "analyse", "__version__"]
 __version__ = "0.1.0"
@@ -26,14 +27,4 @@ _LAZY = {"Analysis": "analysis", "analyse": "analysis"}
 if TYPE_CHECKING:
     from .analysis import Analysis, analyse
 
-
-def __getattr__(name: str):
-    if name in _LAZY:
-        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_names(__name__, _LAZY, globals())

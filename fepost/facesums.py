@@ -82,6 +82,19 @@ def _rows(a: np.ndarray) -> np.ndarray:
     return s
 
 
+def _corner_products(u: np.ndarray, v: np.ndarray, su: np.ndarray, sv: np.ndarray) -> np.ndarray:
+    """Σ_k u_k v_k + Σu Σv per face, from (3, c) corner rows ``u``, ``v`` and their sums.
+
+    The corner sum of every closed form in the module docstring that has the 1/12:
+    Σs Σx + Σ s_k x_k, Σ x_k² + (Σx)², ... In place on one (c,) temporary.
+    """
+    q = u[0] * v[0]
+    q += u[1] * v[1]
+    q += u[2] * v[2]
+    q += su * sv
+    return q
+
+
 def triangle_areas(xy: np.ndarray, tri: np.ndarray) -> np.ndarray:
     """Areas (m²) of the triangles ``tri`` with in-plane node coordinates ``xy``."""
     x, y = xy[:, 0][tri], xy[:, 1][tri]
@@ -124,20 +137,11 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
         e2 = max(e2, float(e.max()))
         sx, sy = _rows(px), _rows(py)
         if location == "point":
-            s0, s1, s2 = V.take(t)
-            ss = s0 + s1
-            ss += s2
-            qx = ss * sx  # Σs Σx + Σ s_k x_k
-            qx += s0 * x0
-            qx += s1 * x1
-            qx += s2 * x2
-            qy = ss * sy
-            qy += s0 * y0
-            qy += s1 * y1
-            qy += s2 * y2
+            ps = V.take(t)  # corner pressures, (3, chunk)
+            ss = _rows(ps)
             tot[0] += _dot(a, ss)
-            tot[1] += _dot(a, qx)
-            tot[2] += _dot(a, qy)
+            tot[1] += _dot(a, _corner_products(ps, px, ss, sx))
+            tot[2] += _dot(a, _corner_products(ps, py, ss, sy))
         else:
             ld = a * V[sl]
             tot[0] += 3.0 * float(ld.sum())
@@ -146,21 +150,9 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
         tot[3] += float(a.sum())
         tot[4] += _dot(a, sx)
         tot[5] += _dot(a, sy)
-        xx = x0 * x0  # Σ x_k² + (Σx)², and likewise yy, xy
-        xx += x1 * x1
-        xx += x2 * x2
-        xx += sx * sx
-        yy = y0 * y0
-        yy += y1 * y1
-        yy += y2 * y2
-        yy += sy * sy
-        xy = x0 * y0
-        xy += x1 * y1
-        xy += x2 * y2
-        xy += sx * sy
-        tot[6] += _dot(a, xx)
-        tot[7] += _dot(a, yy)
-        tot[8] += _dot(a, xy)
+        tot[6] += _dot(a, _corner_products(px, px, sx, sx))
+        tot[7] += _dot(a, _corner_products(py, py, sy, sy))
+        tot[8] += _dot(a, _corner_products(px, py, sx, sy))
     # 2A → A, with the 1/3, 1/12 of the closed forms
     N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy = (float(v) for v in tot * _SCALE)
     return FaceSums(N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy, float(np.sqrt(e2)))

@@ -118,6 +118,13 @@ class Row:
         return d
 
 
+def _named_row(rows: tuple[Row, ...], name: str) -> Row:
+    for r in rows:
+        if r.name == name:
+            return r
+    raise ArgumentError(f"name must be one of {', '.join(ROW_NAMES)}, got {name!r}")
+
+
 @dataclass(frozen=True)
 class GeneralisedTable:
     """The generalised model fitted to the exact-integral curves (same grid, noise and seed).
@@ -134,10 +141,8 @@ class GeneralisedTable:
     form: GeneralisedCurves
 
     def row(self, name: str) -> Row:
-        for r in self.rows:
-            if r.name == name:
-                return r
-        raise ArgumentError(f"name must be one of {', '.join(ROW_NAMES)}, got {name!r}")
+        """The row of ``name`` (one of :data:`ROW_NAMES`)."""
+        return _named_row(self.rows, name)
 
     def to_dict(self) -> dict:
         models = {}
@@ -182,10 +187,8 @@ class Table1:
     generalised: GeneralisedTable | None = None
 
     def row(self, name: str) -> Row:
-        for r in self.rows:
-            if r.name == name:
-                return r
-        raise ArgumentError(f"name must be one of {', '.join(ROW_NAMES)}, got {name!r}")
+        """The row of ``name`` (one of :data:`ROW_NAMES`)."""
+        return _named_row(self.rows, name)
 
     def to_dict(self) -> dict:
         """The table1 JSON (``rows``, the contract) with settings, bias, generalised rows and notes."""

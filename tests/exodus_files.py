@@ -24,6 +24,15 @@ def _names(ds, var: str, dim: str, names: list[str]) -> None:
     v[:] = arr
 
 
+def _ids_and_names(ds, prefix: str, dim: str, count: int, names) -> None:
+    """Status (all active), IDs 1..count and names of ``count`` blocks or sets (``prefix`` eb, ss)."""
+    ds.createVariable(f"{prefix}_status", "i4", (dim,))[:] = np.ones(count, np.int32)
+    prop = ds.createVariable(f"{prefix}_prop1", "i4", (dim,))
+    prop.setncattr("name", "ID")
+    prop[:] = np.arange(1, count + 1, dtype=np.int32)
+    _names(ds, f"{prefix}_names", dim, names or [""] * count)
+
+
 def write(
     path: str | Path,
     points: np.ndarray,
@@ -71,11 +80,7 @@ def write(
         for k, c in enumerate("xyz"[:nd]):
             ds.createVariable(f"coord{c}", "f8", ("num_nodes",))[:] = points[:, k]
         _names(ds, "coor_names", "num_dim", list("xyz"[:nd]))
-        ds.createVariable("eb_status", "i4", ("num_el_blk",))[:] = np.ones(len(blocks), np.int32)
-        prop = ds.createVariable("eb_prop1", "i4", ("num_el_blk",))
-        prop.setncattr("name", "ID")
-        prop[:] = np.arange(1, len(blocks) + 1, dtype=np.int32)
-        _names(ds, "eb_names", "num_el_blk", block_names or [""] * len(blocks))
+        _ids_and_names(ds, "eb", "num_el_blk", len(blocks), block_names)
         for k, (etype, conn) in enumerate(blocks):
             conn = np.asarray(conn, np.int64)
             ds.createDimension(f"num_el_in_blk{k + 1}", len(conn))
@@ -109,11 +114,7 @@ def write(
             v[:] = np.column_stack([np.asarray(g, float).reshape(len(times)) for g in globals_.values()])
         if side_sets:
             ds.createDimension("num_side_sets", len(side_sets))
-            ds.createVariable("ss_status", "i4", ("num_side_sets",))[:] = np.ones(len(side_sets), np.int32)
-            sp = ds.createVariable("ss_prop1", "i4", ("num_side_sets",))
-            sp.setncattr("name", "ID")
-            sp[:] = np.arange(1, len(side_sets) + 1, dtype=np.int32)
-            _names(ds, "ss_names", "num_side_sets", side_set_names or [""] * len(side_sets))
+            _ids_and_names(ds, "ss", "num_side_sets", len(side_sets), side_set_names)
             for k, (el, sd) in enumerate(side_sets):
                 ds.createDimension(f"num_side_ss{k + 1}", len(el))
                 ds.createVariable(f"elem_ss{k + 1}", "i4", (f"num_side_ss{k + 1}",))[:] = np.asarray(el) + 1

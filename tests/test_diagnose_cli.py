@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from importlib import import_module
 from pathlib import Path
 
 import pytest
@@ -222,10 +223,15 @@ def test_make_example_writes_documented_data_that_diagnose_explains(tmp_path, an
 
 
 def test_cli_cause_names_are_the_vocabulary():
-    from fepost.cli.diagnose import CAUSE_NAMES
-    from fepost.diagnose.causes import CAUSES
+    import fepost.diagnose
+    from fepost.cli.diagnose import CAUSES as offered
+    from fepost.diagnose.causes import CAUSES, MEANING
 
-    assert CAUSE_NAMES == CAUSES
+    assert offered is CAUSES is fepost.diagnose.CAUSES and set(MEANING) == set(CAUSES)
+    assert fepost.diagnose.diagnose is import_module("fepost.diagnose.pipeline").diagnose
+    assert {"diagnose", "read_measured", "Diagnosis"} <= set(dir(fepost.diagnose))
+    with pytest.raises(AttributeError, match="has no attribute 'nope'"):
+        fepost.diagnose.nope  # noqa: B018
 
 
 ROOT = Path(__file__).resolve().parents[1]

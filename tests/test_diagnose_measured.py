@@ -73,7 +73,7 @@ def test_empty_and_non_finite_cells():
 
 
 def test_short_row_and_bad_roll_and_bad_load():
-    with pytest.raises(DataError, match=r"^line 2: 4 fields, the header has 6$"):
+    with pytest.raises(DataError, match=r"^line 2, column Fy: missing \(4 fields, the header has 6\)$"):
         parse_csv("vx,vy,wz,Fx,Fy,Mz\n1,2,3,4\n")
     with pytest.raises(DataError, match=r"^line 2, column roll: must be -1, 0 or 1, got 2$"):
         parse_csv("vx,vy,wz,Fx,Fy,Mz,roll\n1,0,0,-1,0,0,2\n")

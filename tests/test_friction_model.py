@@ -14,6 +14,8 @@ Tolerance tiers:
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -335,6 +337,25 @@ def test_zero_kinematics_and_shapes(models):
     assert res.Fx.shape == (2,) and not res.Fx.flags.writeable
     with pytest.raises(ArgumentError, match="wz must be finite"):
         model.resultants(0.1, 0.0, np.nan)
+
+
+@pytest.mark.parametrize(
+    "change,message",
+    [
+        ({"R": "0.1"}, "R must be a real number, got '0.1'"),
+        ({"F0": True}, "F0 must be a real number, got True"),
+        ({"g0": float("inf")}, "g0 must be finite, got inf"),
+        ({"M0": -1.0}, "M0 must be positive, got -1.0"),
+    ],
+)
+def test_scalar_fields_are_checked_and_stored_as_floats(models, change, message):
+    from dataclasses import replace
+
+    _, model = models["uniform", 1.0]
+    with pytest.raises(ArgumentError, match=f"^{re.escape(message)}$"):
+        replace(model, **change)
+    again = replace(model, R=np.float32(model.R), f=1)
+    assert type(again.R) is float and type(again.f) is float and again.f == 1.0
 
 
 def test_json_round_trip(models):

@@ -176,6 +176,39 @@ def test_string_arrays_are_ignored(tmp_path):
     assert "label" not in fld.arrays and fld.field == "CPRESS"
 
 
+def test_point_and_cell_arrays_are_counted_and_named_alike():
+    """One reader of a data object's arrays for points and cells: values per node or cell,
+    component names kept, string arrays passed over, a wrong count named in one line."""
+    from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkStringArray
+
+    from fepost.reader.vtkfile import _data_arrays
+
+    g = pv.Plane(i_resolution=2, j_resolution=1).cast_to_unstructured_grid()  # 6 nodes, 2 cells
+    g.clear_data()
+    vec = vtkDoubleArray()
+    vec.SetName("CSTRESS")
+    vec.SetNumberOfComponents(2)
+    vec.SetComponentName(0, "CPRESS")
+    vec.SetComponentName(1, "CSHEAR1")
+    vec.SetNumberOfTuples(g.n_cells)
+    label = vtkStringArray()
+    label.SetName("label")
+    label.SetNumberOfValues(g.n_cells)
+    g.GetCellData().AddArray(vec)
+    g.GetCellData().AddArray(label)
+    g.point_data["CPRESS"] = np.arange(6.0)
+    components: dict = {}
+    points = _data_arrays("p.vtu", g.GetPointData(), 6, "point", components)
+    cells = _data_arrays("p.vtu", g.GetCellData(), 2, "cell", components)
+    assert list(points) == ["CPRESS"] and points["CPRESS"].tolist() == list(range(6))
+    assert list(cells) == ["CSTRESS"]
+    assert cells["CSTRESS"].shape == (2, 2) and components == {"CSTRESS": ("CPRESS", "CSHEAR1")}
+    with pytest.raises(InputFileError, match=r"^p\.vtu: point array 'CPRESS' has 6 values for 7 nodes$"):
+        _data_arrays("p.vtu", g.GetPointData(), 7, "point", {})
+    with pytest.raises(InputFileError, match=r"^p\.vtu: cell array 'CSTRESS' has 2 values for 3 cells$"):
+        _data_arrays("p.vtu", g.GetCellData(), 3, "cell", {})
+
+
 def test_sidecar_is_validated(tmp_path):
     path = _box(tmp_path / "box.vtu")
     side = tmp_path / "box.json"

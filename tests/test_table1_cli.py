@@ -98,6 +98,10 @@ def test_generalised_rows_beside_the_paper_rows(committed, analysis):
     assert d["generalised"]["fit"]["form"] == "generalised" and d["fit"]["form"] == "paper"
     assert [r["name"] for r in d["rows"]] == list(ROW_NAMES)
     assert "generalised model fitted to the exact-integral curves" in format_table(committed)
+    for table in (committed, g):  # both tables look their rows up alike
+        assert [table.row(n) for n in ROW_NAMES] == list(table.rows)
+        with pytest.raises(ArgumentError, match=r"^name must be one of f, F0, M0, a, m, k_x, got 'F1'$"):
+            table.row("F1")
 
 
 def test_without_rolling_map_k_x_is_assumed_and_said(meshes):

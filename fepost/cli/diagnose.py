@@ -15,21 +15,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..diagnose.causenames import CAUSES  # a light module: no numpy
 from ..errors import ArgumentError, OutputError
 from . import _validate as v
 from ._common import add_friction_option, add_input_options, analysis_kwargs
-
-#: Mirrors fepost.diagnose.causes.CAUSES (kept here so that --help imports nothing heavy).
-CAUSE_NAMES = (
-    "none",
-    "friction_level",
-    "pressure_dependent_friction",
-    "speed_dependent_friction",
-    "elliptic_patch",
-    "anisotropic_friction",
-    "pressure_shift",
-    "sensor_offset",
-)
 
 
 def add_parser(sub) -> None:
@@ -88,11 +77,11 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--cause",
-        choices=CAUSE_NAMES,
+        choices=CAUSES,
         default="pressure_dependent_friction",
         metavar="NAME",
         help="with --make-example: the cause hidden in the data (default pressure_dependent_friction; "
-        f"one of {', '.join(CAUSE_NAMES)})",
+        f"one of {', '.join(CAUSES)})",
     )
     add_input_options(p)
     p.set_defaults(func=run)

@@ -2,7 +2,7 @@
 
 :func:`diagnose` compares measured Fx, Fy, Mz (the measured-data CSV of
 docs/diagnose.md) with the exact friction integrals over the FE contact
-pressure. It fits every candidate cause (:data:`~fepost.diagnose.causes.CAUSES`)
+pressure. It fits every candidate cause (:data:`~fepost.diagnose.causenames.CAUSES`)
 as a physical extension of the model, robustly first to flag gross outliers
 (:mod:`~fepost.diagnose.robust`) and under a noise model chosen per channel
 (:mod:`~fepost.diagnose.noise`); names the cause the data support (BIC with
@@ -13,9 +13,28 @@ measures the gain. :mod:`.synthetic` makes test data with effects, noise, gross
 errors and drift hidden in them; :mod:`.example` writes an example CSV.
 """
 
-from .causes import CAUSES
-from .measured import MeasuredData, read_measured
-from .pipeline import diagnose
-from .result import Diagnosis, ParameterEstimate
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
+from .causenames import CAUSES
 
 __all__ = ["CAUSES", "Diagnosis", "MeasuredData", "ParameterEstimate", "diagnose", "read_measured"]
+
+#: Names re-exported from submodules, imported on first access: ``import fepost.diagnose``
+#: (the command line's ``--cause`` choices) imports no numpy.
+_LAZY = {
+    "Diagnosis": "result",
+    "MeasuredData": "measured",
+    "ParameterEstimate": "result",
+    "diagnose": "pipeline",
+    "read_measured": "measured",
+}
+
+if TYPE_CHECKING:
+    from .measured import MeasuredData, read_measured
+    from .pipeline import diagnose
+    from .result import Diagnosis, ParameterEstimate
+
+__getattr__, __dir__ = lazy_names(__name__, _LAZY, globals())

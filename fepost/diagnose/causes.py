@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .causenames import CAUSES
 from .models import Candidate, Parameter, Predictor, extension_model, with_fixed
 
 __all__ = [
@@ -52,16 +53,6 @@ __all__ = [
     "with_fixed",
 ]
 
-CAUSES = (
-    "none",
-    "friction_level",
-    "pressure_dependent_friction",
-    "speed_dependent_friction",
-    "elliptic_patch",
-    "anisotropic_friction",
-    "pressure_shift",
-    "sensor_offset",
-)
 #: The causes that extend ``friction_level`` with parameters of their own.
 EXTENSIONS = CAUSES[2:]
 

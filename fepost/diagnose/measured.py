@@ -14,7 +14,8 @@ Columns (SI, header row, one row per test point; other columns are ignored):
 =========== ==========================================================
 
 Blank lines and lines whose first non-blank character is ``#`` are skipped
-(before and after the header). Every problem is a one-line
+(before and after the header). The file is read by :mod:`fepost.csvtable`, as
+the kinematics of ``fepost predict`` are: every problem is a one-line
 :class:`~fepost.errors.DataError` naming the file, the line and the column.
 
 Limits: at most :data:`MAX_ROWS` test points (a rig programme has hundreds;
@@ -22,7 +23,7 @@ diagnose takes 1–4 ms per point on a 2-core machine, 7 s for 5000 points, see
 ``benchmarks/bench_diagnose.py``) and
 files of at most :data:`MAX_BYTES`; both are refused before the rows are parsed,
 so a file of a million rows is turned away in a second rather than diagnosed for
-an hour. A cell longer than :data:`MAX_CELL` characters is an error.
+an hour. A cell longer than :data:`fepost.csvtable.MAX_CELL` characters is an error.
 
 :func:`check_plausible` compares the data with the simulation (units, dead
 channels, a test programme in which nothing varies, rolling rows without a
@@ -31,7 +32,6 @@ rolling map) once f, N and R are known.
 
 from __future__ import annotations
 
-import csv
 import io
 import warnings
 from dataclasses import dataclass
@@ -40,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from .._arrays import frozen
+from ..csvtable import CsvFormat, CsvTable, parse_table, read_table
 from ..errors import DataError, FepostWarning
 from ..output import write_text_atomic
 
@@ -58,8 +59,6 @@ MIN_DISTINCT = 6
 MAX_ROWS = 5000
 #: Largest measured-data file read (bytes): 5000 rows of a dozen numbers are ~1 MB.
 MAX_BYTES = 64 * 1024 * 1024
-#: Longest cell (characters): the csv module's default field limit, 128 kB.
-MAX_CELL = 131072
 
 #: |F|/(f·N) above this is not a friction force in N (kN given as N, or N·m in
 #: a force column): error. The largest physical value is about 1 (α ≤ 2 allows 2).
@@ -143,107 +142,45 @@ class MeasuredData:
         return d
 
 
-def _number(text: str, where: str, column: str) -> float:
-    cell = text.strip()
-    try:
-        value = float(cell)
-    except ValueError:
-        shown = cell if cell else "an empty cell"
-        raise DataError(f"{where}, column {column}: not a number: {shown!r}") from None
-    if not np.isfinite(value):
-        raise DataError(f"{where}, column {column}: not a finite number: {cell!r}")
-    return value
+#: The measured-data CSV format (module docstring).
+MEASURED = CsvFormat(
+    required=REQUIRED,
+    optional=OPTIONAL,
+    what="measured data",
+    kind="measured-data CSV file",
+    max_rows=MAX_ROWS,
+    too_many_rows=(
+        f"diagnose takes at most {MAX_ROWS} test points "
+        "(a rig programme has hundreds; average replicates or split the file)"
+    ),
+    max_bytes=MAX_BYTES,
+    too_large=f"measured data (at most {MAX_BYTES // 2**20} MB and {MAX_ROWS} test points)",
+)
+
+
+def _measured(table: CsvTable) -> MeasuredData:
+    roll = table.get("roll")
+    if roll is not None:
+        bad = ~np.isin(roll, (-1.0, 0.0, 1.0))
+        if np.any(bad):
+            i = int(np.flatnonzero(bad)[0])
+            raise DataError(f"{table.where(i)}, column roll: must be -1, 0 or 1, got {roll[i]:g}")
+    return MeasuredData(
+        vx=table["vx"], vy=table["vy"], wz=table["wz"],
+        Fx=table["Fx"], Fy=table["Fy"], Mz=table["Mz"],
+        N=table.get("N"), roll=None if roll is None else roll.astype(int), lines=table.lines,
+        source=table.source, time=table.get("time"),
+    )  # fmt: skip
 
 
 def parse_csv(text: str, source: str = "") -> MeasuredData:
     """Parse the CSV ``text`` (see the module docstring); ``source`` names it in messages."""
-    src = f"{source}: " if source else ""
-    lines_all = text.splitlines()
-    count = sum(1 for line in lines_all if line.strip() and not line.lstrip().startswith("#"))
-    if count - 1 > MAX_ROWS:
-        raise DataError(
-            f"{src}{count - 1} data rows: diagnose takes at most {MAX_ROWS} test points "
-            "(a rig programme has hundreds; average replicates or split the file)"
-        )
-    rows: list[tuple[int, list[str]]] = []
-    for lineno, line in enumerate(lines_all, start=1):
-        stripped = line.strip()
-        if not stripped or stripped.startswith("#"):
-            continue
-        try:
-            fields = next(csv.reader([line]))
-        except csv.Error as exc:
-            if "field limit" in str(exc):
-                raise DataError(f"{src}line {lineno}: a cell is longer than {MAX_CELL} characters") from None
-            raise DataError(f"{src}line {lineno}: not a CSV line ({exc})") from None
-        long = [j for j, c in enumerate(fields) if len(c) > MAX_CELL]
-        if long:
-            raise DataError(f"{src}line {lineno}: a cell is longer than {MAX_CELL} characters")
-        rows.append((lineno, fields))
-    if not rows:
-        raise DataError(f"{src}no header row: the file is empty or only comments")
-    head_line, header = rows[0]
-    names = [h.strip() for h in header]
-    seen: dict[str, int] = {}
-    for j, name in enumerate(names):
-        if name in seen and name in REQUIRED + OPTIONAL:
-            raise DataError(f"{src}line {head_line}: column {name!r} appears twice in the header")
-        seen.setdefault(name, j)
-    missing = [c for c in REQUIRED if c not in seen]
-    if missing:
-        got = ", ".join(repr(n) for n in names if n) or "none"
-        raise DataError(f"{src}missing column(s) {', '.join(missing)} in the header (found {got})")
-    wanted = [c for c in REQUIRED + OPTIONAL if c in seen]
-    values: dict[str, list[float]] = {c: [] for c in wanted}
-    lines = []
-    for lineno, fields in rows[1:]:
-        where = f"{src}line {lineno}"
-        if len(fields) < len(names) and any(seen[c] >= len(fields) for c in wanted):
-            raise DataError(f"{where}: {len(fields)} fields, the header has {len(names)}")
-        for c in wanted:
-            values[c].append(_number(fields[seen[c]], where, c))
-        lines.append(lineno)
-    if not lines:
-        raise DataError(f"{src}no data rows after the header")
-    roll = None
-    if "roll" in values:
-        raw = np.array(values["roll"])
-        bad = ~np.isin(raw, (-1.0, 0.0, 1.0))
-        if np.any(bad):
-            i = int(np.flatnonzero(bad)[0])
-            raise DataError(f"{src}line {lines[i]}, column roll: must be -1, 0 or 1, got {raw[i]:g}")
-        roll = raw.astype(int)
-    arr = {k: np.asarray(v, float) for k, v in values.items()}
-    return MeasuredData(
-        vx=arr["vx"], vy=arr["vy"], wz=arr["wz"],
-        Fx=arr["Fx"], Fy=arr["Fy"], Mz=arr["Mz"],
-        N=arr.get("N"), roll=roll, lines=np.asarray(lines, int), source=source, time=arr.get("time"),
-    )  # fmt: skip
+    return _measured(parse_table(text, MEASURED, source))
 
 
 def read_measured(path) -> MeasuredData:
     """Read a measured-friction CSV file (see the module docstring)."""
-    path = Path(path)
-    try:
-        size = path.stat().st_size
-    except FileNotFoundError:
-        raise DataError(f"{path}: no such file") from None
-    except OSError as exc:
-        raise DataError(f"{path}: cannot read the measured data ({exc.__class__.__name__})") from None
-    if path.is_dir():
-        raise DataError(f"{path}: is a folder, not a measured-data CSV file")
-    if size > MAX_BYTES:
-        raise DataError(
-            f"{path}: {size / 2**20:.0f} MB is too large for measured data "
-            f"(at most {MAX_BYTES // 2**20} MB and {MAX_ROWS} test points)"
-        )
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise DataError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DataError(f"{path}: cannot read the measured data ({exc.__class__.__name__})") from None
-    return parse_csv(text, source=str(path))
+    return _measured(read_table(path, MEASURED))
 
 
 def write_csv(data: MeasuredData, path, comment: str = "") -> None:

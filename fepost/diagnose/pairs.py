@@ -55,7 +55,7 @@ from ..lsq import jacobian_svd
 from .causes import EXTENSIONS, joint_candidate, pair_name
 from .fitting import Fit, fit
 from .models import Candidate, with_fixed
-from .selection import INDISTINGUISHABLE_DBIC, CrossValidation, crossvalidate
+from .selection import INDISTINGUISHABLE_DBIC, CrossValidation, crossvalidate, nesting_tests
 
 #: Level of each second-cause likelihood-ratio test (Bonferroni: 1 % over 6 second causes).
 PAIR_ALPHA = 0.01 / 6
@@ -155,25 +155,6 @@ def needed_ratio(q: int, n_obs: int) -> float:
     return float(max(stats.chi2.isf(PAIR_ALPHA, q), q * np.log(n_obs)))
 
 
-def _nesting(jf: Fit, jcv: CrossValidation, against: dict[str, tuple[Fit, CrossValidation]]):
-    """LR p-values and the reasons a joint fit is not admissible against its nested fits."""
-    pvals, reasons = {}, []
-    for parent, (pf, pcv) in against.items():
-        lr = max(0.0, 2.0 * (jf.log_likelihood - pf.log_likelihood))
-        dk = jf.n_params - pf.n_params
-        p = float(stats.chi2.sf(lr, dk))
-        pvals[parent] = p
-        if jf.bic >= pf.bic:
-            reasons.append(f"BIC not below {parent}")
-        if p >= PAIR_ALPHA:
-            reasons.append(f"likelihood-ratio test vs {parent}: p = {p:.3g} >= {PAIR_ALPHA:.3g}")
-        if jcv.log_score <= pcv.log_score:
-            reasons.append(f"held-out log density not above {parent}")
-    if jf.at_bound:
-        reasons.append(f"parameter(s) at a bound: {', '.join(jf.at_bound)}")
-    return pvals, reasons
-
-
 @dataclass(frozen=True)
 class PairSearch:
     """The second-cause search: every trial, the chosen joint model (or None) and the friction-level test."""
@@ -224,7 +205,7 @@ def search_pairs(
         jf, trouble = _quiet_fit(joint, Y, base.rows, start=at, noise=base.noise)
         jcv = crossvalidate(joint, Y, parts, jf)
         against = {name: (fits[name], cvs[name]) for name in ("none", "friction_level", primary, second)}
-        pvals, reasons = _nesting(jf, jcv, against)
+        pvals, reasons = nesting_tests(jf, jcv, against, PAIR_ALPHA)
         reasons += trouble
         done.append(
             Trial(
@@ -269,7 +250,7 @@ def friction_test(cand: Candidate, full: Fit, cv: CrossValidation, Y: np.ndarray
     fixed = with_fixed(cand, "f", f0, f"{cand.name}|f=f0")
     ff, trouble = _quiet_fit(fixed, Y, full.rows, start=np.delete(full.values, j), noise=full.noise)
     fcv = crossvalidate(fixed, Y, parts, ff)
-    pvals, reasons = _nesting(full, cv, {fixed.name: (ff, fcv)})
+    pvals, reasons = nesting_tests(full, cv, {fixed.name: (ff, fcv)}, PAIR_ALPHA)
     reasons = [r for r in reasons if not r.startswith("parameter(s) at a bound")] + trouble
     out |= {
         "fitted": True,

@@ -137,6 +137,31 @@ class Score:
         }
 
 
+def nesting_tests(
+    ft: Fit, cv: CrossValidation, nested: dict[str, tuple[Fit, CrossValidation]], alpha: float
+) -> tuple[dict[str, float], list[str]]:
+    """The rules of admissibility (module docstring) for the fit ``ft`` with held-out check ``cv``.
+
+    ``nested``: name -> (fit, held-out check) of each model nested in it; ``alpha``: the level
+    of each likelihood-ratio test. Returns the LR p-value against each nested model and the
+    reasons the fit is not admissible (none: admissible); a parameter at a bound is one.
+    """
+    pvals, reasons = {}, []
+    for parent, (pf, pcv) in nested.items():
+        lr = max(0.0, 2.0 * (ft.log_likelihood - pf.log_likelihood))
+        p = float(stats.chi2.sf(lr, ft.n_params - pf.n_params))
+        pvals[parent] = p
+        if ft.bic >= pf.bic:
+            reasons.append(f"BIC not below {parent}")
+        if p >= alpha:
+            reasons.append(f"likelihood-ratio test vs {parent}: p = {p:.3g} >= {alpha:.3g}")
+        if cv.log_score <= pcv.log_score:
+            reasons.append(f"held-out log density not above {parent}")
+    if ft.at_bound:
+        reasons.append(f"parameter(s) at a bound: {', '.join(ft.at_bound)}")
+    return pvals, reasons
+
+
 def score_candidates(
     cands: dict[str, Candidate], fits: dict[str, Fit], cvs: dict[str, CrossValidation]
 ) -> list[Score]:
@@ -145,22 +170,7 @@ def score_candidates(
     scores = []
     for name, cand in cands.items():
         ft, cv = fits[name], cvs[name]
-        pvals = {}
-        reasons = []
-        for parent in cand.nested:
-            pf = fits[parent]
-            lr = max(0.0, 2.0 * (ft.log_likelihood - pf.log_likelihood))
-            dk = ft.n_params - pf.n_params
-            p = float(stats.chi2.sf(lr, dk))
-            pvals[parent] = p
-            if ft.bic >= pf.bic:
-                reasons.append(f"BIC not below {parent}")
-            if p >= ALPHA:
-                reasons.append(f"likelihood-ratio test vs {parent}: p = {p:.3g} >= {ALPHA:.3g}")
-            if cv.log_score <= cvs[parent].log_score:
-                reasons.append(f"held-out log density not above {parent}")
-        if ft.at_bound:
-            reasons.append(f"parameter(s) at a bound: {', '.join(ft.at_bound)}")
+        pvals, reasons = nesting_tests(ft, cv, {p: (fits[p], cvs[p]) for p in cand.nested}, ALPHA)
         scores.append(
             Score(
                 name,

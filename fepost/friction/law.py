@@ -26,6 +26,19 @@ import numpy as np
 from ..errors import ArgumentError
 
 
+def store_reals(obj, names: tuple[str, ...]) -> None:
+    """Check that the fields ``names`` of the frozen dataclass ``obj`` are finite real
+    numbers and store them as floats; :class:`~fepost.errors.ArgumentError` naming the
+    first that is not (a bool is not a number here)."""
+    for name in names:
+        value = getattr(obj, name)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+            raise ArgumentError(f"{name} must be a real number, got {value!r}")
+        if not np.isfinite(value):
+            raise ArgumentError(f"{name} must be finite, got {value!r}")
+        object.__setattr__(obj, name, float(value))
+
+
 @dataclass(frozen=True)
 class FrictionLaw:
     """Parameters of the local friction law (see the module docstring)."""
@@ -37,13 +50,7 @@ class FrictionLaw:
     pressure_ref: float | None = None
 
     def __post_init__(self) -> None:
-        for name in ("f", "pressure_coef", "speed_coef", "anisotropy"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ArgumentError(f"{name} must be a real number, got {value!r}")
-            if not np.isfinite(value):
-                raise ArgumentError(f"{name} must be finite, got {value!r}")
-            object.__setattr__(self, name, float(value))
+        store_reals(self, ("f", "pressure_coef", "speed_coef", "anisotropy"))
         if self.f < 0:
             raise ArgumentError(f"f must be >= 0, got {self.f!r}")
         if self.anisotropy <= 0:

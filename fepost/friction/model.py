@@ -63,6 +63,7 @@ from .._arrays import frozen
 from ..errors import ArgumentError, DataError
 from . import basis
 from .exact import Resultants, _kinematics
+from .law import store_reals
 
 #: Format tag of the JSON export.
 FORMAT = "fepost-friction-model/1"
@@ -116,13 +117,7 @@ class GeneralisedModel:
     source: str = ""
 
     def __post_init__(self) -> None:
-        for name in ("f", "R", "F0", "M0", "anisotropy", "g0"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ArgumentError(f"{name} must be a real number, got {value!r}")
-            if not np.isfinite(value):
-                raise ArgumentError(f"{name} must be finite, got {value!r}")
-            object.__setattr__(self, name, float(value))
+        store_reals(self, ("f", "R", "F0", "M0", "anisotropy", "g0"))
         for name in ("R", "F0", "M0", "anisotropy"):
             if getattr(self, name) <= 0:
                 raise ArgumentError(f"{name} must be positive, got {getattr(self, name)!r}")

@@ -19,22 +19,22 @@ Output CSV, same rows in the same order: ``vx, vy, wz``, then ``Fx, Fy, Mz``
 With a rolling map the kinematics are those of the rolling tire: the exact
 integrals and the generalised model use the rolling map (in the static patch's
 frame), the closed forms add F⊥ with k_x. Without one, the static map and
-k_x = 0. Every problem with the CSV is a one-line
+k_x = 0. The CSV is read by :mod:`fepost.csvtable`, as the measured data of
+``fepost diagnose`` are: every problem with it is a one-line
 :class:`~fepost.errors.DataError` naming the file, the line and the column.
 """
 
 from __future__ import annotations
 
-import csv
 import io
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._arrays import frozen
-from ..errors import ArgumentError, DataError
+from ..csvtable import CsvFormat, CsvTable, parse_table, read_table
+from ..errors import ArgumentError
 from .closed_form import components
 from .exact import Resultants, friction_resultants
 from .law import FrictionLaw
@@ -68,79 +68,22 @@ class Kinematics:
         return int(self.vx.size)
 
 
-def _number(text: str, where: str, column: str) -> float:
-    cell = text.strip()
-    try:
-        value = float(cell)
-    except ValueError:
-        shown = cell if cell else "an empty cell"
-        raise DataError(f"{where}, column {column}: not a number: {shown!r}") from None
-    if not np.isfinite(value):
-        raise DataError(f"{where}, column {column}: not a finite number: {cell!r}")
-    return value
+#: The kinematics CSV format (module docstring).
+KINEMATICS = CsvFormat(required=COLUMNS, what="kinematics")
+
+
+def _kinematics(table: CsvTable) -> Kinematics:
+    return Kinematics(vx=table["vx"], vy=table["vy"], wz=table["wz"], lines=table.lines, source=table.source)
 
 
 def parse_kinematics(text: str, source: str = "") -> Kinematics:
     """Parse the kinematics CSV ``text`` (module docstring); ``source`` names it in messages."""
-    src = f"{source}: " if source else ""
-    rows: list[tuple[int, list[str]]] = []
-    try:
-        for lineno, line in enumerate(io.StringIO(text), start=1):
-            stripped = line.strip()
-            if not stripped or stripped.startswith("#"):
-                continue
-            rows.append((lineno, next(csv.reader([line.rstrip("\r\n")]))))
-    except csv.Error as exc:
-        raise DataError(f"{src}not a CSV file ({exc})") from None
-    if not rows:
-        raise DataError(f"{src}no header row: the file is empty or only comments")
-    head_line, header = rows[0]
-    names = [h.strip() for h in header]
-    index: dict[str, int] = {}
-    for j, name in enumerate(names):
-        if name in index and name in COLUMNS:
-            raise DataError(f"{src}line {head_line}: column {name!r} appears twice in the header")
-        index.setdefault(name, j)
-    missing = [c for c in COLUMNS if c not in index]
-    if missing:
-        got = ", ".join(repr(n) for n in names if n) or "none"
-        raise DataError(f"{src}missing column(s) {', '.join(missing)} in the header (found {got})")
-    values: dict[str, list[float]] = {c: [] for c in COLUMNS}
-    lines = []
-    for lineno, fields in rows[1:]:
-        where = f"{src}line {lineno}"
-        for c in COLUMNS:
-            if index[c] >= len(fields):
-                raise DataError(
-                    f"{where}, column {c}: missing ({len(fields)} fields, the header has {len(names)})"
-                )
-            values[c].append(_number(fields[index[c]], where, c))
-        lines.append(lineno)
-    if not lines:
-        raise DataError(f"{src}no data rows after the header")
-    return Kinematics(
-        vx=np.asarray(values["vx"], float),
-        vy=np.asarray(values["vy"], float),
-        wz=np.asarray(values["wz"], float),
-        lines=np.asarray(lines),
-        source=source,
-    )
+    return _kinematics(parse_table(text, KINEMATICS, source))
 
 
 def read_kinematics(path) -> Kinematics:
     """Read a kinematics CSV file (module docstring)."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise DataError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise DataError(f"{path}: is a folder, not a CSV file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DataError(f"{path}: cannot read the kinematics ({exc.__class__.__name__})") from None
-    if "\x00" in text:
-        raise DataError(f"{path}: not a text CSV file (binary data)")
-    return parse_kinematics(text, source=str(path))
+    return _kinematics(read_table(path, KINEMATICS))
 
 
 @dataclass(frozen=True)

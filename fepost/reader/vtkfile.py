@@ -226,7 +226,7 @@ def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
             bad = int(np.sum(~np.isfinite(pts).all(axis=1)))
             raise InputFileError(f"{path}: {bad} node coordinates are NaN or infinite")
         pts_parts.append(pts)
-        point_pieces.append(_point_data(path, ds, n, components))
+        point_pieces.append(_data_arrays(path, ds.GetPointData(), n, "point", components))
         sizes.append(n)
         types, off, con = _cells(ds)
         conn_size += len(con)
@@ -238,7 +238,7 @@ def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
                     f"{path}: cell offsets are inconsistent with the connectivity (corrupt file)"
                 )
             check_connectivity(con, n, str(path))
-        cdata = _cell_data(path, ds, len(types), components)
+        cdata = _data_arrays(path, ds.GetCellData(), len(types), "cell", components)
         where = f" of piece {piece + 1}" if len(leaves) > 1 else ""
         present = np.flatnonzero(np.bincount(types, minlength=256)) if len(types) else np.empty(0, np.int64)
         single = len(present) == 1
@@ -298,17 +298,22 @@ def _numeric(arr) -> bool:
     return isinstance(arr, vtkDataArray)
 
 
-def _point_data(path, ds, n: int, components) -> dict[str, np.ndarray]:
-    pd = ds.GetPointData()
+def _data_arrays(path, data, n: int, where: str, components) -> dict[str, np.ndarray]:
+    """The named numeric arrays of a point or cell ``data`` object, each checked to have ``n`` values.
+
+    ``where`` is ``"point"`` or ``"cell"`` (the arrays' ``n`` are nodes or cells). Component
+    names of multi-component arrays go into ``components`` (the first piece's are kept).
+    """
+    counted = "nodes" if where == "point" else "cells"
     out = {}
-    for i in range(pd.GetNumberOfArrays()):
-        arr = pd.GetAbstractArray(i)
+    for i in range(data.GetNumberOfArrays()):
+        arr = data.GetAbstractArray(i)
         name = arr.GetName() if arr is not None else None
         if not name or not _numeric(arr):
             continue  # string and unnamed arrays carry no field values
         a = np.asarray(_np(arr))
         if a.shape[0] != n:
-            raise InputFileError(f"{path}: point array {name!r} has {a.shape[0]} values for {n} nodes")
+            raise InputFileError(f"{path}: {where} array {name!r} has {a.shape[0]} values for {n} {counted}")
         if arr.GetNumberOfComponents() > 1:
             names = tuple(arr.GetComponentName(k) or "" for k in range(arr.GetNumberOfComponents()))
             if any(names):
@@ -332,25 +337,6 @@ def _join(pieces: list[dict[str, np.ndarray]], sizes: list[int]) -> dict[str, np
             got = p.get(name)
             parts.append(got if got is not None and got.shape[1:] == tail else np.zeros((n, *tail)))
         out[name] = np.concatenate(parts)
-    return out
-
-
-def _cell_data(path, ds, m: int, components) -> dict[str, np.ndarray]:
-    cd = ds.GetCellData()
-    out = {}
-    for i in range(cd.GetNumberOfArrays()):
-        arr = cd.GetAbstractArray(i)
-        name = arr.GetName() if arr is not None else None
-        if not name or not _numeric(arr):
-            continue
-        a = np.asarray(_np(arr))
-        if a.shape[0] != m:
-            raise InputFileError(f"{path}: cell array {name!r} has {a.shape[0]} values for {m} cells")
-        if arr.GetNumberOfComponents() > 1:
-            names = tuple(arr.GetComponentName(k) or "" for k in range(arr.GetNumberOfComponents()))
-            if any(names):
-                components.setdefault(name, names)
-        out[name] = a
     return out
 
 

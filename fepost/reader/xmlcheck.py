@@ -29,6 +29,12 @@ _TAG = re.compile(
     rb"<!--.*?-->|<\?.*?\?>|<!\[CDATA\[.*?\]\]>|<(/?)([A-Za-z_][\w:.-]*)((?:[^>\"']|\"[^\"]*\"|'[^']*')*)>",
     re.S,
 )
+#: Elements that label the DataArrays inside them with their name, up to their end tag.
+#: FieldData labels the arrays after it too (they are not checked against a piece's
+#: counts), but its end tag does not clear the label.
+_SECTIONS = frozenset(
+    {b"Points", b"Cells", b"Verts", b"Lines", b"Strips", b"Polys", b"PointData", b"CellData"}
+)
 _ATTR = re.compile(rb"([A-Za-z_][\w:.-]*)\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
 
 
@@ -122,16 +128,7 @@ class Xml:
                 if not stack or stack[-1] != name:
                     raise _bad(self.path, f"unexpected XML tag </{name.decode('latin-1')}>")
                 stack.pop()
-                if name in (
-                    b"Points",
-                    b"Cells",
-                    b"Verts",
-                    b"Lines",
-                    b"Strips",
-                    b"Polys",
-                    b"PointData",
-                    b"CellData",
-                ):
+                if name in _SECTIONS:
                     section = ""
                 continue
             attrs = {
@@ -144,17 +141,7 @@ class Xml:
                 root = attrs
             if name == b"Piece":
                 pieces.append(_Piece(attrs))
-            elif name in (
-                b"Points",
-                b"Cells",
-                b"Verts",
-                b"Lines",
-                b"Strips",
-                b"Polys",
-                b"PointData",
-                b"CellData",
-                b"FieldData",
-            ):
+            elif name in _SECTIONS or name == b"FieldData":
                 section = name.decode()
             elif name == b"DataArray" and pieces:
                 end = data.find(b"<", m.end(), limit)
