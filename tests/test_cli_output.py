@@ -227,6 +227,40 @@ def test_sigterm_during_report_leaves_nothing(small_map, tmp_path, delay):
     assert not out.exists() and temporaries(tmp_path) == []
 
 
+_HALF_BUILT = """
+import os, signal, sys, time
+import fepost.cli as cli
+import fepost.cli.coefficients as command
+
+class HalfBuilt:  # like a renderer stopped in its constructor: its finaliser then fails
+    def __init__(self):
+        self.cycle = self
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(10)
+        self.actor = None
+
+    def __del__(self):
+        self.actor
+
+def run(args):
+    HalfBuilt()
+    return 0
+
+command.run = run
+sys.argv = ["fepost", "coefficients", sys.argv[1]]
+cli.console_main()
+"""
+
+
+def test_sigterm_message_is_the_last_line_even_when_finalisers_fail(small_map):
+    """A SIGTERM that stops an object half-built: one line, no "Exception ignored" after it."""
+    p = subprocess.run(
+        [sys.executable, "-c", _HALF_BUILT, str(small_map)], capture_output=True, text=True, timeout=60
+    )
+    assert p.returncode == 143, p.stderr
+    assert p.stderr == "fepost: terminated by SIGTERM\n"
+
+
 def test_sigkill_litter_is_removed_by_the_next_run(small_map, tmp_path, capsys):
     out = tmp_path / "rep"
     p = _start_report(small_map, out)

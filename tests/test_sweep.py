@@ -115,7 +115,8 @@ def load_sweep(tmp_path_factory):
 def test_table_equals_single_file_json(cluster, load_sweep, tmp_path):
     d, files, loads = load_sweep
     res = run_sweep([str(d / "*_static.*")], tmp_path / "out", client=cluster)
-    assert res.ok and res.computed == 5 and res.reused == 0
+    assert res.ok, [(r["source"], r["error"]) for r in res.rows if r["status"] != "ok"]
+    assert res.computed == 5 and res.reused == 0
     assert [r["source"] for r in res.rows] == [str(f) for f in sorted(files)]
     for row in res.rows:
         assert_row_equals(dict(row), single_file(tmp_path, row["source"]))
@@ -146,7 +147,7 @@ def test_rolling_pairs_rule_and_csv(cluster, load_sweep, tmp_path):
     assert doc["k_x"] == pytest.approx(0.15, rel=0.05)  # the map's own shift, O(h) on 12 rings
     # naming rule: the rolling map is consumed, not a row of its own
     res = run_sweep([str(d)], tmp_path / "rule", rolling_pairs="static=rolling", client=cluster, trends=False)
-    assert res.ok
+    assert res.ok, [(r["source"], r["error"]) for r in res.rows if r["status"] != "ok"]
     assert len(res.rows) == 5
     row = next(r for r in res.rows if r["source"].endswith("case3_static.vtu"))
     assert row["rolling"] == str(rolling)
@@ -297,7 +298,7 @@ def test_exodus_time_steps(cluster, tmp_path):
     series = write_exodus(tmp_path / "ramp.e", pts, cells, data, times=times)
     series.with_suffix(".json").write_text(json.dumps({"load": list(loads), "inflation_pressure": 1.4e6}))
     res = run_sweep([str(series)], tmp_path / "out", steps="all", client=cluster)
-    assert res.ok
+    assert res.ok, [(r["source"], r["error"]) for r in res.rows if r["status"] != "ok"]
     assert [r["step"] for r in res.rows] == list(range(n))
     assert [r["time"] for r in res.rows] == pytest.approx(times, rel=1e-12)
     assert [r["load"] for r in res.rows] == list(loads)

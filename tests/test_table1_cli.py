@@ -173,22 +173,25 @@ def test_cli_bad_path_exits_2_one_line_no_json(tmp_path, capsys):
 
 
 def test_cli_missing_sample_meshes_names_the_path(tmp_path, capsys, monkeypatch):
-    import fepost.cli._common as common
+    import fepost.report.samples as samples
 
-    monkeypatch.setattr(common, "repo_meshes", lambda: tmp_path / "meshes")
+    monkeypatch.setattr(samples, "meshes_folder", lambda: tmp_path / "meshes")
     code = main(["table1"])
     assert code == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and str(tmp_path / "meshes" / "static.vtu") in err
+    assert err.count("\n") == 1 and str(tmp_path / "meshes" / samples.SAMPLE_STATIC) in err
 
 
 def test_cli_uses_sample_meshes_by_default(meshes, capsys, monkeypatch):
-    import fepost.cli._common as common
+    """Without inputs: the report's sample pair (static and rolling), found beside the package."""
+    import fepost.report.samples as samples
 
-    monkeypatch.setattr(common, "repo_meshes", lambda: meshes[0].parent)
+    monkeypatch.setattr(samples, "meshes_folder", lambda: meshes[0].parent)
+    monkeypatch.setattr(samples, "SAMPLE_STATIC", meshes[0].name)
+    monkeypatch.setattr(samples, "SAMPLE_ROLLING", meshes[1].name)
     assert main(["table1"]) == 0
     out = capsys.readouterr().out
-    assert "rolling map, k_x" in out and str(meshes[1]) in out
+    assert "rolling map, k_x" in out and str(meshes[0]) in out and str(meshes[1]) in out
 
 
 def test_cli_unwritable_json_exits_2(meshes, tmp_path, capsys):

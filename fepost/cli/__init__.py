@@ -144,6 +144,11 @@ class _Run:
         a SIGALRM 50 ms later that checks again (:meth:`on_alarm`).
         """
         self.signum = self.signum or signum
+        if not self.debug:
+            # The exception unwinds through half-built objects (a renderer stopped in its
+            # constructor); their finalisers then fail, and Python would print each such
+            # failure as "Exception ignored in ..." after the one-line message.
+            sys.unraisablehook = _ignore_unraisable
         self.on_alarm(signal.SIGALRM, frame)
 
     def on_alarm(self, signum, frame) -> None:
@@ -164,6 +169,10 @@ class _Run:
         else:
             _say(f"fepost: terminated by {signal.Signals(self.signum).name}")
         return 128 + self.signum
+
+
+def _ignore_unraisable(unraisable) -> None:
+    """``sys.unraisablehook`` after a stopping signal: finalisers' errors stay quiet."""
 
 
 #: Delay (s) before a signal that arrived during an import is checked again.
