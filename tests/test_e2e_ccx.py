@@ -118,8 +118,11 @@ def test_aircraft_deck_cards(tmp_path):
     assert text.count("*HYPERELASTIC, NEO HOOKE") == 2
     assert "*BOUNDARY, AMPLITUDE=AROADZ" in text and "*DLOAD, AMPLITUDE=APRESS" in text
     assert "*CONTROLS, PARAMETERS=FIELD\n0.02" in text
-    assert info.output_times == {"inflation": ad.INFLATION_TIME, "half": ad.INFLATION_TIME + 0.5,
-                                 "end": ad.INFLATION_TIME + 1.0}
+    assert info.output_times == {
+        "inflation": ad.INFLATION_TIME,
+        "half": ad.INFLATION_TIME + 0.5,
+        "end": ad.INFLATION_TIME + 1.0,
+    }
     assert "SYMN, 2, 2" in text and "BEAD, 1, 3" in text
     for c in ad.CARCASS.values():
         assert ad.orthotropic_ok(c)

@@ -165,9 +165,7 @@ def test_bad_measured_csv(capsys, data, case):
 
 @pytest.mark.parametrize(
     "case",
-    [
-        name for name in DIAGNOSE_OWNED
-    ],
+    [name for name in DIAGNOSE_OWNED],
 )
 def test_bad_measured_csv_owned_elsewhere(capsys, data, case):
     folder, static, good = data

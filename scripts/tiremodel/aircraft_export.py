@@ -182,8 +182,17 @@ def model_description(mesh: AircraftMesh) -> dict:
         "carcass": {
             k: dict(
                 zip(
-                    ("E1_meridional", "E2_circumferential", "E3_normal", "nu12", "nu13", "nu23", "G12", "G13",
-                     "G23"),
+                    (
+                        "E1_meridional",
+                        "E2_circumferential",
+                        "E3_normal",
+                        "nu12",
+                        "nu13",
+                        "nu23",
+                        "G12",
+                        "G13",
+                        "G23",
+                    ),
                     v,
                     strict=True,
                 )
