@@ -100,11 +100,20 @@ def main() -> None:
         N_ref = analytic.load("hertz", 0.15, 1e6)
         if args.mode in ("both", "inprocess"):
             reads, fulls, base = [], [], []
-            for _ in range(args.repeat):
+            # With a baseline both checkouts are imported the same way (PYTHONPATH) and run
+            # in alternating order: a same-code control then reads 1.00 ± noise, where
+            # a fixed order and different import routes read up to 1.10.
+            here = str(Path(__file__).resolve().parents[1]) if args.baseline else None
+            for k in range(args.repeat):
                 reads.append(child("read", path))
-                fulls.append(child("full", path))
-                if args.baseline:
+                if not args.baseline:
+                    fulls.append(child("full", path))
+                elif k % 2 == 0:
+                    fulls.append(child("full", path, here))
                     base.append(child("full", path, str(args.baseline)))
+                else:
+                    base.append(child("full", path, str(args.baseline)))
+                    fulls.append(child("full", path, here))
             mr = statistics.median(r["time"] for r in reads)
             mf = statistics.median(r["time"] for r in fulls)
             f = fulls[0]
