@@ -269,3 +269,79 @@ def test_started_reads_run_side_by_side_and_leave_no_child(analytic_mesh):
     assert _children() == before
     with pytest.raises(FieldError, match=r"x\.vtu: no array named 'P'"):
         isolate.start(_field_error, what="x.vtu").result()
+
+
+# --- locks of the caller's other threads (held for ever in a forked child) ---------------
+
+_HALF_IMPORTED = """
+import builtins, os
+_gate = getattr(builtins, "_fepost_gate", None)
+if _gate is not None and os.getpid() == _gate[0]:
+    _gate[1].set()  # the import is under way in the caller's other thread ...
+    _gate[2].wait()  # ... and holds this module's import lock until released
+VALUE = 42
+"""
+
+
+def _import_value(name):
+    import importlib
+
+    return importlib.import_module(name).VALUE
+
+
+def test_a_module_another_thread_is_importing_does_not_block_the_child(tmp_path, monkeypatch):
+    """A Dask worker imports on its event-loop thread while a task thread forks a reader; the
+    child must not wait for that thread's module lock (it does not exist in the child)."""
+    import builtins
+    import sys
+    import threading
+
+    (tmp_path / "fepost_half_imported.py").write_text(_HALF_IMPORTED)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    started, release = threading.Event(), threading.Event()
+    monkeypatch.setattr(builtins, "_fepost_gate", (os.getpid(), started, release), raising=False)
+    t = threading.Thread(target=_import_value, args=("fepost_half_imported",))
+    t.start()
+    try:
+        assert started.wait(10)
+        assert isolate.call(_import_value, "fepost_half_imported", what="probe", timeout=15) == 42
+    finally:
+        release.set()
+        t.join(10)
+        sys.modules.pop("fepost_half_imported", None)
+
+
+class _StreamHeldByAnotherThread:
+    """A stream whose lock another thread of the caller holds (it is writing) at the fork."""
+
+    def __init__(self, lock):
+        self.lock = lock
+
+    def write(self, text):
+        return len(text)
+
+    def flush(self):
+        if os.getpid() != self.owner_pid:
+            self.lock.acquire()  # in the child: the holder does not exist, this never returns
+
+    owner_pid = os.getpid()
+
+
+def _print_and_answer():
+    print("the child writes to its own stdout")  # captured, as C-level chatter is
+    return 7
+
+
+def test_streams_another_thread_is_writing_do_not_block_the_child(monkeypatch):
+    import sys
+    import threading
+
+    lock = threading.Lock()
+    lock.acquire()
+    stream = _StreamHeldByAnotherThread(lock)
+    monkeypatch.setattr(sys, "stdout", stream)
+    monkeypatch.setattr(sys, "stderr", stream)
+    try:
+        assert isolate.call(_print_and_answer, what="probe", timeout=15) == 7
+    finally:
+        lock.release()

@@ -16,6 +16,9 @@ How
 * ``os.fork`` (not :mod:`multiprocessing`): the child inherits the already
   imported modules, starts in milliseconds, and works inside daemonic
   processes (Dask workers), where ``multiprocessing`` refuses to start children.
+* The child first lets go of what the caller's other threads held at the fork
+  (per-module import locks, the streams' locks; :mod:`fepost.reader.afterfork`):
+  a Dask worker imports on one thread while another forks a reader.
 * The child's file descriptors 1 and 2 are redirected to an anonymous memory
   file, so the C libraries' chatter is captured at the descriptor level; the
   first error line is quoted in the message, nothing reaches the terminal.
@@ -58,6 +61,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..errors import FepostError, FepostWarning, InputFileError
+from . import afterfork
 
 #: Environment variable: ``off`` reads in the calling process (no child).
 ISOLATION_ENV = "FEPOST_READ_ISOLATION"
@@ -290,6 +294,7 @@ def _address(raw: memoryview) -> int:
 
 
 def _child_main(wfd: int, ack: int, func, args, kwargs, nbytes: int) -> None:
+    afterfork.settle()  # first: locks of the caller's other threads are held for ever here
     import faulthandler
 
     faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
@@ -298,10 +303,9 @@ def _child_main(wfd: int, ack: int, func, args, kwargs, nbytes: int) -> None:
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent around the fork
     cap = _capture_fd()
-    sys.stdout.flush()
-    sys.stderr.flush()
     os.dup2(cap, 1)
     os.dup2(cap, 2)
+    afterfork.fresh_streams()  # the inherited stream objects are not flushed (afterfork)
     _limit_memory(nbytes)
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
