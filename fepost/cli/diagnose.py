@@ -101,7 +101,7 @@ def _make_example(args: argparse.Namespace) -> int:
         raise OutputError(f"{target}: is a folder; --make-example needs a CSV file name")
     if target.exists() and not args.force:
         raise OutputError(f"{target}: file exists (use --force to replace it)")
-    if not (target.parent if str(target.parent) else Path(".")).is_dir():
+    if not target.parent.is_dir():
         raise OutputError(f"{target}: folder {target.parent} does not exist")
     seed = EXAMPLE_SEED if args.seed is None else args.seed
     syn = make_example(
