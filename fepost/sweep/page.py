@@ -22,6 +22,8 @@ from .figures import MAX_SERIES, plot_load_trends, plot_time_trends, transient_s
 from .table import normalise
 from .trends import PowerLaw, load_trends
 
+#: Heading of the section (on the trends page, and by default when embedded).
+TITLE = "Sweep: coefficients against load"
 #: Most rows listed in the HTML table (the CSV and Parquet files hold them all).
 MAX_TABLE_ROWS = 200
 #: How the page writes a fitted quantity (HTML; subscripts as <sub>).
@@ -129,7 +131,7 @@ def sweep_section(
     href: str = "",
     *,
     heading_level: int = 2,
-    title: str | None = "Sweep: coefficients against load",
+    title: str | None = TITLE,
 ) -> str:
     """An HTML ``<section>`` with the sweep's figures, power-law fits and table.
 
@@ -149,7 +151,18 @@ def sweep_section(
         The section's heading; None for none (the page around it gives one).
     """
     rows = [normalise(r) for r in rows]
-    fits = load_trends(rows)
+    return _section(rows, load_trends(rows), figure_dir, href, heading_level, title)
+
+
+def _section(
+    rows: Sequence[Mapping],
+    fits: Sequence[PowerLaw],
+    figure_dir: str | os.PathLike,
+    href: str,
+    heading_level: int,
+    title: str | None,
+) -> str:
+    """:func:`sweep_section` of normalised ``rows`` with their fits ``fits``."""
     figures = draw_figures(rows, fits, Path(figure_dir))
     prefix = href.rstrip("/") + "/" if href else ""
     listed = list(rows)[:MAX_TABLE_ROWS]
@@ -175,9 +188,11 @@ def write_trends(rows: Sequence[Mapping], out: str | os.PathLike) -> Path:
     The figures are drawn into a temporary folder and moved into place whole.
     """
     out = Path(out)
+    rows = [normalise(r) for r in rows]
+    fits = load_trends(rows)
     tmp = Path(tempfile.mkdtemp(prefix=".trends.", suffix=".tmp", dir=out))
     try:
-        section = sweep_section(rows, tmp, "trends")
+        section = _section(rows, fits, tmp, "trends", 2, TITLE)
         final = out / "trends"
         if final.is_dir():
             old = out / f".trends.old-{os.getpid()}"
@@ -189,15 +204,13 @@ def write_trends(rows: Sequence[Mapping], out: str | os.PathLike) -> Path:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    from markupsafe import Markup
-
     page = (
         _environment()
         .get_template("trends.html.j2")
         .render(
-            section=Markup(section),
+            section=markupsafe.Markup(section),
             n_rows=len(rows),
         )
     )
-    write_json_atomic(out / "trends.json", {"fits": [f.to_dict() for f in load_trends(rows)]})
+    write_json_atomic(out / "trends.json", {"fits": [f.to_dict() for f in fits]})
     return write_text_atomic(out / "trends.html", page)
