@@ -236,15 +236,15 @@ def run_sweep(
         keys = [j.key() for j in jobs]
         rows: list[dict | None] = [None] * len(jobs)
         todo = []
+        reused = 0
         for i, (job, key) in enumerate(zip(jobs, keys, strict=True)):
-            saved = work.load_row(key)
             if job.error is not None:
                 rows[i] = run_job(job)
-            elif saved is not None and saved.get("status") == "ok":
+            elif (saved := work.load_row(key)) is not None and saved["status"] == "ok":
                 rows[i] = saved
+                reused += 1
             else:
                 todo.append(i)
-        reused = sum(r is not None and jobs[i].error is None for i, r in enumerate(rows))
         bar = ProgressBar(len(todo), done=len(jobs) - len(todo), enabled=progress)
         if todo:
             _compute(cluster, jobs, keys, todo, rows, work, bar)
