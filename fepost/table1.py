@@ -148,7 +148,9 @@ class GeneralisedTable:
         models = {}
         for tag, m in (("static", self.form.static), ("rolling", self.form.rolling)):
             K, L = m.order
-            models[tag] = {"order": [K, L], "accuracy": dict(m.accuracy), "source": m.source}
+            # the paper's forms' errors (compare_*) belong to the coefficients JSON, not here
+            acc = {k: v for k, v in m.accuracy.items() if not k.startswith("compare_")}
+            models[tag] = {"order": [K, L], "accuracy": acc, "source": m.source}
         return {
             "rows": [r.to_dict() for r in self.rows],
             "source": self.curves.source,
@@ -406,7 +408,7 @@ def table1(
     gen = None
     if generalised:
         gen = _generalised_table(
-            c,
+            analysis,
             quad,
             rolling_quad,
             kx,
@@ -447,17 +449,23 @@ def table1(
 
 
 def _generalised_table(
-    c, quad, rolling_quad, kx, *, n_points, span, noise, amplitude, seed
+    analysis, quad, rolling_quad, kx, *, n_points, span, noise, amplitude, seed
 ) -> GeneralisedTable:
-    """Build the two generalised models, make the exact curves, fit (no profile bounds)."""
-    from .friction.build import build_model
-    from .friction.law import FrictionLaw
+    """Take the analysis's generalised models (built once, shared with
+    :attr:`~fepost.analysis.Analysis.model_summary`; without a rolling map the
+    rolling model is built on σ0(1 + k_x x/R)), make the exact curves, fit (no
+    profile bounds)."""
+    c = analysis.coefficients
+    summary = analysis.model_summary
+    if rolling_quad is not None:
+        roll, rolling = rolling_quad, summary.rolling
+    else:
+        from .friction.build import build_model
+        from .friction.law import FrictionLaw
 
-    law = FrictionLaw(f=c.f)
-    roll = rolling_quad if rolling_quad is not None else rolling_model(quad, kx, c.R)
-    form = GeneralisedCurves(
-        static=build_model(quad, law, radius=c.R), rolling=build_model(roll, law, radius=c.R), k_ref=kx
-    )
+        roll = rolling_model(quad, kx, c.R)
+        rolling = build_model(roll, FrictionLaw(f=c.f), radius=c.R)
+    form = GeneralisedCurves(static=summary.static, rolling=rolling, k_ref=kx)
     truth = {"F0": c.F0, "M0": c.M0, "a": c.a, "m": c.m, "k_x": kx, "R": c.R, "N": c.N}
     clean = make_test_curves(
         "exact", truth, quad=quad, rolling_quad=roll, n_points=n_points, span=span, amplitude=0.0

@@ -444,6 +444,19 @@ def test_bias_of_the_closed_forms_on_exact_data(hertz_quad, truth):
     assert set(d["bias"]) == set(PARAMETERS)
 
 
+def test_bias_integrates_the_exact_curves_once(hertz_quad, truth, monkeypatch):
+    """The noisy curves are the noise-free ones plus noise (with_noise): one integration."""
+    import fepost.identify.curves as curves
+
+    calls = []
+    real = curves.exact_curves
+    monkeypatch.setattr(curves, "exact_curves", lambda *a, **k: calls.append(1) or real(*a, **k))
+    b = approximation_bias(truth, hertz_quad, seed=4)
+    assert len(calls) == 1
+    noisy = make_test_curves("exact", truth, quad=hertz_quad, seed=4)
+    assert b.noisy.value("a") == fit_table1(noisy, truth["N"], profile=False).value("a")
+
+
 def test_runs_test_and_autocorrelation_on_known_sequences():
     alt = np.array([1.0, -1.0] * 20)
     runs, mu, p = runs_test(alt)

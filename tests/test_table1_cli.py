@@ -104,6 +104,19 @@ def test_generalised_rows_beside_the_paper_rows(committed, analysis):
             table.row("F1")
 
 
+def test_generalised_table_shares_the_analysis_models(committed, analysis):
+    """The generalised models are built once per analysis: Table 1 fits the models of
+    ``analysis.model_summary`` (the coefficients output and the report show the same ones),
+    and its JSON keeps only the models' own errors (the paper's forms' are the coefficients')."""
+    form = committed.generalised.form
+    summary = analysis.model_summary
+    assert form.static is summary.static and form.rolling is summary.rolling
+    assert "compare_force" in summary.static.accuracy
+    for m in committed.to_dict()["generalised"]["models"].values():
+        assert {"model_force", "model_torque", "base_force", "base_torque"} <= set(m["accuracy"])
+        assert not any(k.startswith("compare_") for k in m["accuracy"])
+
+
 def test_without_rolling_map_k_x_is_assumed_and_said(meshes):
     a = analyse(meshes[0])
     t = table1(a, bias=False, profile=False, generalised=False)

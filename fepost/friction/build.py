@@ -27,6 +27,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from threadpoolctl import threadpool_limits
 
@@ -160,7 +162,7 @@ def build_model(
     vx, vy, u, th, t = sphere_nodes(n_theta, 0.5 * (nodes + 1.0))
     wz = u / R
     exact = friction_resultants(eq, vx, vy, wz, iso)
-    b = GeneralisedModel(**{**_fields(base), "anisotropy": 1.0, "correction_g": None})
+    b = replace(base, anisotropy=1.0, correction_g=None)
     bx, by, bm = b(vx, vy, wz)
     cos1, sin1 = np.cos(th), np.sin(th)
     G, Gt, Gth = basis.design(cos1, sin1, t, K, L)
@@ -194,33 +196,11 @@ def build_model(
         with threadpool_limits(limits=1, user_api="blas"):
             sol2 = np.linalg.lstsq(A2, (g_exact - g_base) / M0, rcond=None)[0]
         correction_g = sol2.reshape(2 * K + 1, L)
-    model = GeneralisedModel(
-        **{**_fields(base), "correction": correction, "correction_g": correction_g, "source": quad.source}
-    )
+    model = replace(base, correction=correction, correction_g=correction_g)
     if check:
         acc = measure_accuracy(model, quad, law, CHECK_GRID, compare=compare)
-        model = GeneralisedModel(**{**_fields(model), "accuracy": acc})
+        model = replace(model, accuracy=acc)
     return model
-
-
-def _fields(m: GeneralisedModel) -> dict:
-    return {
-        "f": m.f,
-        "R": m.R,
-        "F0": m.F0,
-        "M0": m.M0,
-        "Q": m.Q,
-        "S": m.S,
-        "g": m.g,
-        "xc": m.xc,
-        "correction": m.correction,
-        "anisotropy": m.anisotropy,
-        "g0": m.g0,
-        "g1": m.g1,
-        "correction_g": m.correction_g,
-        "accuracy": dict(m.accuracy),
-        "source": m.source,
-    }
 
 
 def measure_accuracy(

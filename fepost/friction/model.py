@@ -73,7 +73,6 @@ CHUNK = 1 << 14
 POTENTIAL_WEIGHT = (3, 2)
 #: ... and of the anisotropic-torque correction.
 DIRECT_WEIGHT = (2, 2)
-_J = np.array([[0.0, -1.0], [1.0, 0.0]])
 
 
 def _matrix(name: str, value, shape: tuple[int, ...]) -> np.ndarray:

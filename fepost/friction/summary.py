@@ -162,13 +162,6 @@ def summarise(analysis: Analysis, *, order="auto") -> ModelSummary:
     )
 
 
-def model_lines(analysis: Analysis) -> list[str]:
-    """The summary rows of ``analysis`` as text lines (label, two spaces, value)."""
-    rows = analysis.model_summary.lines()
-    width = max(len(k) for k, _ in rows)
-    return [f"{k:<{width}}  {v}" for k, v in rows]
-
-
 def analysis_error_map(analysis: Analysis, *, rolling: bool = False, n_beta: int = 37, n_t: int = 65):
     """The :class:`~fepost.friction.sphere.ErrorMap` of the paper's closed forms, the
     generalised base and the generalised model on the static (or rolling) map of

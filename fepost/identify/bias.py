@@ -23,6 +23,7 @@ from .curves import (
     DEFAULT_SPAN,
     _coefficient_values,
     make_test_curves,
+    with_noise,
 )
 from .fit import fit_table1
 from .result import Identification
@@ -125,20 +126,17 @@ def approximation_bias(
     noisy fit shows whether the paper's 20 % noise would hide it.
     """
     c = _coefficient_values(coefficients)
-    clean, noisy = (
-        make_test_curves(
-            "exact",
-            c,
-            quad=quad,
-            rolling_quad=rolling_quad,
-            n_points=n_points,
-            span=span,
-            noise=noise,
-            amplitude=amp,
-            seed=seed,
-        )
-        for amp in (0.0, amplitude)
+    clean = make_test_curves(
+        "exact",
+        c,
+        quad=quad,
+        rolling_quad=rolling_quad,
+        n_points=n_points,
+        span=span,
+        noise=noise,
+        amplitude=0.0,
     )
+    noisy = with_noise(clean, noise=noise, amplitude=amplitude, seed=seed)  # integrated once
     fit0 = fit_table1(clean, c["N"], profile=False)
     fit1 = fit_table1(noisy, c["N"], profile=False)
     structure = {}
