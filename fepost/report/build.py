@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import __version__
 from ..analysis import analyse
 from ..output import staged_folder, to_json
 from ..table1 import DEFAULT_SEED, table1
@@ -84,15 +85,6 @@ class _Steps:
         if self.progress is not None:
             self.progress(len(self.done), self.total, name, dt)
         return value
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("fepost")
-    except PackageNotFoundError:
-        return "unknown"
 
 
 def build_report(
@@ -287,7 +279,7 @@ def build_report(
                 p_star=p_star,
                 p_star_source=p_src,
                 seed=seed,
-                version=_version(),
+                version=__version__,
                 error_maps={stem: json.loads(texts[f"{stem}.json"]) for stem in map_docs},
             )
             ctx.update(
