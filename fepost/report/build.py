@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -17,7 +18,7 @@ from ..output import staged_folder, to_json
 from ..table1 import DEFAULT_SEED, table1
 from .assemble import _check_inflation_option, friction_curves, page_context, resolve_inflation_pressure
 from .figures import Figure, save_matplotlib, save_plotter
-from .samples import sample_inputs
+from .samples import meshes_folder, sample_inputs
 from .sections import DEFAULT_SECTIONS, ReportData, SectionProvider, run_providers
 
 Progress = Callable[[int, int, str, float], None]
@@ -130,8 +131,9 @@ def build_report(
     Raises
     ------
     OutputError
-        ``out`` exists and is not empty (without ``force``) or cannot be
-        written; nothing is left behind on error.
+        ``out`` exists and is not empty (without ``force``), holds the input
+        files, the sample meshes, the current or the home folder (even with
+        ``force``), or cannot be written; nothing is left behind on error.
     """
     import matplotlib
 
@@ -150,7 +152,8 @@ def build_report(
         _check_inflation_option(inflation_pressure)
     has_roll = rolling is not None
     steps = _Steps(total=12 + (1 if has_roll else 0), progress=progress)
-    with staged_folder(out, force=force) as tmp:
+    inputs = [Path(p) for p in (static, rolling) if isinstance(p, str | os.PathLike)]
+    with staged_folder(out, force=force, protect=[*inputs, meshes_folder()]) as tmp:
         a = steps.run(
             "read and analyse the FE maps",
             analyse,
