@@ -383,6 +383,21 @@ def test_report_unwritable_folder(small_map, capsys):
     assert err.count("\n") == 1
 
 
+def test_build_report_force_never_deletes_its_inputs(tmp_path):
+    """The Python API guards its inputs as the command line does: refused before any work."""
+    from fepost.errors import OutputError
+    from fepost.report import build_report
+
+    (tmp_path / "data").mkdir()
+    static = write_map(tmp_path / "data" / "small.vtu", "hertz", n_rings=8)
+    before = static.read_bytes()
+    with pytest.raises(OutputError, match=r"refusing to replace this folder: it contains the input"):
+        build_report(static, out=static.parent, force=True)
+    with pytest.raises(OutputError, match=r"refusing to replace this folder: it is the input"):
+        build_report(static, out=meshes_folder(), force=True)
+    assert static.read_bytes() == before and sorted(p.name for p in static.parent.iterdir()) == ["small.vtu"]
+
+
 def test_report_parent_is_a_file(tmp_path, small_map, capsys):
     (tmp_path / "afile").write_text("x")
     out = tmp_path / "afile" / "rep"

@@ -52,7 +52,7 @@ EXIT_STATUSES = {
     143: "terminated (SIGTERM; 129 for SIGHUP); nothing half-written is left",
 }
 OK, FAILED_INPUTS, BAD_INPUT, INTERNAL = 0, 1, 2, 3
-INTERRUPTED, BROKEN_PIPE = 130, 141
+BROKEN_PIPE = 141
 
 
 class UsageError(Exception):

@@ -387,7 +387,7 @@ def page_context(
         if coef.get(key) is not None
     ]
     coefficient_rows += [
-        {**_row(f"A.{j}", f"A{j}", "pressure", f"∫₀¹ σ̄₀(ρ) ρ{'⁰¹²³'[j]} dρ", coef["A"][j], "coefficients")}
+        _row(f"A.{j}", f"A{j}", "pressure", f"∫₀¹ σ̄₀(ρ) ρ{'⁰¹²³'[j]} dρ", coef["A"][j], "coefficients")
         for j in range(4)
     ]
     if coef.get("reaction_z") is not None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -11,12 +12,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import __version__
 from ..analysis import analyse
 from ..output import staged_folder, to_json
 from ..table1 import DEFAULT_SEED, table1
 from .assemble import _check_inflation_option, friction_curves, page_context, resolve_inflation_pressure
 from .figures import Figure, save_matplotlib, save_plotter
-from .samples import sample_inputs
+from .samples import meshes_folder, sample_inputs
 from .sections import DEFAULT_SECTIONS, ReportData, SectionProvider, run_providers
 
 Progress = Callable[[int, int, str, float], None]
@@ -86,15 +88,6 @@ class _Steps:
         return value
 
 
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("fepost")
-    except PackageNotFoundError:
-        return "unknown"
-
-
 def build_report(
     static=None,
     rolling=None,
@@ -138,8 +131,9 @@ def build_report(
     Raises
     ------
     OutputError
-        ``out`` exists and is not empty (without ``force``) or cannot be
-        written; nothing is left behind on error.
+        ``out`` exists and is not empty (without ``force``), holds the input
+        files, the sample meshes, the current or the home folder (even with
+        ``force``), or cannot be written; nothing is left behind on error.
     """
     import matplotlib
 
@@ -158,7 +152,8 @@ def build_report(
         _check_inflation_option(inflation_pressure)
     has_roll = rolling is not None
     steps = _Steps(total=12 + (1 if has_roll else 0), progress=progress)
-    with staged_folder(out, force=force) as tmp:
+    inputs = [Path(p) for p in (static, rolling) if isinstance(p, str | os.PathLike)]
+    with staged_folder(out, force=force, protect=[*inputs, meshes_folder()]) as tmp:
         a = steps.run(
             "read and analyse the FE maps",
             analyse,
@@ -287,7 +282,7 @@ def build_report(
                 p_star=p_star,
                 p_star_source=p_src,
                 seed=seed,
-                version=_version(),
+                version=__version__,
                 error_maps={stem: json.loads(texts[f"{stem}.json"]) for stem in map_docs},
             )
             ctx.update(
