@@ -184,11 +184,18 @@ def start(
     return Pending(what, child=_fork(func, args, kwargs, what, nbytes, deadline))
 
 
-def _unexpected(what: str, exc: BaseException, tb: str) -> InputFileError:
-    first = _first_line(exc)
-    err = InputFileError(f"{what}: cannot read the file ({type(exc).__name__}: {first})")
+def _unexpected(what: str, name: str, first: str, tb: str, detail: str = "") -> InputFileError:
+    """The one-line error for an unexpected exception ``name: first`` (``tb`` kept for ``--debug``)."""
+    msg = f"{what}: cannot read the file ({name}: {first})"
+    if detail and detail not in msg:
+        msg = f"{msg}; reader said: {detail}"
+    err = InputFileError(msg)
     err.__cause__ = ChildTraceback(tb)
     return err
+
+
+def _out_of_memory(what: str) -> InputFileError:
+    return InputFileError(f"{what}: not enough memory to read the file (declared sizes too large?)")
 
 
 def _first_line(obj: object) -> str:
@@ -203,13 +210,11 @@ def _in_process(func, args, kwargs, what):
     except FepostError:
         raise
     except MemoryError:
-        raise InputFileError(
-            f"{what}: not enough memory to read the file (declared sizes too large?)"
-        ) from None
+        raise _out_of_memory(what) from None
     except (KeyboardInterrupt, SystemExit):
         raise
     except Exception as exc:  # a library error on a malformed file: one line, never a traceback
-        raise _unexpected(what, exc, traceback.format_exc()) from None
+        raise _unexpected(what, type(exc).__name__, _first_line(exc), traceback.format_exc()) from None
 
 
 # ----------------------------------------------------------------------------- child side
@@ -443,12 +448,6 @@ def _finish(pid: int, reader: transfer.Reader, what: str, timeout: float, nbytes
     if kind == "fepost":
         raise value
     if kind == "memory":
-        raise InputFileError(f"{what}: not enough memory to read the file (declared sizes too large?)")
+        raise _out_of_memory(what)
     name, first, tb = value
-    detail = _chatter_summary(text)
-    msg = f"{what}: cannot read the file ({name}: {first})"
-    if detail and detail not in msg:
-        msg = f"{msg}; reader said: {detail}"
-    err = InputFileError(msg)
-    err.__cause__ = ChildTraceback(tb)
-    raise err
+    raise _unexpected(what, name, first, tb, _chatter_summary(text))
