@@ -108,11 +108,6 @@ class ContactField:
         """Number of element faces (triangles and the other face types)."""
         return int(self.triangles.shape[0]) + sum(len(f) for f in self.faces.values())
 
-    @property
-    def linear_triangles_only(self) -> bool:
-        """True when every face is a linear triangle (no refinement needed downstream)."""
-        return not self.faces
-
     def face_groups(self) -> Iterator[tuple[str, np.ndarray, slice]]:
         """(face type, connectivity, slice of :attr:`values` for face data) of every non-empty group."""
         start = 0

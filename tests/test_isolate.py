@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from fepost.errors import FieldError, InputFileError, ReaderWarning
-from fepost.reader import isolate, read_contact
+from fepost.reader import isolate, read_contact, transfer
 
 
 def _segfault():
@@ -125,7 +125,7 @@ def test_arrays_arrive_intact_as_views_of_one_receiving_map():
 
 def _lying_send(fd, payload, ack):
     # a header that declares far more than a reading child can hold (a compromised child)
-    os.write(fd, isolate._LEN.pack(10) + isolate._LEN.pack(1) + isolate._LEN.pack(1 << 62) + bytes(8))
+    os.write(fd, transfer.LEN.pack(10) + transfer.LEN.pack(1) + transfer.LEN.pack(1 << 62) + bytes(8))
 
 
 def _short_send(fd, payload, ack):
@@ -134,8 +134,8 @@ def _short_send(fd, payload, ack):
     buffers = []
     head = __import__("pickle").dumps(payload, protocol=5, buffer_callback=buffers.append)
     raws = [b.raw() for b in buffers]
-    table = b"".join(isolate._LEN.pack(r.nbytes) + isolate._LEN.pack(8) for r in raws)
-    os.write(fd, isolate._LEN.pack(len(head)) + isolate._LEN.pack(len(raws)) + table + head)
+    table = b"".join(transfer.LEN.pack(r.nbytes) + transfer.LEN.pack(8) for r in raws)
+    os.write(fd, transfer.LEN.pack(len(head)) + transfer.LEN.pack(len(raws)) + table + head)
     assert os.read(ack, 1) == b"p"
     os.write(fd, bytes(raws[0][:1000]))
 
@@ -145,16 +145,16 @@ def _copy_refused(*args):
 
 
 def test_buffers_are_copied_straight_from_the_child_where_allowed(monkeypatch):
-    if isolate._vm_readv() is None:
+    if transfer.vm_readv() is None:
         pytest.skip("no process_vm_readv on this platform")
     copies = []
-    real = isolate._copy_from
+    real = transfer.copy_from
 
     def spy(*args):
         copies.append(real(*args))
         return copies[-1]
 
-    monkeypatch.setattr(isolate, "_copy_from", spy)
+    monkeypatch.setattr(transfer, "copy_from", spy)
     got = isolate.call(_array, what="big")
     np.testing.assert_array_equal(got["a"], np.arange(3_000_000, dtype=float))
     if copies != [True]:
@@ -162,7 +162,7 @@ def test_buffers_are_copied_straight_from_the_child_where_allowed(monkeypatch):
 
 
 def test_buffers_come_through_the_pipe_where_the_caller_cannot_copy_them(monkeypatch):
-    monkeypatch.setattr(isolate, "_copy_from", _copy_refused)
+    monkeypatch.setattr(transfer, "copy_from", _copy_refused)
     got = isolate.call(_mixed_arrays, what="big")
     for name, arr in _mixed_arrays().items():
         np.testing.assert_array_equal(got[name], arr)
@@ -176,7 +176,7 @@ def test_buffers_come_through_the_pipe_where_the_caller_cannot_copy_them(monkeyp
     ],
 )
 def test_a_malformed_or_cut_answer_is_one_line_error(monkeypatch, send, pattern):
-    monkeypatch.setattr(isolate, "_send", send)  # inherited by the forked child
+    monkeypatch.setattr(transfer, "send", send)  # inherited by the forked child
     with pytest.raises(InputFileError, match=pattern):
         isolate.call(_array, what="f.vtu")
 

@@ -25,13 +25,9 @@ How
 * The child's address space is limited (:data:`MEMORY_BUDGET` beyond what it
   holds at the fork), so a header declaring 10¹² points fails fast.
 * The result travels back as a pickle (protocol 5) whose large numpy buffers
-  go out of band into one anonymous private map in the caller, backed by
-  transparent huge pages where the system offers them (the caller's arrays are
-  views of it). The caller copies them straight out of the waiting child with
-  ``process_vm_readv`` (Linux; one copy, no scheduling round trips) or, where
-  that is not allowed, reads them through the pipe. (A shared map made before
-  the fork cost 2-3x as much: its pages fault one by one in both processes and
-  are slow to free.)
+  go out of band into one anonymous private map in the caller (the caller's
+  arrays are views of it), copied straight out of the waiting child where
+  Linux allows it, else through the pipe (:mod:`fepost.reader.transfer`).
 * The parent waits with a deadline (:func:`timeout_for`); a child that misses
   it is killed. A child that has sent its whole answer is reaped in the
   background: its exit (freeing its memory) is not waited for.
@@ -46,11 +42,8 @@ function runs in the calling process (the validation still applies).
 
 from __future__ import annotations
 
-import io
-import mmap
 import os
 import pickle
-import select
 import signal
 import struct
 import sys
@@ -61,7 +54,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..errors import FepostError, FepostWarning, InputFileError
-from . import afterfork
+from . import afterfork, transfer
 
 #: Environment variable: ``off`` reads in the calling process (no child).
 ISOLATION_ENV = "FEPOST_READ_ISOLATION"
@@ -74,11 +67,6 @@ TIMEOUT_PER_MB = 2.0
 MEMORY_BUDGET = 6 << 30
 #: Pipe size asked for on Linux (fewer wake-ups on large results).
 _PIPE_SIZE = 1 << 20
-_LEN = struct.Struct("<Q")
-#: Alignment (bytes) of each array in the caller's receiving map.
-_ALIGN = 64
-#: Huge-page size the receiving map is rounded to (2 MB on x86-64 and most arm64 systems).
-_HUGE = 2 << 20
 
 
 class ChildTraceback(Exception):
@@ -196,11 +184,18 @@ def start(
     return Pending(what, child=_fork(func, args, kwargs, what, nbytes, deadline))
 
 
-def _unexpected(what: str, exc: BaseException, tb: str) -> InputFileError:
-    first = _first_line(exc)
-    err = InputFileError(f"{what}: cannot read the file ({type(exc).__name__}: {first})")
+def _unexpected(what: str, name: str, first: str, tb: str, detail: str = "") -> InputFileError:
+    """The one-line error for an unexpected exception ``name: first`` (``tb`` kept for ``--debug``)."""
+    msg = f"{what}: cannot read the file ({name}: {first})"
+    if detail and detail not in msg:
+        msg = f"{msg}; reader said: {detail}"
+    err = InputFileError(msg)
     err.__cause__ = ChildTraceback(tb)
     return err
+
+
+def _out_of_memory(what: str) -> InputFileError:
+    return InputFileError(f"{what}: not enough memory to read the file (declared sizes too large?)")
 
 
 def _first_line(obj: object) -> str:
@@ -215,16 +210,19 @@ def _in_process(func, args, kwargs, what):
     except FepostError:
         raise
     except MemoryError:
-        raise InputFileError(
-            f"{what}: not enough memory to read the file (declared sizes too large?)"
-        ) from None
+        raise _out_of_memory(what) from None
     except (KeyboardInterrupt, SystemExit):
         raise
     except Exception as exc:  # a library error on a malformed file: one line, never a traceback
-        raise _unexpected(what, exc, traceback.format_exc()) from None
+        raise _unexpected(what, type(exc).__name__, _first_line(exc), traceback.format_exc()) from None
 
 
 # ----------------------------------------------------------------------------- child side
+
+
+def _budget(nbytes: int) -> int:
+    """The address space (bytes) a child reading ``nbytes`` of file may add: the most it can answer with."""
+    return max(MEMORY_BUDGET, 64 * nbytes)
 
 
 def _limit_memory(nbytes: int) -> None:
@@ -233,7 +231,7 @@ def _limit_memory(nbytes: int) -> None:
 
         with open("/proc/self/statm", "rb") as fh:
             vsize = int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
-        budget = max(MEMORY_BUDGET, 64 * nbytes)
+        budget = _budget(nbytes)
         resource.setrlimit(resource.RLIMIT_AS, (vsize + budget, vsize + budget))
     except (OSError, ValueError, ImportError, AttributeError):
         pass  # no /proc or no limits on this platform: the deadline still applies
@@ -257,40 +255,6 @@ def _chatter(fd: int, limit: int = 1 << 16) -> str:
         return os.read(fd, limit).decode("utf-8", "replace")
     except OSError:
         return ""
-
-
-def _write_all(fd: int, data) -> None:
-    view = memoryview(data).cast("B")
-    while view.nbytes:
-        n = os.write(fd, view)
-        view = view[n:]
-
-
-def _send(fd: int, payload: Any, ack: int | None = None) -> None:
-    """Write the payload: its header (size and address of each out-of-band buffer), the pickle,
-    then wait for the caller's word on ``ack``: it has copied the buffers itself (``v``), or they
-    follow through the pipe (``p``)."""
-    buffers: list[pickle.PickleBuffer] = []
-    head = pickle.dumps(payload, protocol=5, buffer_callback=buffers.append)
-    raws = [b.raw() for b in buffers]
-    table = b"".join(_LEN.pack(r.nbytes) + _LEN.pack(_address(r)) for r in raws)
-    _write_all(fd, _LEN.pack(len(head)) + _LEN.pack(len(raws)) + table)
-    _write_all(fd, head)
-    if not raws:
-        return
-    how = os.read(ack, 1) if ack is not None else b"p"
-    if how == b"p":
-        for r in raws:
-            _write_all(fd, r)
-
-
-def _address(raw: memoryview) -> int:
-    """The address of a contiguous buffer's first byte (0 when empty)."""
-    if not raw.nbytes:
-        return 0
-    import numpy as np
-
-    return int(np.frombuffer(raw, np.uint8).ctypes.data)
 
 
 def _child_main(wfd: int, ack: int, func, args, kwargs, nbytes: int) -> None:
@@ -321,61 +285,13 @@ def _child_main(wfd: int, ack: int, func, args, kwargs, nbytes: int) -> None:
     caught = [(w.category, str(w.message)) for w in rec if issubclass(w.category, FepostWarning)]
     text = _chatter(cap)
     try:
-        _send(wfd, (payload, caught, text), ack)
+        transfer.send(wfd, (payload, caught, text), ack)
     except Exception as exc:  # the result itself could not be pickled: say so
         other = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
-        _send(wfd, (other, caught, text), ack)
+        transfer.send(wfd, (other, caught, text), ack)
 
 
 # ----------------------------------------------------------------------------- parent side
-
-
-class _Deadline(Exception):
-    pass
-
-
-class _Reader:
-    def __init__(self, fd: int, deadline: float, ack: int | None = None):
-        self.f = io.FileIO(fd, "rb", closefd=True)
-        self.deadline = deadline
-        self.ack = ack  # the write end of the caller's reply to the child
-
-    def reply(self, word: bytes) -> None:
-        """Tell the child how its buffers travel (it waits for this once its header is sent)."""
-        if self.ack is not None:
-            try:
-                os.write(self.ack, word)
-            except OSError:
-                pass  # the child is gone: the pipe's end of file says so
-
-    def _wait(self) -> None:
-        left = self.deadline - time.monotonic()
-        if left <= 0:
-            raise _Deadline
-        ready, _, _ = select.select([self.f], [], [], left)
-        if not ready:
-            raise _Deadline
-
-    def exact(self, n: int) -> bytearray:
-        buf = bytearray(n)
-        self.into(memoryview(buf))
-        return buf
-
-    def into(self, view: memoryview) -> None:
-        """Fill ``view`` from the pipe (EOFError if the child stops short)."""
-        pos, n = 0, view.nbytes
-        while pos < n:
-            self._wait()
-            got = self.f.readinto(view[pos:])
-            if not got:
-                raise EOFError
-            pos += got
-
-    def close(self) -> None:
-        self.f.close()
-        if self.ack is not None:
-            os.close(self.ack)
-            self.ack = None
 
 
 def _signal_name(sig: int) -> str:
@@ -423,87 +339,6 @@ def _reap_soon(pid: int) -> None:
         threading.Thread(target=_reap, args=(pid, False), name="fepost-reap", daemon=True).start()
 
 
-def _copy_from(pid: int, buf: mmap.mmap, offsets: list[int], sizes: list[int], addresses: list[int]) -> bool:
-    """Copy the child's buffers into ``buf`` with ``process_vm_readv``; False where not possible.
-
-    Linux only, and only where the caller may trace its child (the usual default); a
-    short or failed copy also gives False: the buffers then come through the pipe.
-    """
-    found = _vm_readv()
-    if found is None or len(sizes) > 1024:  # IOV_MAX
-        return False
-    import ctypes
-
-    call, iovec = found
-    holder = ctypes.c_char.from_buffer(buf)
-    try:
-        base = ctypes.addressof(holder)
-        n = len(sizes)
-        local, remote = (iovec * n)(), (iovec * n)()
-        for i, (at, size, where) in enumerate(zip(offsets, sizes, addresses, strict=True)):
-            local[i].base, local[i].len = base + at, size
-            remote[i].base, remote[i].len = where, size
-        return call(pid, local, n, remote, n, 0) == sum(sizes)
-    finally:
-        del holder
-
-
-_VM_READV: list = []
-
-
-def _vm_readv():
-    """(libc's process_vm_readv, its iovec type) through ctypes, or None where there is none."""
-    if not _VM_READV:
-        _VM_READV.append(_load_vm_readv())
-    return _VM_READV[0]
-
-
-def _load_vm_readv():
-    if not sys.platform.startswith("linux"):
-        return None
-    try:
-        import ctypes
-
-        class Iovec(ctypes.Structure):
-            _fields_ = [("base", ctypes.c_void_p), ("len", ctypes.c_size_t)]
-
-        fn = ctypes.CDLL(None, use_errno=True).process_vm_readv
-    except (OSError, AttributeError, ImportError):
-        return None
-    fn.restype = ctypes.c_ssize_t
-    iov = ctypes.POINTER(Iovec)
-    fn.argtypes = [ctypes.c_int, iov, ctypes.c_ulong, iov, ctypes.c_ulong, ctypes.c_ulong]
-    return fn, Iovec
-
-
-def _answer_limit(nbytes: int) -> int:
-    """The most bytes a child reading a file of ``nbytes`` can answer with (its memory budget)."""
-    return max(MEMORY_BUDGET, 64 * nbytes)
-
-
-def _receiving_map(sizes: list[int]) -> tuple[mmap.mmap | None, list[int]]:
-    """A private anonymous map for buffers of ``sizes`` (bytes), and the offset of each.
-
-    Backed by transparent huge pages where the system allows it (one page fault per
-    2 MB instead of per 4 kB). None when there is nothing to receive.
-    """
-    offsets, pos = [], 0
-    for n in sizes:
-        offsets.append(pos)
-        pos += -(-n // _ALIGN) * _ALIGN
-    if pos == 0:
-        return None, offsets
-    size = -(-pos // _HUGE) * _HUGE
-    private = getattr(mmap, "MAP_PRIVATE", 0) | getattr(mmap, "MAP_ANONYMOUS", 0)
-    buf = mmap.mmap(-1, size, flags=private) if private else mmap.mmap(-1, size)
-    if hasattr(mmap, "MADV_HUGEPAGE"):
-        try:
-            buf.madvise(mmap.MADV_HUGEPAGE)
-        except OSError:
-            pass  # no transparent huge pages here: ordinary pages
-    return buf, offsets
-
-
 def _fork(func, args, kwargs, what, nbytes, timeout):
     import fcntl
 
@@ -537,7 +372,7 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
     try:
         os.close(wfd)
         os.close(ack_r)
-        reader = _Reader(rfd, time.monotonic() + timeout, ack_w)
+        reader = transfer.Reader(rfd, time.monotonic() + timeout, ack_w)
         _restore_signals(old_mask)  # a signal that came meanwhile is handled here
     except BaseException:
         _reap(pid, kill=True)
@@ -564,34 +399,13 @@ def _restore_signals(old_mask) -> None:
         signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
 
 
-def _finish(pid: int, reader: _Reader, what: str, timeout: float, nbytes: int):
+def _finish(pid: int, reader: transfer.Reader, what: str, timeout: float, nbytes: int):
     received = None
     killed = malformed = False
     try:
         try:
-            sizes = reader.exact(16)
-            nhead, nbuf = _LEN.unpack_from(sizes, 0)[0], _LEN.unpack_from(sizes, 8)[0]
-            if nbuf > 1 << 20:
-                raise ValueError("too many buffers")
-            table = reader.exact(16 * nbuf)
-            lengths = [_LEN.unpack_from(table, 16 * i)[0] for i in range(nbuf)]
-            addresses = [_LEN.unpack_from(table, 16 * i + 8)[0] for i in range(nbuf)]
-            if nhead > _answer_limit(nbytes) or sum(lengths) > _answer_limit(nbytes):
-                raise ValueError("the child declares more than it could hold")
-            head = reader.exact(nhead)
-            buf, offsets = _receiving_map(lengths)
-            view = memoryview(buf) if buf is not None else memoryview(bytearray(0))
-            # the arrays are views of the receiving map: no further copy
-            bufs = [view[at : at + n] for n, at in zip(lengths, offsets, strict=True)]
-            if bufs:
-                if buf is not None and _copy_from(pid, buf, offsets, lengths, addresses):
-                    reader.reply(b"v")
-                else:
-                    reader.reply(b"p")
-                    for part in bufs:
-                        reader.into(part)
-            received = pickle.loads(head, buffers=bufs)
-        except _Deadline:
+            received = transfer.receive(pid, reader, _budget(nbytes))
+        except transfer.Deadline:
             killed = True
         except EOFError:  # the child stopped short: its exit status says why
             received = None
@@ -634,12 +448,6 @@ def _finish(pid: int, reader: _Reader, what: str, timeout: float, nbytes: int):
     if kind == "fepost":
         raise value
     if kind == "memory":
-        raise InputFileError(f"{what}: not enough memory to read the file (declared sizes too large?)")
+        raise _out_of_memory(what)
     name, first, tb = value
-    detail = _chatter_summary(text)
-    msg = f"{what}: cannot read the file ({name}: {first})"
-    if detail and detail not in msg:
-        msg = f"{msg}; reader said: {detail}"
-    err = InputFileError(msg)
-    err.__cause__ = ChildTraceback(tb)
-    raise err
+    raise _unexpected(what, name, first, tb, _chatter_summary(text))

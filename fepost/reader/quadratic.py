@@ -173,16 +173,23 @@ def gauss_rule(kind: str, n: int = GAUSS_POINTS) -> tuple[np.ndarray, np.ndarray
     return U.ravel(), (V * (1.0 - U)).ravel(), W.ravel()
 
 
+def _in_plane(ftype: str, xy: np.ndarray, conn: np.ndarray):
+    """Shape functions N (q, k) and weights w (q,) at the Gauss points of ``ftype``, the faces'
+    in-plane node coordinates X, Y (m, k) and their Jacobian det ∂(x, y)/∂(ξ, η) (m, q)."""
+    xi, eta, w = gauss_rule("tri" if ftype.startswith("tri") else "quad")
+    N, dxi, deta = shape(ftype, xi, eta)
+    X, Y = xy[:, 0][conn], xy[:, 1][conn]  # (m, k)
+    det = (X @ dxi.T) * (Y @ deta.T) - (X @ deta.T) * (Y @ dxi.T)  # (m, q)
+    return N, w, X, Y, det
+
+
 def face_loads(ftype: str, xy: np.ndarray, conn: np.ndarray, values: np.ndarray, location: str) -> np.ndarray:
     """Exact load of each face projected on the plane of the in-plane coordinates ``xy`` (N).
 
     ``xy`` (n, 2) node coordinates in the patch plane (m); ``conn`` (m, k);
     ``values`` per node (``location="point"``) or per face (Pa).
     """
-    xi, eta, w = gauss_rule("tri" if ftype.startswith("tri") else "quad")
-    N, dxi, deta = shape(ftype, xi, eta)
-    X, Y = xy[:, 0][conn], xy[:, 1][conn]  # (m, k)
-    det = (X @ dxi.T) * (Y @ deta.T) - (X @ deta.T) * (Y @ dxi.T)  # (m, q)
+    N, w, _, _, det = _in_plane(ftype, xy, conn)
     jac = np.abs(det) * w
     if location == "point":
         return np.einsum("mq,mq->m", np.asarray(values, float)[conn] @ N.T, jac)
@@ -191,10 +198,7 @@ def face_loads(ftype: str, xy: np.ndarray, conn: np.ndarray, values: np.ndarray,
 
 def folded(ftype: str, xy: np.ndarray, conn: np.ndarray) -> np.ndarray:
     """True for faces whose map onto the plane of ``xy`` folds over (its Jacobian changes sign)."""
-    xi, eta, _ = gauss_rule("tri" if ftype.startswith("tri") else "quad")
-    _, dxi, deta = shape(ftype, xi, eta)
-    X, Y = xy[:, 0][conn], xy[:, 1][conn]
-    det = (X @ dxi.T) * (Y @ deta.T) - (X @ deta.T) * (Y @ dxi.T)
+    det = _in_plane(ftype, xy, conn)[4]
     scale = np.max(np.abs(det), axis=1)
     return (det.min(axis=1) < -1e-9 * scale) & (det.max(axis=1) > 1e-9 * scale)
 
@@ -203,10 +207,7 @@ def face_moments(
     ftype: str, xy: np.ndarray, conn: np.ndarray, values: np.ndarray, location: str
 ) -> np.ndarray:
     """Exact (load, ∬σx, ∬σy) of each face in the plane of ``xy``: an (m, 3) array."""
-    xi, eta, w = gauss_rule("tri" if ftype.startswith("tri") else "quad")
-    N, dxi, deta = shape(ftype, xi, eta)
-    X, Y = xy[:, 0][conn], xy[:, 1][conn]
-    det = (X @ dxi.T) * (Y @ deta.T) - (X @ deta.T) * (Y @ dxi.T)
+    N, w, X, Y, det = _in_plane(ftype, xy, conn)
     jac = np.abs(det) * w
     sig = np.asarray(values, float)[conn] @ N.T if location == "point" else np.asarray(values, float)[:, None]
     f = sig * jac

@@ -105,11 +105,3 @@ class RawMesh:
     @property
     def time(self) -> float | None:
         return None if self.step is None or not self.steps else float(self.steps[self.step])
-
-    def cell_arrays(self) -> list[str]:
-        names: list[str] = []
-        for b in self.blocks:
-            for n in b.cell_data:
-                if n not in names:
-                    names.append(n)
-        return names
