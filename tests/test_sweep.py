@@ -201,7 +201,7 @@ def test_bad_inputs_are_error_rows_and_exit_1(cluster, load_sweep, tmp_path, cap
         f"{bad / 'garbage.e'}: cannot",
         f"{bad / 'missing.vtu'}: no such file",
         f"{bad / 'nothing*.vtu'}: no FE export matches this pattern",
-        f"{side.with_suffix('.json')}: 'load' must be a finite number",
+        f"{side.with_suffix('.json')}: sidecar key 'load' must be a finite number, got 'heavy'",
     ]
     for r, start in zip(failed, expect, strict=True):
         assert r["error"].startswith(start), r["error"]

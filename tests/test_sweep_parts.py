@@ -90,47 +90,90 @@ def test_rolling_pairs_csv(tmp_path):
         parse_rolling_pairs(str(tmp_path / "absent.csv"))
 
 
-def test_sidecar_metadata(tmp_path):
-    f = touch(tmp_path / "case.e")
-    assert case_metadata(f, None, None) == {
-        "case": None,
-        "load": None,
-        "deflection": None,
-        "inflation_pressure": None,
-    }
-    side = f.with_suffix(".json")
-    side.write_text(
-        json.dumps(
-            {
-                "case": 7,
-                "reaction_z": 1.5e5,
-                "deflection": 0.04,
-                "inflation_pressure": [1.0e6, 1.1e6, 1.2e6],
-                "other": "ignored",
-            }
-        )
-    )
-    assert case_metadata(f, 2, 3) == {
+def test_sidecar_metadata():
+    assert case_metadata(None) == {"case": None, "load": None, "deflection": None, "inflation_pressure": None}
+    side = {"case": 7, "reaction_z": 1.5e5, "deflection": 0.04, "inflation_pressure": 1.2e6, "other": "x"}
+    assert case_metadata(side) == {
         "case": "7",
         "load": 1.5e5,
         "deflection": 0.04,
         "inflation_pressure": 1.2e6,
     }
-    side.write_text(json.dumps({"load": 2.0e5, "reaction_z": 1.9e5}))
-    assert case_metadata(f, None, None)["load"] == 2.0e5  # a prescribed load wins over the reaction
+    assert case_metadata({"load": 2.0e5, "reaction_z": 1.9e5})["load"] == 2.0e5  # a prescribed load wins
+
+
+def _ramp(tmp_path, sidecar):
+    """A 3-step Exodus map beside ``sidecar`` (text)."""
+    import numpy as np
+
+    from fepost.synthetic import disc_mesh, write_exodus
+
+    p, c = disc_mesh(8)
+    pts = np.column_stack([p, np.zeros(len(p))])
+    r2 = (p**2).sum(axis=1)
+    e = write_exodus(
+        tmp_path / "ramp.e",
+        pts,
+        c,
+        [{"CPRESS": k * 1e5 * np.clip(1.0 - r2, 0.0, None)} for k in (1, 2, 3)],
+        times=[0.0, 0.5, 1.0],
+    )
+    e.with_suffix(".json").write_text(sidecar)
+    return e
+
+
+def test_per_step_sidecar_lists_are_resolved_by_the_reader_at_the_step_read(tmp_path):
+    """Every number key may list one value per time step: the reader gives the step's value
+    (also the report's inflation pressure and the solver reaction N is compared with)."""
+    from fepost.reader import read_contact
+
+    e = _ramp(
+        tmp_path,
+        json.dumps(
+            {
+                "case": "ramp",
+                "load": [1.0e4, 2.0e4, 3.0e4],
+                "reaction_z": [0.9e4, 1.9e4, 2.9e4],
+                "inflation_pressure": [1.0e6, 1.1e6, 1.2e6],
+                "deflection": 0.04,
+            }
+        ),
+    )
+    for step in (0, 1, 2):
+        field = read_contact(e, step=step)
+        assert field.reaction_z == [0.9e4, 1.9e4, 2.9e4][step]
+        assert case_metadata(field.sidecar) == {
+            "case": "ramp",
+            "load": [1.0e4, 2.0e4, 3.0e4][step],
+            "deflection": 0.04,
+            "inflation_pressure": [1.0e6, 1.1e6, 1.2e6][step],
+        }
+    assert read_contact(e).sidecar["load"] == 3.0e4  # no step given: the last one
     for text, message in (
-        ('{"load": [1, 2]}', "'load' lists 2 values but .* has 3 time steps"),
-        ('{"load": [1, 2]}', "'load' lists 2 values but .* has no time steps"),
-        ('{"deflection": "large"}', "'deflection' must be a finite number, got 'large'"),
-        ('{"load": true}', "'load' must be a finite number"),
-        ('{"load": 1e999}', "'load' must be a finite number"),
-        ("[1, 2]", "the sidecar must be a JSON object"),
-        ("{oops", "unreadable sidecar JSON"),
+        ('{"load": [1, 2]}', r"ramp\.json: 'load' lists 2 values but .*ramp\.e has 3 time steps"),
+        (
+            '{"deflection": "large"}',
+            r"ramp\.json: sidecar key 'deflection' must be a finite number, got 'large'",
+        ),
+        ('{"load": true}', r"sidecar key 'load' must be a finite number"),
+        ('{"load": [1, true, 3]}', r"sidecar key 'load' must be a finite number or a non-empty list"),
+        ('{"load": []}', r"sidecar key 'load' must be a finite number or a non-empty list"),
+        ('{"load": 1e999}', r"unreadable sidecar JSON|must be a finite number"),
+        ("[1, 2]", r"sidecar JSON must be an object"),
+        ("{oops", r"unreadable sidecar JSON"),
     ):
-        side.write_text(text)
-        steps = 3 if "3 time steps" in message else None
+        e.with_suffix(".json").write_text(text)
         with pytest.raises(InputFileError, match=message):
-            case_metadata(f, 0 if steps else None, steps)
+            read_contact(e, step=0)
+
+
+def test_per_step_sidecar_list_beside_a_file_without_steps(analytic_mesh):
+    from fepost.reader import read_contact
+
+    f = analytic_mesh("one.vtu")
+    f.with_suffix(".json").write_text('{"load": [1, 2]}')
+    with pytest.raises(InputFileError, match=r"'load' lists 2 values but .*one\.vtu has no time steps"):
+        read_contact(f)
 
 
 def test_time_steps_adapter(tmp_path):

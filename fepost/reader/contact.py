@@ -22,7 +22,7 @@ from .cells import SPECS
 from .exodus import read_exodus
 from .names import ArrayInfo, FieldChoice, norm, pick_displacement, pick_field
 from .raw import RawMesh
-from .sidecar import read_sidecar
+from .sidecar import at_step, read_sidecar
 from .surface import select_surface
 from .units import UnitSystem
 from .vtkfile import read_vtk
@@ -167,6 +167,7 @@ def _scaled_sidecar(side: dict | None, units: UnitSystem | None) -> dict | None:
     scale = {
         "reaction_z": units.force,
         "cpress_integral": units.force,
+        "load": units.force,
         "inflation_pressure": units.pressure,
         "deflection": units.length,
     }
@@ -266,7 +267,7 @@ def _contact(
         vals = surf.values or {}
         order = ["tri3", *OTHER_FACE_TYPES]
         values = np.concatenate([vals[t] for t in order if t in surf.conn]) if vals else np.empty(0)
-    side = _scaled_sidecar(read_sidecar(path), units)
+    side = _scaled_sidecar(at_step(read_sidecar(path), path, raw.step, len(raw.steps)), units)
     reaction = None if side is None else side.get("reaction_z")
     time = raw.time
     if time is not None and units is not None:

@@ -4,7 +4,10 @@ A sidecar is a JSON object whose keys describe the run (``reaction_z``: the
 solver's total normal reaction, in the model's force unit; ``inflation_pressure``;
 ``deflection``; …). It is checked before use: an object at the top, at most
 :data:`MAX_BYTES`, no ``NaN``/``Infinity`` literals, and every key fepost reads
-(:data:`NUMBER_KEYS`) either absent, null or a finite number (not a boolean).
+(:data:`NUMBER_KEYS`) either absent, null, a finite number (not a boolean) or,
+for a file with time steps, a list of finite numbers, one per step:
+:func:`at_step` then takes the value of the step read, so what the rest of
+fepost sees is always one number per key.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from ..errors import InputFileError
 #: Largest sidecar accepted, bytes.
 MAX_BYTES = 1 << 20
 #: Keys fepost reads as numbers.
-NUMBER_KEYS = ("reaction_z", "inflation_pressure", "deflection", "friction", "cpress_integral")
+NUMBER_KEYS = ("reaction_z", "inflation_pressure", "deflection", "friction", "cpress_integral", "load")
 
 
 def _no_constants(name: str):
@@ -54,6 +57,40 @@ def read_sidecar(path: Path) -> dict | None:
         v = data.get(key)
         if v is None:
             continue
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+        if isinstance(v, list):
+            if not v or not all(_finite(x) for x in v):
+                raise InputFileError(
+                    f"{side}: sidecar key {key!r} must be a finite number or a non-empty list of them "
+                    f"(one per time step), got {v!r}"
+                )
+        elif not _finite(v):
             raise InputFileError(f"{side}: sidecar key {key!r} must be a finite number, got {v!r}")
     return data
+
+
+def _finite(v) -> bool:
+    return not isinstance(v, bool) and isinstance(v, int | float) and math.isfinite(v)
+
+
+def at_step(data: dict | None, path: Path, step: int | None, n_steps: int) -> dict | None:
+    """``data`` (a validated sidecar of ``path``) with each per-step list replaced by the
+    value of time step ``step`` of ``n_steps`` (``step`` None: a file without steps).
+
+    Raises
+    ------
+    InputFileError
+        A list whose length is not the file's number of time steps.
+    """
+    if data is None or not any(isinstance(data.get(k), list) for k in NUMBER_KEYS):
+        return data
+    out = dict(data)
+    for key in NUMBER_KEYS:
+        v = data.get(key)
+        if isinstance(v, list):
+            if step is None or len(v) != n_steps:
+                raise InputFileError(
+                    f"{path.with_suffix('.json')}: {key!r} lists {len(v)} values but {path} has "
+                    f"{n_steps or 'no'} time steps"
+                )
+            out[key] = v[step]
+    return out

@@ -16,12 +16,10 @@ import os
 import time
 import warnings
 from dataclasses import dataclass
-from functools import partial
 
 from ..errors import ArgumentError, FepostError, FepostWarning
 from .metadata import case_metadata, sidecar_path
 from .options import RowOptions
-from .steps import time_steps
 from .table import coefficient_columns, one_line
 
 
@@ -48,8 +46,6 @@ class Job:
         Absolute paths the worker reads (None: nothing to read, see ``error``).
     step : int or None
         Time step to read; None: the file's last step (or a file without steps).
-    n_steps : int or None
-        Number of time steps of the file when listed (for per-step sidecar lists).
     time : float or None
         Time value of ``step`` when listed.
     options : RowOptions
@@ -65,7 +61,6 @@ class Job:
     options: RowOptions
     rolling: str | None = None
     rolling_given: str | None = None
-    n_steps: int | None = None
     time: float | None = None
     error: str | None = None
 
@@ -92,11 +87,6 @@ class Job:
         }
 
 
-def _count_steps(path: str, units) -> int | None:
-    listed = time_steps(path, units)
-    return len(listed) if listed else None
-
-
 def analysis_row(job: Job, res) -> dict:
     """The ok row of ``job`` from its analysis ``res`` (:class:`fepost.analysis.Analysis`):
     the job's identity columns, the coefficient columns and the sidecar metadata.
@@ -109,16 +99,13 @@ def analysis_row(job: Job, res) -> dict:
     ------
     ArgumentError
         The job names no file.
-    InputFileError
-        The sidecar cannot be read (:func:`fepost.sweep.metadata.case_metadata`).
     """
     path = job.path
     if path is None:
         raise ArgumentError(f"{job.source}: the job names no file")
     row = job.base_row()
     step = res.static_field.step
-    n_steps = job.n_steps if job.n_steps is not None else partial(_count_steps, path, job.options.units)
-    meta = case_metadata(path, step, n_steps)
+    meta = case_metadata(res.static_field.sidecar)
     columns = coefficient_columns(res.to_dict(model=False))  # the table has no model block
     row.update(step=step, time=res.static_field.time, **columns, **meta)
     row["status"], row["error"] = "ok", ""

@@ -1,8 +1,10 @@
 """Case metadata from a sidecar ``<case>.json`` beside an FE export.
 
-Solvers do not store the load case in the mesh file, so a sweep reads it from
-``<stem>.json`` next to the export (the file the reader also takes the
-solver's reaction from). Recognised keys, SI units:
+Solvers do not store the load case in the mesh file, so a sweep takes it from
+``<stem>.json`` next to the export: the sidecar the reader already reads,
+validates, converts with the model's units (``--units``) and resolves at the
+time step read (:mod:`fepost.reader.sidecar`; a per-step list gives the value
+of that step). Recognised keys, SI units:
 
 ====================== ========================================= ======
 column                 sidecar key(s)                             unit
@@ -13,19 +15,13 @@ column                 sidecar key(s)                             unit
 ``inflation_pressure`` ``inflation_pressure``                     Pa
 ====================== ========================================= ======
 
-A number applies to every time step of the file; a list of numbers gives one
-value per time step (its length must equal the number of steps). Other keys
-are ignored.
+Other keys are ignored.
 """
 
 from __future__ import annotations
 
-import json
-import math
-from collections.abc import Callable
+from collections.abc import Mapping
 from pathlib import Path
-
-from ..errors import InputFileError
 
 #: Numeric metadata columns and the sidecar keys they are read from, first found wins.
 NUMERIC_KEYS: dict[str, tuple[str, ...]] = {
@@ -38,67 +34,20 @@ COLUMNS = ("case", *NUMERIC_KEYS)
 
 
 def sidecar_path(path: str | Path) -> Path:
+    """The sidecar of the export ``path`` (whether it exists or not)."""
     return Path(path).with_suffix(".json")
 
 
-def read_sidecar(path: str | Path) -> dict | None:
-    """The parsed sidecar of the export ``path``, or None when there is none.
-
-    Raises
-    ------
-    InputFileError
-        The sidecar exists but is not a JSON object.
-    """
-    side = sidecar_path(path)
-    if not side.is_file():
-        return None
-    try:
-        data = json.loads(side.read_text())
-    except (OSError, ValueError) as exc:
-        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
-        raise InputFileError(f"{side}: unreadable sidecar JSON ({first})") from None
-    if not isinstance(data, dict):
-        raise InputFileError(f"{side}: the sidecar must be a JSON object, got {type(data).__name__}")
-    return data
-
-
-def _number(side: Path, key: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise InputFileError(f"{side}: {key!r} must be a finite number, got {value!r}")
-    return float(value)
-
-
-def case_metadata(path: str | Path, step: int | None, n_steps: int | None | Callable[[], int | None]) -> dict:
-    """The metadata columns of one row: file ``path`` at time ``step`` of ``n_steps``.
-
-    Missing keys (or no sidecar) give None. ``step`` and ``n_steps`` matter only
-    for per-step lists; ``n_steps`` may be a function, called only then.
-
-    Raises
-    ------
-    InputFileError
-        Unreadable sidecar, a non-numeric value, or a per-step list whose length
-        is not the number of time steps.
-    """
+def case_metadata(sidecar: Mapping | None) -> dict:
+    """The metadata columns of one row from the sidecar the reader resolved for it
+    (:attr:`fepost.field.ContactField.sidecar`); missing keys (or no sidecar) give None."""
     row: dict = dict.fromkeys(COLUMNS)
-    data = read_sidecar(path)
-    if data is None:
+    if not sidecar:
         return row
-    side = sidecar_path(path)
-    if data.get("case") is not None:
-        row["case"] = str(data["case"])
+    if sidecar.get("case") is not None:
+        row["case"] = str(sidecar["case"])
     for column, keys in NUMERIC_KEYS.items():
-        key = next((k for k in keys if data.get(k) is not None), None)
-        if key is None:
-            continue
-        value = data[key]
-        if isinstance(value, list):
-            if callable(n_steps):
-                n_steps = n_steps()
-            if n_steps is None or len(value) != n_steps or step is None:
-                raise InputFileError(
-                    f"{side}: {key!r} lists {len(value)} values but {path} has {n_steps or 'no'} time steps"
-                )
-            value = value[step]
-        row[column] = _number(side, key, value)
+        value = next((sidecar[k] for k in keys if sidecar.get(k) is not None), None)
+        if value is not None:
+            row[column] = float(value)
     return row

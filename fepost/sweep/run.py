@@ -157,8 +157,7 @@ def _jobs(pairings: Sequence[Pairing], steps, listed: dict, options: RowOptions)
             elif not times:
                 jobs.append(base)
             else:
-                n = len(times)
-                jobs += [replace(base, step=k, n_steps=n, time=t) for k, t in enumerate(times)]
+                jobs += [replace(base, step=k, time=t) for k, t in enumerate(times)]
     return jobs
 
 
