@@ -40,10 +40,6 @@ import sys
 
 def settle() -> None:
     """In a freshly forked child: drop foreign import locks and half-imported modules."""
-    _forget_import_locks()
-
-
-def _forget_import_locks() -> None:
     # the loaded bootstrap module itself: an import statement here could block already
     bootstrap = sys.modules.get("_frozen_importlib") or sys.modules.get("importlib._bootstrap")
     if bootstrap is None:  # another Python: nothing to reset
