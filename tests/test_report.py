@@ -383,8 +383,11 @@ def test_report_unwritable_folder(small_map, capsys):
     assert err.count("\n") == 1
 
 
-def test_build_report_force_never_deletes_its_inputs(tmp_path):
-    """The Python API guards its inputs as the command line does: refused before any work."""
+def test_build_report_force_never_deletes_its_inputs(tmp_path, monkeypatch):
+    """The Python API guards its inputs and the sample meshes as the command line does: refused
+    before any work. The sample folder is a scratch one here (a failing guard must not cost the
+    repository its meshes), looked up when the report is built, as in use."""
+    import fepost.report.samples as samples
     from fepost.errors import OutputError
     from fepost.report import build_report
 
@@ -393,9 +396,14 @@ def test_build_report_force_never_deletes_its_inputs(tmp_path):
     before = static.read_bytes()
     with pytest.raises(OutputError, match=r"refusing to replace this folder: it contains the input"):
         build_report(static, out=static.parent, force=True)
+    scratch = tmp_path / "meshes"
+    scratch.mkdir()
+    (scratch / "kept.vtu").write_bytes(before)
+    monkeypatch.setattr(samples, "meshes_folder", lambda: scratch)
     with pytest.raises(OutputError, match=r"refusing to replace this folder: it is the input"):
-        build_report(static, out=meshes_folder(), force=True)
+        build_report(static, out=scratch, force=True)
     assert static.read_bytes() == before and sorted(p.name for p in static.parent.iterdir()) == ["small.vtu"]
+    assert sorted(p.name for p in scratch.iterdir()) == ["kept.vtu"]
 
 
 def test_report_parent_is_a_file(tmp_path, small_map, capsys):

@@ -16,9 +16,9 @@ from .. import __version__
 from ..analysis import analyse
 from ..output import staged_folder, to_json
 from ..table1 import DEFAULT_SEED, table1
+from . import samples
 from .assemble import _check_inflation_option, friction_curves, page_context, resolve_inflation_pressure
 from .figures import Figure, save_matplotlib, save_plotter
-from .samples import meshes_folder, sample_inputs
 from .sections import DEFAULT_SECTIONS, ReportData, SectionProvider, run_providers
 
 Progress = Callable[[int, int, str, float], None]
@@ -146,14 +146,16 @@ def build_report(
     from .vtkfiles import write_vtk_files
 
     if static is None:
-        static, rolling = sample_inputs()
+        static, rolling = samples.sample_inputs()
     out = Path(out)
     if inflation_pressure is not None:
         _check_inflation_option(inflation_pressure)
     has_roll = rolling is not None
     steps = _Steps(total=12 + (1 if has_roll else 0), progress=progress)
     inputs = [Path(p) for p in (static, rolling) if isinstance(p, str | os.PathLike)]
-    with staged_folder(out, force=force, protect=[*inputs, meshes_folder()]) as tmp:
+    with staged_folder(
+        out, force=force, protect=[*inputs, samples.meshes_folder()]
+    ) as tmp:  # looked up now, not at import
         a = steps.run(
             "read and analyse the FE maps",
             analyse,
