@@ -234,6 +234,16 @@ def test_the_timeout_scales_with_the_file_and_the_environment(monkeypatch):
     assert isolate.timeout_for(0) == isolate.TIMEOUT_BASE
 
 
+def _describe(pid: int) -> str:
+    """State and command line of a process (for a failure message)."""
+    try:
+        state = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[0]
+        cmd = open(f"/proc/{pid}/cmdline", "rb").read().replace(b"\0", b" ").decode(errors="replace")
+    except OSError:
+        return "gone"
+    return f"state {state}: {cmd[:200]}"
+
+
 def _children() -> set[int]:
     """Process ids of this process's children (zombies included)."""
     import glob
@@ -254,19 +264,22 @@ def _children() -> set[int]:
 def test_started_reads_run_side_by_side_and_leave_no_child(analytic_mesh):
     from fepost.reader import start_reading
 
-    before = _children()
     a = start_reading(analytic_mesh("a.vtu", "uniform", peak=1e5, n_rings=8))
     b = start_reading(analytic_mesh("b.vtu", "uniform", peak=2e5, n_rings=8))
+    ours = {a.pid, b.pid}
+    assert None not in ours and ours <= _children()
     assert float(b.result().values.max()) == pytest.approx(2e5)
     assert float(a.result().values.max()) == pytest.approx(1e5)
     hung = isolate.start(_hang, what="h.vtu", timeout=30)
-    assert _children() - before  # the hung child runs
+    ours.add(hung.pid)
+    assert hung.pid in _children()  # the hung child runs
     hung.cancel()
     # killed and reaped; the finished readers are reaped in the background: no zombie left
+    # (only the readers' own children are followed: other tests may leave helpers of their own)
     deadline = time.monotonic() + 5.0
-    while _children() != before and time.monotonic() < deadline:
+    while ours & _children() and time.monotonic() < deadline:
         time.sleep(0.01)
-    assert _children() == before
+    assert not ours & _children(), {pid: _describe(pid) for pid in ours & _children()}
     with pytest.raises(FieldError, match=r"x\.vtu: no array named 'P'"):
         isolate.start(_field_error, what="x.vtu").result()
 

@@ -128,6 +128,11 @@ class Pending:
         self._value, self._error, self._child = value, error, child
 
     @property
+    def pid(self) -> int | None:
+        """Process id of the reading child while it computes the value (None in-process or after)."""
+        return None if self._child is None else self._child[0]
+
+    @property
     def running(self) -> bool:
         """True while a child computes the value (False once :meth:`result` has collected it)."""
         return self._child is not None
