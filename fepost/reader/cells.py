@@ -217,7 +217,7 @@ class Faces:
         return sum(len(c) for c in self.conn.values())
 
 
-def _pack_key(corners: np.ndarray) -> np.ndarray:
+def pack_key(corners: np.ndarray) -> np.ndarray:
     """One sortable row per face from its sorted corner nodes (padded with -1)."""
     s = np.sort(corners, axis=1)
     if s.shape[1] < 4:
@@ -253,7 +253,7 @@ def boundary_faces(blocks: list[tuple[str, np.ndarray]]) -> Faces:
     volume = any(SPECS[name].dim == 3 and len(conn) for name, conn in blocks)
     keep: list[np.ndarray]
     if volume:
-        keys = np.concatenate([_pack_key(c[2]) for c in chunks])
+        keys = np.concatenate([pack_key(c[2]) for c in chunks])
         void = keys.view(np.dtype((np.void, keys.dtype.itemsize * 4))).ravel()
         _, inverse, counts = np.unique(void, return_inverse=True, return_counts=True)
         once = counts[inverse.ravel()] == 1

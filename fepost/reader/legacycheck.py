@@ -6,7 +6,7 @@ import re
 from pathlib import Path
 
 from ..errors import InputFileError
-from .vtkcheck import MAX_COUNT, Counts, _bad
+from .checks import MAX_COUNT, Counts, bad_file
 
 _LEGACY_SIZES = {
     "bit": 0,
@@ -25,7 +25,11 @@ _LEGACY_SIZES = {
     "vtktypeuint64": 8,
     "vtktypeint32": 4,
     "vtktypeuint32": 4,
+    "signed_char": 1,
 }
+#: Array types whose values are not fixed-size numbers (strings, variants): a FIELD block holding
+#: one is left to VTK from there on (the child process still guards the read).
+_UNCOUNTED = ("string", "utf8_string", "variant", "unicode_string")
 _CELL_SECTIONS = (b"CELLS", b"POLYGONS", b"LINES", b"VERTICES", b"TRIANGLE_STRIPS")
 _NUMBER = re.compile(rb"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|inf|infinity)", re.I)
 
@@ -37,7 +41,7 @@ class Legacy:
         self.path, self.data = path, data
 
     def bad(self, what: str) -> InputFileError:
-        return _bad(self.path, what)
+        return bad_file(self.path, what)
 
     def check(self) -> Counts:
         lines = self.data.split(b"\n", 4)
@@ -187,9 +191,14 @@ class Legacy:
             blocks = self._sizes(words, counts)
             if key == b"FIELD":
                 for _ in range(counts.pop("field")):
+                    if i < n and tokens[i] == b"NULL_ARRAY":
+                        i += 1
+                        continue
                     if i + 4 > n:
                         raise self.bad("FIELD arrays end early")
-                    size, _ = self._field_array(tokens[i : i + 4])
+                    size, dtype = self._field_array(tokens[i : i + 4])
+                    if dtype in _UNCOUNTED:
+                        return Counts()  # strings are not numbers: left to VTK
                     i += 4
                     i = self._skip_numbers(tokens, i, size)
                 continue
@@ -215,8 +224,7 @@ class Legacy:
         counts: dict = {}
         n = len(data)
         while pos < n:
-            while pos < n and data[pos : pos + 1] in (b"\n", b"\r", b" ", b"\t"):
-                pos += 1
+            pos = self._gap(pos)
             if pos >= n:
                 break
             eol = data.find(b"\n", pos)
@@ -226,25 +234,40 @@ class Legacy:
                 raise self.bad(
                     "the header disagrees with the data: binary data where a section keyword belongs"
                 )
-            if words[0].upper() == b"METADATA":
-                end = data.find(b"\n\n", pos)
-                pos = n if end < 0 else end + 2
-                continue
             blocks = self._sizes(words, counts)
             if blocks is None:
                 return Counts()  # unknown keyword: left to VTK
             pos = (eol if eol >= 0 else n) + 1
             if words[0].upper() == b"FIELD":
                 for _ in range(counts.pop("field")):
+                    # each array's binary values end with a newline, and may be followed by METADATA
+                    pos = self._gap(pos)
                     eol = data.find(b"\n", pos)
                     if eol < 0:
                         raise self.bad("FIELD arrays end early")
-                    size, dtype = self._field_array(data[pos:eol].split())
+                    words = data[pos:eol].split()
+                    if words == [b"NULL_ARRAY"]:
+                        pos = eol + 1
+                        continue
+                    size, dtype = self._field_array(words)
+                    if dtype in _UNCOUNTED:
+                        return Counts()  # strings are not numbers: left to VTK
                     pos = self._skip_bytes(eol + 1, size, dtype)
                 continue
             for size, dtype in blocks:
                 pos = self._skip_bytes(pos, size, dtype)
         return Counts([counts.get("conn", 0)])
+
+    def _gap(self, pos: int) -> int:
+        """The position after the whitespace and METADATA blocks (text up to a blank line) at ``pos``."""
+        data, n = self.data, len(self.data)
+        while True:
+            while pos < n and data[pos : pos + 1] in (b"\n", b"\r", b" ", b"\t"):
+                pos += 1
+            if data[pos : pos + 8].upper() != b"METADATA":
+                return pos
+            end = data.find(b"\n\n", pos)
+            pos = n if end < 0 else end + 2
 
     def _skip_bytes(self, pos: int, size: int, dtype: str) -> int:
         width = _LEGACY_SIZES.get(dtype)

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import FieldError
-from .cells import FACE_TYPES, SPECS, Faces, _pack_key, boundary_faces, side_faces
+from .cells import FACE_TYPES, SPECS, Faces, boundary_faces, pack_key, side_faces
 from .raw import RawMesh
 
 #: Share of one part's loaded nodes that must lie near the other's for "both sides of one contact".
@@ -150,7 +150,7 @@ def select_surface(
 
 def _keys(conn: dict[str, np.ndarray]) -> np.ndarray:
     """One void-typed key per face from its sorted corners (comparable across face types)."""
-    parts = [_pack_key(c[:, : (3 if t.startswith("tri") else 4)]) for t, c in conn.items() if len(c)]
+    parts = [pack_key(c[:, : (3 if t.startswith("tri") else 4)]) for t, c in conn.items() if len(c)]
     if not parts:
         return np.empty(0, np.dtype((np.void, 32)))
     keys = np.concatenate(parts)

@@ -35,46 +35,25 @@ process the file is read in (:mod:`fepost.reader.isolate`).
 from __future__ import annotations
 
 import mmap
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputFileError
+from .checks import MAX_COUNT, MAX_DEPTH, MAX_VTM_DEPTH, Counts, bad_file
+from .legacycheck import Legacy
+from .xmlcheck import Xml
 
-#: Deepest XML nesting accepted (VTK files need about 6).
-MAX_DEPTH = 32
-#: Largest point, cell or value count accepted from a header.
-MAX_COUNT = (1 << 31) - 1
-#: Most nested .vtm files followed.
-MAX_VTM_DEPTH = 4
+__all__ = ["MAX_COUNT", "MAX_DEPTH", "MAX_VTM_DEPTH", "Counts", "check_file"]
 
 
-@dataclass
-class Counts:
-    """What a checked file declares, for the comparison after VTK has read it."""
-
-    connectivity: list[int] = field(default_factory=list)  # values of each piece's connectivity arrays
-
-
-def _bad(path: Path, what: str) -> InputFileError:
-    """The one-line error for ``path``: refusals as they are, everything else as corrupt or truncated."""
-    if what.startswith("refused: "):
-        return InputFileError(f"{path}: refused {path.suffix} file ({what[len('refused: ') :]})")
-    return InputFileError(f"{path}: corrupt or truncated {path.suffix} file ({what})")
-
-
-def check_file(path: Path, depth: int = 0) -> Counts:
-    """Check ``path`` (suffix-chosen); raise :class:`InputFileError` on any inconsistency."""
+def check_file(path: Path) -> Counts:
+    """Check ``path`` (suffix-chosen); raise `InputFileError` on any inconsistency."""
     suffix = path.suffix.lower()
     try:
         with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
             if suffix == ".vtk":
-                from .legacycheck import Legacy
-
                 return Legacy(path, data[:]).check()
-            from .xmlcheck import Xml
-
-            return Xml(path, data, depth).check()
+            return Xml(path, data, 0).check()
     except InputFileError:
         raise
     except (OSError, ValueError) as exc:
-        raise _bad(path, f"cannot read ({getattr(exc, 'strerror', None) or exc})") from None
+        raise bad_file(path, f"cannot read ({getattr(exc, 'strerror', None) or exc})") from None

@@ -1,4 +1,10 @@
-"""Checks of VTK XML files (``.vtu .vtp .vtm``) before VTK reads them (see :mod:`.vtkcheck`)."""
+"""Checks of VTK XML files before VTK reads them (see `vtkcheck`).
+
+Serial files (``.vtu .vtp``), structured grids (``.vts .vtr``: the counts follow from
+the piece's ``Extent``), multi-block files (``.vtm``) and parallel files (``.pvtu
+.pvtp``). The files a ``.vtm`` or a parallel file points at must lie in its folder (or
+below), exist, have the suffix of their kind and pass these same checks.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +16,8 @@ import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .vtkcheck import MAX_COUNT, MAX_DEPTH, MAX_VTM_DEPTH, Counts, _bad, check_file
+from ..errors import InputFileError
+from .checks import MAX_COUNT, MAX_DEPTH, MAX_VTM_DEPTH, Counts, bad_file, inside_folder
 
 _SIZES = {
     "Int8": 1,
@@ -24,7 +31,19 @@ _SIZES = {
     "Float32": 4,
     "Float64": 8,
 }
-_ROOT = {".vtu": "UnstructuredGrid", ".vtp": "PolyData", ".vtm": "vtkMultiBlockDataSet"}
+_ROOT = {
+    ".vtu": "UnstructuredGrid",
+    ".vtp": "PolyData",
+    ".vtm": "vtkMultiBlockDataSet",
+    ".vts": "StructuredGrid",
+    ".vtr": "RectilinearGrid",
+    ".pvtu": "PUnstructuredGrid",
+    ".pvtp": "PPolyData",
+}
+#: The suffix of the pieces of a parallel file.
+_PIECE_SUFFIX = {".pvtu": ".vtu", ".pvtp": ".vtp"}
+#: Most pieces a parallel file may list.
+MAX_PIECES = 4096
 _TAG = re.compile(
     rb"<!--.*?-->|<\?.*?\?>|<!\[CDATA\[.*?\]\]>|<(/?)([A-Za-z_][\w:.-]*)((?:[^>\"']|\"[^\"]*\"|'[^']*')*)>",
     re.S,
@@ -33,7 +52,7 @@ _TAG = re.compile(
 #: FieldData labels the arrays after it too (they are not checked against a piece's
 #: counts), but its end tag does not clear the label.
 _SECTIONS = frozenset(
-    {b"Points", b"Cells", b"Verts", b"Lines", b"Strips", b"Polys", b"PointData", b"CellData"}
+    {b"Points", b"Cells", b"Verts", b"Lines", b"Strips", b"Polys", b"PointData", b"CellData", b"Coordinates"}
 )
 _ATTR = re.compile(rb"([A-Za-z_][\w:.-]*)\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
 
@@ -41,14 +60,14 @@ _ATTR = re.compile(rb"([A-Za-z_][\w:.-]*)\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
 def _int(path: Path, attrs: dict[str, str], key: str, default: int | None = None) -> int:
     if key not in attrs:
         if default is None:
-            raise _bad(path, f"missing {key}")
+            raise bad_file(path, f"missing {key}")
         return default
     text = attrs[key].strip()
     if not re.fullmatch(r"[+-]?\d{1,20}", text):
-        raise _bad(path, f"{key}={attrs[key]!r} is not an integer")
+        raise bad_file(path, f"{key}={attrs[key]!r} is not an integer")
     value = int(text)
     if value < 0 or value > MAX_COUNT:
-        raise _bad(path, f"{key}={value} is out of range")
+        raise bad_file(path, f"{key}={value} is out of range")
     return value
 
 
@@ -78,23 +97,32 @@ class Xml:
         first = data.find(b"<VTKFile", 0, limit)
         prologue = data[: first if first >= 0 else min(limit, 1 << 16)]
         if re.search(rb"<!(DOCTYPE|ENTITY)", prologue, re.I):
-            raise _bad(
+            raise bad_file(
                 path, "refused: XML with DOCTYPE/ENTITY declarations (not a VTK file; entity expansion)"
             )
         root, pieces, refs = self._scan(limit)
         want = _ROOT.get(suffix)
         if root.get("type") != want:
-            raise _bad(path, f"not a VTK XML {want} file: VTKFile type={root.get('type')!r}")
+            raise bad_file(path, f"not a VTK XML {want} file: VTKFile type={root.get('type')!r}")
         self.header_size = 8 if root.get("header_type", "UInt32") == "UInt64" else 4
         if root.get("header_type", "UInt32") not in ("UInt32", "UInt64"):
-            raise _bad(path, f"header_type={root.get('header_type')!r}")
+            raise bad_file(path, f"header_type={root.get('header_type')!r}")
         self.endian = ">" if root.get("byte_order", "LittleEndian") == "BigEndian" else "<"
         self.compressed = bool(root.get("compressor"))
         self.appended = self._appended(cut)
         counts = Counts()
         if suffix == ".vtm":
-            self._check_refs(refs)
+            self._check_refs(refs, (".vtu", ".vtp", ".vtm"), "multi-block piece")
             return counts
+        if suffix in _PIECE_SUFFIX:
+            if not pieces:
+                raise bad_file(path, "a parallel file that lists no pieces")
+            if len(pieces) > MAX_PIECES:
+                raise bad_file(path, f"refused: {len(pieces)} pieces (at most {MAX_PIECES})")
+            sources = [p.attrs.get("Source", "") for p in pieces]
+            if not all(sources):
+                raise bad_file(path, "a Piece without its Source file")
+            return self._check_refs(sources, (_PIECE_SUFFIX[suffix],), "piece")
         for piece in pieces:
             counts.connectivity.append(self._piece(piece, suffix))
         return counts
@@ -108,7 +136,7 @@ class Xml:
                 return
             m = _TAG.match(data, pos, limit)
             if m is None:
-                raise _bad(self.path, "a '<' that opens no XML tag")
+                raise bad_file(self.path, "a '<' that opens no XML tag")
             yield m
             pos = m.end()
 
@@ -126,7 +154,7 @@ class Xml:
             selfclose = rest.rstrip().endswith(b"/")
             if closing:
                 if not stack or stack[-1] != name:
-                    raise _bad(self.path, f"unexpected XML tag </{name.decode('latin-1')}>")
+                    raise bad_file(self.path, f"unexpected XML tag </{name.decode('latin-1')}>")
                 stack.pop()
                 if name in _SECTIONS:
                     section = ""
@@ -137,7 +165,7 @@ class Xml:
             }
             if root is None:
                 if name != b"VTKFile":
-                    raise _bad(self.path, "no VTKFile element: not a VTK XML file")
+                    raise bad_file(self.path, "no VTKFile element: not a VTK XML file")
                 root = attrs
             if name == b"Piece":
                 pieces.append(_Piece(attrs))
@@ -152,11 +180,11 @@ class Xml:
             if not selfclose:
                 stack.append(name)
                 if len(stack) > MAX_DEPTH:
-                    raise _bad(self.path, f"refused: XML nested more than {MAX_DEPTH} levels deep")
+                    raise bad_file(self.path, f"refused: XML nested more than {MAX_DEPTH} levels deep")
         if root is None:
-            raise _bad(self.path, "no VTKFile element: not a VTK XML file")
+            raise bad_file(self.path, "no VTKFile element: not a VTK XML file")
         if stack and self.data.find(b"<AppendedData") < 0:
-            raise _bad(self.path, f"XML element <{stack[-1].decode('latin-1')}> is not closed")
+            raise bad_file(self.path, f"XML element <{stack[-1].decode('latin-1')}> is not closed")
         return root, pieces, refs
 
     def _appended(self, cut: int) -> tuple[int, bool] | None:
@@ -164,28 +192,30 @@ class Xml:
             return None
         close = self.data.find(b">", cut)
         if close < 0:
-            raise _bad(self.path, "AppendedData element is not closed")
+            raise bad_file(self.path, "AppendedData element is not closed")
         attrs = dict(
             (k.decode("latin-1"), (a or b).decode("latin-1"))
             for k, a, b in _ATTR.findall(self.data[cut:close])
         )
         mark = self.data.find(b"_", close)
         if mark < 0:
-            raise _bad(self.path, "AppendedData without its '_' marker")
+            raise bad_file(self.path, "AppendedData without its '_' marker")
         return mark + 1, attrs.get("encoding", "raw") == "base64"
 
-    def _check_refs(self, refs: list[str]) -> None:
+    def _check_refs(self, refs: list[str], suffixes: tuple[str, ...], what: str) -> Counts:
         if self.depth >= MAX_VTM_DEPTH:
-            raise _bad(self.path, f"refused: multi-block files nested more than {MAX_VTM_DEPTH} deep")
+            raise bad_file(self.path, f"refused: multi-block files nested more than {MAX_VTM_DEPTH} deep")
+        counts = Counts()
         for ref in refs:
-            sub = (self.path.parent / ref).resolve()
-            if sub.suffix.lower() not in (".vtu", ".vtp", ".vtm"):
-                raise _bad(self.path, f"multi-block piece {ref!r} is not a VTK XML file")
-            if not sub.is_file():
-                raise _bad(self.path, f"multi-block piece {ref!r} not found")
+            sub = inside_folder(self.path, ref, what)
+            if sub.suffix.lower() not in suffixes:
+                raise bad_file(self.path, f"{what} {ref!r} is not a {' or '.join(suffixes)} file")
             if sub == self.path.resolve():
-                raise _bad(self.path, "multi-block file refers to itself")
-            check_file(sub, self.depth + 1)
+                raise bad_file(self.path, f"{what} {ref!r} is the file itself")
+            if not sub.is_file():
+                raise bad_file(self.path, f"{what} {ref!r} not found")
+            counts.connectivity += check_xml(sub, self.depth + 1).connectivity
+        return counts
 
     # -- array lengths --
 
@@ -199,7 +229,7 @@ class Xml:
             return None
         size = _SIZES.get(dtype)
         if size is None:
-            raise _bad(self.path, f"unknown data type {dtype!r} of array {a.get('Name', '?')!r}")
+            raise bad_file(self.path, f"unknown data type {dtype!r} of array {a.get('Name', '?')!r}")
         fmt = a.get("format", "ascii")
         name = a.get("Name", "?")
         if fmt == "ascii":
@@ -208,7 +238,7 @@ class Xml:
             nbytes, have = self._binary_size(arr.start, arr.end, name)
         elif fmt == "appended":
             if self.appended is None:
-                raise _bad(self.path, f"array {name!r} is appended but the file has no AppendedData")
+                raise bad_file(self.path, f"array {name!r} is appended but the file has no AppendedData")
             off = _int(self.path, a, "offset")
             base, b64 = self.appended
             if b64:
@@ -217,9 +247,11 @@ class Xml:
             else:
                 nbytes, have = self._raw_size(base + off, name)
         else:
-            raise _bad(self.path, f"format={fmt!r} of array {name!r}")
+            raise bad_file(self.path, f"format={fmt!r} of array {name!r}")
         if nbytes % size:
-            raise _bad(self.path, f"array {name!r}: {nbytes} bytes is not a whole number of {dtype} values")
+            raise bad_file(
+                self.path, f"array {name!r}: {nbytes} bytes is not a whole number of {dtype} values"
+            )
         return nbytes // size
 
     def _words(self, raw: bytes, n: int) -> tuple[int, ...]:
@@ -239,7 +271,7 @@ class Xml:
         try:
             return base64.b64decode(head + b"=" * (-len(head) % 4))
         except (binascii.Error, ValueError):
-            raise _bad(self.path, f"array {name!r}: invalid base64 data") from None
+            raise bad_file(self.path, f"array {name!r}: invalid base64 data") from None
 
     def _binary_size(self, start: int, end: int, name: str) -> tuple[int, int]:
         """(uncompressed bytes, bytes present at most) of a base64 array in data[start:end]."""
@@ -248,28 +280,28 @@ class Xml:
         if self.compressed:
             head = self._decoded(start, end, 3 * h, name)
             if len(head) < 3 * h:
-                raise _bad(self.path, f"array {name!r}: truncated block header")
+                raise bad_file(self.path, f"array {name!r}: truncated block header")
             nblocks, block, last = self._words(head, 3)
             if nblocks > MAX_COUNT // max(block, 1):
-                raise _bad(self.path, f"array {name!r}: block header out of range")
+                raise bad_file(self.path, f"array {name!r}: block header out of range")
             head = self._decoded(start, end, (3 + nblocks) * h, name)
             if len(head) < (3 + nblocks) * h:
-                raise _bad(self.path, f"array {name!r}: truncated block header")
+                raise bad_file(self.path, f"array {name!r}: truncated block header")
             csizes = self._words(head, 3 + nblocks)[3:]
             total = 0 if nblocks == 0 else (nblocks - 1) * block + (last or block)
             present = text_len * 3 // 4 - (3 + nblocks) * h
             if sum(csizes) > present + 3:
-                raise _bad(
+                raise bad_file(
                     self.path, f"array {name!r}: compressed data shorter than its header says (truncated?)"
                 )
             return total, present
         head = self._decoded(start, end, h, name)
         if len(head) < h:
-            raise _bad(self.path, f"array {name!r}: truncated length header")
+            raise bad_file(self.path, f"array {name!r}: truncated length header")
         (nbytes,) = self._words(head, 1)
         present = text_len * 3 // 4 - h
         if nbytes > present + 3:
-            raise _bad(
+            raise bad_file(
                 self.path, f"array {name!r}: {nbytes} bytes announced, {max(present, 0)} present (truncated?)"
             )
         return nbytes, present
@@ -280,39 +312,59 @@ class Xml:
         if self.compressed:
             head = data[pos : pos + 3 * h]
             if len(head) < 3 * h:
-                raise _bad(self.path, f"array {name!r}: truncated block header")
+                raise bad_file(self.path, f"array {name!r}: truncated block header")
             nblocks, block, last = self._words(head, 3)
             if nblocks > MAX_COUNT // max(block, 1) or pos + (3 + nblocks) * h > len(data):
-                raise _bad(self.path, f"array {name!r}: block header out of range (truncated?)")
+                raise bad_file(self.path, f"array {name!r}: block header out of range (truncated?)")
             csizes = self._words(data[pos : pos + (3 + nblocks) * h], 3 + nblocks)[3:]
             present = len(data) - pos - (3 + nblocks) * h
             if sum(csizes) > present:
-                raise _bad(
+                raise bad_file(
                     self.path, f"array {name!r}: compressed data shorter than its header says (truncated?)"
                 )
             total = 0 if nblocks == 0 else (nblocks - 1) * block + (last or block)
             return total, present
         head = data[pos : pos + h]
         if len(head) < h:
-            raise _bad(self.path, f"array {name!r}: truncated length header")
+            raise bad_file(self.path, f"array {name!r}: truncated length header")
         (nbytes,) = self._words(head, 1)
         present = len(data) - pos - h
         if nbytes > present:
-            raise _bad(self.path, f"array {name!r}: {nbytes} bytes announced, {present} present (truncated?)")
+            raise bad_file(
+                self.path, f"array {name!r}: {nbytes} bytes announced, {present} present (truncated?)"
+            )
         return nbytes, present
+
+    def _extent(self, attrs: dict[str, str]) -> tuple[int, int, int]:
+        """Points along each axis of a structured piece, from its ``Extent``."""
+        words = attrs.get("Extent", "").split()
+        if len(words) != 6 or not all(re.fullmatch(r"[+-]?\d{1,10}", w) for w in words):
+            raise bad_file(self.path, f"Extent={attrs.get('Extent')!r} is not six integers")
+        lo, hi = [int(w) for w in words[0::2]], [int(w) for w in words[1::2]]
+        dims = tuple(b - a + 1 for a, b in zip(lo, hi, strict=True))
+        if min(dims) < 1 or dims[0] * dims[1] * dims[2] > MAX_COUNT:
+            raise bad_file(self.path, f"Extent={attrs['Extent']!r} is out of range")
+        return dims  # type: ignore[return-value]
 
     def _piece(self, piece: _Piece, suffix: str) -> int:
         path = self.path
-        npts = _int(path, piece.attrs, "NumberOfPoints", 0)
-        if suffix == ".vtu":
+        dims: tuple[int, int, int] | None = None
+        if suffix in (".vts", ".vtr"):
+            dims = self._extent(piece.attrs)
+            npts = dims[0] * dims[1] * dims[2]
+            sections = {"Cells": max(dims[0] - 1, 1) * max(dims[1] - 1, 1) * max(dims[2] - 1, 1)}
+        elif suffix == ".vtu":
+            npts = _int(path, piece.attrs, "NumberOfPoints", 0)
             sections = {"Cells": _int(path, piece.attrs, "NumberOfCells", 0)}
         else:
+            npts = _int(path, piece.attrs, "NumberOfPoints", 0)
             sections = {
                 s: _int(path, piece.attrs, f"NumberOf{s}", 0) for s in ("Verts", "Lines", "Strips", "Polys")
             }
         ncells = sum(sections.values())
         conn_total = 0
-        seen_points = False
+        seen_points = dims is not None and suffix == ".vtr"  # a rectilinear grid has Coordinates
+        axis = 0
         for arr in piece.arrays:
             n = self._values(arr)
             if n is None:
@@ -320,13 +372,19 @@ class Xml:
             name = arr.attrs.get("Name", "?")
             ncomp = _int(path, arr.attrs, "NumberOfComponents", 1)
             if ncomp == 0:
-                raise _bad(path, f"array {name!r} declares 0 components")
+                raise bad_file(path, f"array {name!r} declares 0 components")
             if "NumberOfTuples" in arr.attrs and arr.section != "FieldData":
                 if _int(path, arr.attrs, "NumberOfTuples") * ncomp != n:
-                    raise _bad(path, f"array {name!r}: NumberOfTuples disagrees with its data")
+                    raise bad_file(path, f"array {name!r}: NumberOfTuples disagrees with its data")
             if arr.section == "Points":
                 seen_points = True
                 self._expect(n, 3 * npts, f"{npts} points", "the Points array", ncomp=3)
+            elif arr.section == "Coordinates" and dims is not None:
+                if axis > 2:
+                    raise bad_file(path, "a rectilinear piece with more than 3 Coordinates arrays")
+                want = dims[axis]
+                self._expect(n, want, f"{want} points along axis {axis}", f"coordinate array {name!r}")
+                axis += 1
             elif arr.section in sections:
                 count = sections[arr.section]
                 if name in ("offsets", "types"):
@@ -345,13 +403,26 @@ class Xml:
             elif arr.section == "CellData":
                 self._expect(n, ncells * ncomp, f"{ncells} cells", f"cell array {name!r}", ncomp=ncomp)
         if npts and not seen_points:
-            raise _bad(path, f"a piece of {npts} points has no Points array")
+            raise bad_file(path, f"a piece of {npts} points has no Points array")
+        if dims is not None and suffix == ".vtr" and axis != 3:
+            raise bad_file(path, f"a rectilinear piece with {axis} Coordinates arrays instead of 3")
         return conn_total
 
     def _expect(self, have: int, want: int, declared: str, what: str, ncomp: int = 1) -> None:
         if have != want:
             held = f"{have} values" if ncomp == 1 else f"{have} values ({have / ncomp:g} tuples of {ncomp})"
-            raise _bad(
+            raise bad_file(
                 self.path,
                 f"the header disagrees with the data: the piece declares {declared} but {what} holds {held}",
             )
+
+
+def check_xml(path: Path, depth: int = 0) -> Counts:
+    """Check the VTK XML file ``path`` (its suffix says which kind); raise `InputFileError` if it fails."""
+    try:
+        with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+            return Xml(path, data, depth).check()
+    except InputFileError:
+        raise
+    except (OSError, ValueError) as exc:
+        raise bad_file(path, f"cannot read ({getattr(exc, 'strerror', None) or exc})") from None

@@ -1,0 +1,55 @@
+"""What the pre-read checks of every format share: the limits, the declared counts, the error.
+
+`vtkcheck` (dispatch by suffix), `xmlcheck` (VTK XML files, serial, parallel and
+structured), `legacycheck` (legacy ``.vtk``) and `xdmfcheck` (XDMF) all import
+from here and never from each other's private names.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputFileError
+
+#: Deepest XML nesting accepted (VTK files need about 6, XDMF about 8).
+MAX_DEPTH = 32
+#: Largest point, cell or value count accepted from a header.
+MAX_COUNT = (1 << 31) - 1
+#: Most nested .vtm files followed.
+MAX_VTM_DEPTH = 4
+
+
+@dataclass
+class Counts:
+    """What a checked file declares, for the comparison after the library has read it."""
+
+    connectivity: list[int] = field(default_factory=list)  # values of each piece's connectivity arrays
+
+
+def bad_file(path: Path, what: str) -> InputFileError:
+    """The one-line error for ``path``: refusals as they are, everything else as corrupt or truncated.
+
+    ``what`` starting with ``"refused: "`` gives "refused .SUFFIX file (...)"; any other
+    text gives "corrupt or truncated .SUFFIX file (...)".
+    """
+    if what.startswith("refused: "):
+        return InputFileError(f"{path}: refused {path.suffix} file ({what[len('refused: ') :]})")
+    return InputFileError(f"{path}: corrupt or truncated {path.suffix} file ({what})")
+
+
+def inside_folder(path: Path, ref: str, what: str) -> Path:
+    """The file ``ref`` names relative to ``path``'s folder; refused when it lies outside that folder.
+
+    A parallel or multi-block file, or an XDMF file's heavy data, may only point at files
+    in its own folder or below it: an absolute path, ``..`` or a symbolic link that leaves
+    the folder is refused (a file handed to fepost must not make it read elsewhere).
+    """
+    folder = path.parent.resolve()
+    try:
+        target = (path.parent / ref).resolve()
+    except (OSError, RuntimeError, ValueError):
+        raise bad_file(path, f"refused: {what} {ref!r} cannot be resolved") from None
+    if not target.is_relative_to(folder):
+        raise bad_file(path, f"refused: {what} {ref!r} lies outside the file's folder")
+    return target
