@@ -426,7 +426,8 @@ def test_multiblock_references(bases, tmp_path, capsys):
     for body, pattern in (
         ('<DataSet index="0" file="missing.vtu"/>', "multi-block piece 'missing.vtu' not found"),
         ('<DataSet index="0" file="multi.vtm"/>', "refers to itself"),
-        ('<DataSet index="0" file="/etc/passwd"/>', "is not a VTK XML file"),
+        ('<DataSet index="0" file="/etc/passwd"/>', r"refused \.vtm file \(multi-block piece '/etc/passwd' lies outside the file's folder\)"),
+        ('<DataSet index="0" file="notes.txt"/>', "multi-block piece 'notes.txt' is not a VTK XML file"),
     ):
         path = _vtm(tmp_path, body)
         code, lines, _ = _run(path, capsys)

@@ -38,7 +38,7 @@ from .units import SYSTEMS, UnitSystem, unit_system
 if TYPE_CHECKING:
     from ..field import ContactField
 
-VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm")
+VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm", ".vts", ".vtr", ".pvtu", ".pvtp")
 EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
 #: Values that mean "no contact data" rather than a pressure (MOOSE writes −99999).
 SENTINELS = (-99999.0, -999999.0, -9999.0, -1.0e30, -1.0e20)

@@ -200,7 +200,7 @@ def _contact(
         raise InputFileError(f"{source}: the mesh has no surface faces (only points or lines){extra}")
     catalogue = _catalogue(raw)
     choice = pick_field(source, catalogue, field)
-    notes = [choice.note] if choice.note else []
+    notes = [*raw.notes, choice.note] if choice.note else list(raw.notes)
     if raw.skipped:
         notes.append("cells not read: " + ", ".join(f"{n} {k}" for k, n in raw.skipped.items()))
 

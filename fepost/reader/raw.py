@@ -95,6 +95,7 @@ class RawMesh:
     ncomp: dict[str, int] = field(default_factory=dict)  # components of lazily loaded point arrays
     closer: Callable[[], None] | None = None
     connectivity_size: int = 0  # VTK files: node references of all cells as read
+    notes: list[str] = field(default_factory=list)  # what the format reader did, for the result's notes
 
     def close(self) -> None:
         """Release the file (lazy arrays cannot be loaded afterwards)."""

@@ -1,4 +1,9 @@
-"""VTK files (XML ``.vtu .vtp .vtm`` and legacy ``.vtk``) read with VTK's own readers.
+"""VTK files read with VTK's own readers.
+
+XML ``.vtu .vtp .vtm``, structured XML grids ``.vts .vtr`` (turned into hexahedra
+or quadrilaterals, whose boundary is then taken as for any volume mesh), parallel
+XML ``.pvtu .pvtp`` (read piece by piece by VTK's parallel readers, ghost cells
+dropped, then joined by `fepost.reader.pieces`) and legacy ``.vtk``.
 
 VTK's readers are used directly (``vtkmodules``, not pyvista: the same
 readers, a third of the import time). Each file is first checked by
@@ -21,7 +26,25 @@ from ..errors import InputFileError
 from .cells import SPECS, VTK_TYPES, check_connectivity
 from .raw import Block, RawMesh
 
-VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm")
+VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm", ".vts", ".vtr", ".pvtu", ".pvtp")
+#: Parallel files: pieces read one by one and joined.
+PARALLEL_SUFFIXES = (".pvtu", ".pvtp")
+_XML_READERS = {
+    ".vtu": "vtkXMLUnstructuredGridReader",
+    ".vtp": "vtkXMLPolyDataReader",
+    ".vtm": "vtkXMLMultiBlockDataReader",
+    ".vts": "vtkXMLStructuredGridReader",
+    ".vtr": "vtkXMLRectilinearGridReader",
+    ".pvtu": "vtkXMLPUnstructuredGridReader",
+    ".pvtp": "vtkXMLPPolyDataReader",
+}
+_FORMAT_NAMES = {
+    ".vtk": "VTK legacy",
+    ".vts": "VTK XML structured grid",
+    ".vtr": "VTK XML rectilinear grid",
+    ".pvtu": "VTK parallel XML",
+    ".pvtp": "VTK parallel XML",
+}
 #: VTK cell types without area that are passed over (named in the notes): they carry no contact pressure.
 _PASSED_OVER = {2: "poly-vertex", 4: "poly-line", 35: "cubic line", 68: "Lagrange curve", 75: "Bezier curve"}
 #: VTK cell types with area that fepost cannot read: refused by name, so no load is dropped silently.
@@ -70,18 +93,10 @@ class _ErrorWindow:
 
 
 def _reader_for(suffix: str):
-    if suffix == ".vtu":
-        from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+    if suffix in _XML_READERS:
+        from vtkmodules import vtkIOXML
 
-        return vtkXMLUnstructuredGridReader()
-    if suffix == ".vtp":
-        from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
-
-        return vtkXMLPolyDataReader()
-    if suffix == ".vtm":
-        from vtkmodules.vtkIOXML import vtkXMLMultiBlockDataReader
-
-        return vtkXMLMultiBlockDataReader()
+        return getattr(vtkIOXML, _XML_READERS[suffix])()
     from vtkmodules.vtkIOLegacy import vtkDataSetReader
 
     r = vtkDataSetReader()
@@ -107,17 +122,42 @@ def _leaves(obj) -> list:
     return [obj]
 
 
+def _pieces(reader) -> tuple[list, bool]:
+    """The pieces of a parallel file, one data set each, ghost cells removed (and whether any were)."""
+    reader.UpdateInformation()
+    n = reader.GetNumberOfPieces()
+    out, ghosts = [], False
+    for i in range(n):
+        reader.UpdatePiece(i, n, 0)
+        got = reader.GetOutputDataObject(0)
+        ds = got.NewInstance()
+        ds.DeepCopy(got)
+        if ds.GetCellData().GetArray("vtkGhostType") is not None:
+            before = ds.GetNumberOfCells()
+            ds.RemoveGhostCells()
+            ghosts = ghosts or ds.GetNumberOfCells() != before
+        out.append(ds)
+    return out, ghosts
+
+
 def read_vtk(path: Path) -> RawMesh:
-    """Read a VTK file into a :class:`~fepost.reader.raw.RawMesh`."""
+    """Read a VTK file into a `fepost.reader.raw.RawMesh`."""
+    from .pieces import join_pieces
     from .vtkcheck import check_file
 
     suffix = path.suffix.lower()
     counts = check_file(path)
     reader = _reader_for(suffix)
+    ghosts = False
+    pieces: list = []
     with _ErrorWindow() as win:
         reader.SetFileName(str(path))
-        reader.Update()
-        out = reader.GetOutputDataObject(0)
+        if suffix in PARALLEL_SUFFIXES:
+            pieces, ghosts = _pieces(reader)
+            out = None
+        else:
+            reader.Update()
+            out = reader.GetOutputDataObject(0)
     errors = win.errors()
     if errors:
         raise InputFileError(f"{path}: corrupt or truncated {suffix} file ({errors[0]})")
@@ -128,16 +168,20 @@ def read_vtk(path: Path) -> RawMesh:
             f"{path}: cannot read {suffix} file "
             f"({vtkErrorCode.GetStringFromErrorCode(reader.GetErrorCode())})"
         )
-    leaves = [leaf for leaf in _leaves(out) if leaf is not None and leaf.GetNumberOfPoints() > 0]
+    leaves = _leaves(out) if out is not None else pieces
+    leaves = [leaf for leaf in leaves if leaf is not None and leaf.GetNumberOfPoints() > 0]
     if not leaves:
         raise InputFileError(f"{path}: the file holds no mesh (0 nodes or 0 cells)")
-    raw = _assemble(path, leaves, f"VTK {'legacy' if suffix == '.vtk' else 'XML'} ({suffix})")
+    raw = _assemble(path, leaves, f"{_FORMAT_NAMES.get(suffix, 'VTK XML')} ({suffix})")
     declared = sum(counts.connectivity)
-    if declared and suffix != ".vtm" and declared != raw.connectivity_size:
+    if declared and suffix != ".vtm" and not ghosts and declared != raw.connectivity_size:
         raise InputFileError(
             f"{path}: the header disagrees with the data: the connectivity holds {declared} values, "
             f"the declared cells use {raw.connectivity_size}"
         )
+    if suffix in PARALLEL_SUFFIXES:
+        raw, merged = join_pieces(raw, [int(leaf.GetNumberOfPoints()) for leaf in leaves])
+        raw.notes = [f"{len(leaves)} pieces joined ({merged} nodes shared by pieces merged)"]
     return raw
 
 
@@ -340,4 +384,4 @@ def _join(pieces: list[dict[str, np.ndarray]], sizes: list[int]) -> dict[str, np
     return out
 
 
-__all__ = ["VTK_SUFFIXES", "read_vtk"]
+__all__ = ["PARALLEL_SUFFIXES", "VTK_SUFFIXES", "read_vtk"]

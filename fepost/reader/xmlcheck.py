@@ -209,9 +209,11 @@ class Xml:
         for ref in refs:
             sub = inside_folder(self.path, ref, what)
             if sub.suffix.lower() not in suffixes:
-                raise bad_file(self.path, f"{what} {ref!r} is not a {' or '.join(suffixes)} file")
+                kind = "VTK XML" if len(suffixes) > 1 else suffixes[0]
+                raise bad_file(self.path, f"{what} {ref!r} is not a {kind} file")
             if sub == self.path.resolve():
-                raise bad_file(self.path, f"{what} {ref!r} is the file itself")
+                whole = "multi-block" if what.startswith("multi") else "parallel"
+                raise bad_file(self.path, f"{whole} file refers to itself")
             if not sub.is_file():
                 raise bad_file(self.path, f"{what} {ref!r} not found")
             counts.connectivity += check_xml(sub, self.depth + 1).connectivity
