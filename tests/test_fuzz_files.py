@@ -468,6 +468,13 @@ def test_hostile_exodus_files(bases, tmp_path, capsys):
             "no contact-pressure array found",
         ),
     ]
+    three = np.stack([val, val, val])
+    for name, times, message in (
+        ("inf_time.e", (0.0, np.inf, 2.0), "step 1 (t = inf) is not a finite number"),
+        ("nan_times.e", (np.nan, 1.0, -np.inf), "step 0 (t = nan), step 2 (t = -inf) are not a finite number"),
+    ):
+        kw = dict(points=pts, blocks=[("TRI3", tri)], nodal={"CPRESS": three}, times=times)
+        cases.append((name, kw, re.escape(f"{tmp_path / name}: corrupt Exodus II time values: {message}")))
     for name, kw, pattern in cases:
         path = write_exodus_classic(tmp_path / name, **kw)
         code, lines, _ = _run(path, capsys)
@@ -501,3 +508,19 @@ def test_a_separate_process_ends_with_exit_2_never_a_signal(bases, tmp_path, nam
     assert proc.returncode == 2, (proc.returncode, proc.stderr)
     lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1 and lines[0].startswith(f"fepost: error: {path}"), proc.stderr
+
+
+def test_symbolic_link_loop_and_dangling_link(tmp_path, capsys):
+    loop = tmp_path / "loop.vtu"
+    other = tmp_path / "other.vtu"
+    loop.symlink_to(other)
+    other.symlink_to(loop)
+    dangling = tmp_path / "dangling.vtu"
+    dangling.symlink_to(tmp_path / "gone.vtu")
+    for path, message in (
+        (loop, f"{loop}: a symbolic-link loop (the links never reach a file)"),
+        (dangling, f"{dangling}: a symbolic link to {str(tmp_path / 'gone.vtu')!r}, which does not exist"),
+        (tmp_path / "none.vtu", f"{tmp_path / 'none.vtu'}: no such file"),
+    ):
+        code, lines, _ = _run(path, capsys)
+        assert code == 2 and lines == [f"fepost: error: {message}"], lines

@@ -26,6 +26,8 @@ Modules, one concern each: :mod:`.cells` (element types, faces, boundary),
 
 from __future__ import annotations
 
+import errno
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -63,10 +65,23 @@ def supported_suffixes() -> tuple[str, ...]:
     return VTK_SUFFIXES + EXODUS_SUFFIXES
 
 
+def _missing(path: Path, exc: OSError) -> InputFileError:
+    """The error for a path that cannot be followed to a file: missing, a link loop, a dangling link."""
+    if exc.errno == errno.ELOOP:
+        return InputFileError(f"{path}: a symbolic-link loop (the links never reach a file)")
+    if path.is_symlink():
+        return InputFileError(f"{path}: a symbolic link to {os.readlink(path)!r}, which does not exist")
+    if exc.errno in (errno.ENOENT, errno.ENOTDIR):
+        return InputFileError(f"{path}: no such file")
+    return InputFileError(f"{path}: cannot open ({exc.strerror or exc})")
+
+
 def _checked(path: str | Path) -> tuple[Path, int]:
     path = Path(path)
-    if not path.exists():
-        raise InputFileError(f"{path}: no such file")
+    try:
+        os.stat(path)
+    except OSError as exc:
+        raise _missing(path, exc) from None
     if not path.is_file():
         raise InputFileError(f"{path}: not a file")
     if path.suffix.lower() not in supported_suffixes():

@@ -106,10 +106,19 @@ def _read(ds, name: str, shape: tuple[int, ...] | None = None, dtype=float) -> n
     return np.asarray(a, dtype=dtype)
 
 
-def _steps(ds) -> np.ndarray:
+def _steps(ds, path: Path | str) -> np.ndarray:
+    """The time values of the steps; a NaN or infinite one is refused, naming the step(s)."""
     if "time_whole" not in ds.variables:
         return np.empty(0)
     t = np.asarray(ds.variables["time_whole"][:], float).ravel()
+    bad = np.flatnonzero(~np.isfinite(t))
+    if len(bad):
+        listed = ", ".join(f"step {k} (t = {t[k]})" for k in bad[:5])
+        more = f" and {len(bad) - 5} more" if len(bad) > 5 else ""
+        raise InputFileError(
+            f"{path}: corrupt Exodus II time values: {listed}{more} "
+            f"{'is' if len(bad) == 1 else 'are'} not a finite number"
+        )
     return t
 
 
@@ -117,7 +126,9 @@ def read_steps(path: Path) -> tuple[float, ...]:
     """The time value of every step stored in an Exodus II file."""
     ds = _open(path)
     try:
-        return tuple(float(t) for t in _steps(ds))
+        return tuple(float(t) for t in _steps(ds, path))
+    except InputFileError:
+        raise
     except (KeyError, ValueError, OSError, RuntimeError, IndexError) as exc:
         raise InputFileError(f"{path}: malformed Exodus II file ({_one_line(exc)})") from None
     finally:
@@ -198,7 +209,7 @@ def _read_exodus(ds, path: Path, step: int | None) -> RawMesh:
         bad = int(np.sum(~np.isfinite(points).all(axis=1)))
         raise InputFileError(f"{path}: {bad} node coordinates are NaN or infinite")
 
-    times = _steps(ds)
+    times = _steps(ds, path)
     n_steps = len(times)
     if n_steps and "time_step" in ds.dimensions and len(ds.dimensions["time_step"]) < n_steps:
         raise ValueError("time_whole is longer than the time_step dimension")
