@@ -426,7 +426,10 @@ def test_multiblock_references(bases, tmp_path, capsys):
     for body, pattern in (
         ('<DataSet index="0" file="missing.vtu"/>', "multi-block piece 'missing.vtu' not found"),
         ('<DataSet index="0" file="multi.vtm"/>', "refers to itself"),
-        ('<DataSet index="0" file="/etc/passwd"/>', r"refused \.vtm file \(multi-block piece '/etc/passwd' lies outside the file's folder\)"),
+        (
+            '<DataSet index="0" file="/etc/passwd"/>',
+            r"refused \.vtm file \(multi-block piece '/etc/passwd' lies outside the file's folder\)",
+        ),
         ('<DataSet index="0" file="notes.txt"/>', "multi-block piece 'notes.txt' is not a VTK XML file"),
     ):
         path = _vtm(tmp_path, body)
@@ -471,7 +474,11 @@ def test_hostile_exodus_files(bases, tmp_path, capsys):
     three = np.stack([val, val, val])
     for name, times, message in (
         ("inf_time.e", (0.0, np.inf, 2.0), "step 1 (t = inf) is not a finite number"),
-        ("nan_times.e", (np.nan, 1.0, -np.inf), "step 0 (t = nan), step 2 (t = -inf) are not a finite number"),
+        (
+            "nan_times.e",
+            (np.nan, 1.0, -np.inf),
+            "step 0 (t = nan), step 2 (t = -inf) are not a finite number",
+        ),
     ):
         kw = dict(points=pts, blocks=[("TRI3", tri)], nodal={"CPRESS": three}, times=times)
         cases.append((name, kw, re.escape(f"{tmp_path / name}: corrupt Exodus II time values: {message}")))

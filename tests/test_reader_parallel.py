@@ -21,7 +21,6 @@ import pyvista as pv
 
 from fepost import analyse
 from fepost.polar import PolarGrid
-from fepost.reader import read_contact
 
 SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "aircraft" / "static_100.vtu"
 GRID = PolarGrid.make(nr=24, nphi=48)

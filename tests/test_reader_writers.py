@@ -98,7 +98,8 @@ def _xml(grids, out: Path, kind: str, mode: str, encode: bool, compressor: str) 
 
 
 LEGACY = [
-    (kind, version, binary) for kind, version, binary in itertools.product(("ug", "pd"), (42, 51), (True, False))
+    (kind, version, binary)
+    for kind, version, binary in itertools.product(("ug", "pd"), (42, 51), (True, False))
 ]
 XML = [
     (kind, mode, encode, comp)
@@ -178,7 +179,9 @@ def test_pressure_as_cell_data(grids, original, tmp_path, suffix):
     c = res.coefficients
     assert 0.0 <= c.R - r0 <= h
     dn_fe = abs(res.static_patch.N_fe - point.static_patch.N_fe)
-    area = 0.5 * np.linalg.norm(np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1]), axis=1)
+    area = 0.5 * np.linalg.norm(
+        np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1]), axis=1
+    )
     spread = p.max(axis=1) - p.min(axis=1)
     e_m = FRICTION * np.sum(edges.max(axis=1) / 2 * area * spread) + FRICTION * r0 * dn_fe
     assert abs(c.N - n0) <= dn_fe + 0.02 * n0

@@ -23,7 +23,7 @@ from .exodus import read_exodus
 from .names import ArrayInfo, FieldChoice, norm, pick_displacement, pick_field
 from .raw import RawMesh
 from .sidecar import at_step, read_sidecar
-from .surface import select_surface
+from .surface import Surface, loaded_surfaces, select_surface
 from .units import UnitSystem
 from .vtkfile import read_vtk
 
@@ -127,9 +127,20 @@ def _mask_sentinels(source: str, values: np.ndarray) -> np.ndarray:
     return values
 
 
-def _no_contact(raw: RawMesh, path: Path, choice: FieldChoice) -> None:
-    """Refuse a step without contact, naming the steps that have some (Exodus series)."""
+def _no_contact(raw: RawMesh, path: Path, choice: FieldChoice, values: np.ndarray) -> None:
+    """Refuse a step without contact: tension when the values are negative, else naming the steps
+    that carry contact (Exodus series)."""
     where = f"at step {raw.step} (t = {raw.time:g})" if raw.step is not None and raw.time is not None else ""
+    lo = _range(values)[0]
+    if lo < 0:
+        n = int(np.sum(values < 0))
+        what = "nodes" if choice.location == "point" else "faces"
+        raise PressureError(
+            f"{path}: pressure array {choice.label!r} has no positive value {where}".rstrip()
+            + f" and is negative at {n} {what} (down to {lo:.4g}): the interface is in tension "
+            "(a tied interface pulled apart), not pressed into contact; fepost reads compression "
+            "as positive pressure"
+        )
     others = ""
     if raw.step_values is not None and choice.location == "point" and choice.component is None:
         try:
@@ -146,7 +157,7 @@ def _no_contact(raw: RawMesh, path: Path, choice: FieldChoice) -> None:
             else:
                 others = f"; it is zero at all {series.shape[0]} steps"
     raise PressureError(
-        f"{path}: pressure array {choice.label!r} is zero or negative everywhere {where}".rstrip()
+        f"{path}: pressure array {choice.label!r} is zero everywhere {where}".rstrip()
         + f" (no contact){others}"
     )
 
@@ -174,15 +185,8 @@ def _scaled_sidecar(side: dict | None, units: UnitSystem | None) -> dict | None:
     return {k: (v * scale[k] if k in scale and isinstance(v, int | float) else v) for k, v in side.items()}
 
 
-def _contact(
-    raw: RawMesh,
-    path: Path,
-    field: str | None,
-    displacement: str | None,
-    units: UnitSystem | None,
-    surface: str | None,
-) -> ContactField:
-    source = str(path)
+def _check_mesh(raw: RawMesh, source: str) -> None:
+    """Refuse 2-D models and files without surface cells."""
     if raw.dim < 3:
         raise DimensionError(
             f"{source}: 2-D model (num_dim = {raw.dim}: plane strain, plane stress or axisymmetric): "
@@ -198,32 +202,31 @@ def _contact(
             raise InputFileError(f"{source}: the file holds no mesh (0 nodes or 0 cells)")
         extra = f"; not read: {skipped}" if skipped else ""
         raise InputFileError(f"{source}: the mesh has no surface faces (only points or lines){extra}")
-    catalogue = _catalogue(raw)
-    choice = pick_field(source, catalogue, field)
-    notes = [*raw.notes, choice.note] if choice.note else list(raw.notes)
-    if raw.skipped:
-        notes.append("cells not read: " + ", ".join(f"{n} {k}" for k, n in raw.skipped.items()))
 
-    point_values = cell_values = None
+
+def _pressures(
+    raw: RawMesh, source: str, choice: FieldChoice
+) -> tuple[np.ndarray | None, list[np.ndarray] | None, np.ndarray]:
+    """(nodal values or None, per-block cell values or None, all values) of the chosen array."""
     what = f"{source}: array {choice.name!r}"
     if choice.location == "point":
-        point_values = _mask_sentinels(source, _column(raw.point_data[choice.name], choice.component, what))
-        checked = point_values
-    else:
-        cell_values = []
-        for b in raw.blocks:
-            if choice.name in b.cell_data:
-                cell_values.append(_column(b.cell_data[choice.name], choice.component, what))
-            else:
-                cell_values.append(np.zeros(len(b.conn)))
-        allv = _mask_sentinels(source, np.concatenate(cell_values)) if cell_values else np.empty(0)
-        sizes = np.cumsum([len(v) for v in cell_values])[:-1]
-        cell_values = np.split(allv, sizes)
-        checked = allv
-    if not _range(checked)[1] > 0:  # NaN passed over; +inf counts (refused later as not finite)
-        _no_contact(raw, path, choice)
-    _absurd(source, f"pressure values of {choice.label!r}", checked, MAX_PRESSURE)
+        values = _mask_sentinels(source, _column(raw.point_data[choice.name], choice.component, what))
+        return values, None, values
+    cell_values = []
+    for b in raw.blocks:
+        if choice.name in b.cell_data:
+            cell_values.append(_column(b.cell_data[choice.name], choice.component, what))
+        else:
+            cell_values.append(np.zeros(len(b.conn)))
+    allv = _mask_sentinels(source, np.concatenate(cell_values)) if cell_values else np.empty(0)
+    sizes = np.cumsum([len(v) for v in cell_values])[:-1]
+    return None, np.split(allv, sizes), allv
 
+
+def _deformed(
+    raw: RawMesh, source: str, catalogue: list[ArrayInfo], displacement: str | None, units: UnitSystem | None
+) -> np.ndarray:
+    """The node coordinates with the displacement added, in SI (a new array when changed)."""
     points = np.asarray(raw.points, float)
     _absurd(source, "node coordinates", points, MAX_COORDINATE)
     disp = pick_displacement(source, catalogue, displacement)
@@ -239,25 +242,70 @@ def _contact(
         points[:, : min(3, u.shape[1])] += u[:, :3]
     if units is not None and not units.is_si:
         points *= units.length
-        if point_values is not None:
-            point_values = point_values * units.pressure
-        else:
-            cell_values = [v * units.pressure for v in cell_values]
+    return points
 
+
+def _surface(
+    raw: RawMesh,
+    source: str,
+    choice: FieldChoice,
+    point_values: np.ndarray | None,
+    cell_values: list[np.ndarray] | None,
+    surface: str | None,
+) -> Surface:
+    """The loaded faces; a surface named with --surface that carries no pressure is refused."""
     surf = select_surface(raw, choice.location, point_values, cell_values, surface)
     if not surf.conn:
         raise InputFileError(f"{source}: the mesh has no surface faces carrying {choice.label!r}")
-    notes += surf.notes
+    if surface is not None:
+        if point_values is not None:
+            peak = max(_range(point_values[np.concatenate([c.ravel() for c in surf.conn.values()])])[1], 0.0)
+        else:
+            vals = surf.values or {}
+            peak = max((_range(v)[1] for v in vals.values() if len(v)), default=0.0)
+        if not peak > 0:
+            where = loaded_surfaces(raw, point_values, cell_values)
+            elsewhere = (
+                f"; the pressure is on {', '.join(where)}: choose one of them with --surface"
+                if where
+                else " (nor does any other side set or block)"
+            )
+            raise PressureError(
+                f"{source}: surface {surface!r} ({surf.body}) carries no positive {choice.label!r}{elsewhere}"
+            )
+    return surf
 
+
+def _contact(
+    raw: RawMesh,
+    path: Path,
+    field: str | None,
+    displacement: str | None,
+    units: UnitSystem | None,
+    surface: str | None,
+) -> ContactField:
+    source = str(path)
+    _check_mesh(raw, source)
+    catalogue = _catalogue(raw)
+    choice = pick_field(source, catalogue, field)
+    notes = [*raw.notes, choice.note]
+    if raw.skipped:
+        notes.append("cells not read: " + ", ".join(f"{n} {k}" for k, n in raw.skipped.items()))
+    point_values, cell_values, checked = _pressures(raw, source, choice)
+    if not _range(checked)[1] > 0:  # NaN passed over; +inf counts (refused later as not finite)
+        _no_contact(raw, path, choice, checked)
+    _absurd(source, f"pressure values of {choice.label!r}", checked, MAX_PRESSURE)
+    points = _deformed(raw, source, catalogue, displacement, units)
+    if units is not None and not units.is_si:
+        if point_values is not None:
+            point_values = point_values * units.pressure
+        else:
+            cell_values = [v * units.pressure for v in cell_values or []]
+
+    surf = _surface(raw, source, choice, point_values, cell_values, surface)
+    notes += surf.notes
     if choice.location == "point" and any(SPECS[b.cell_type].dim == 3 for b in raw.blocks):
-        used = np.zeros(len(points), bool)
-        for conn in surf.conn.values():
-            used[conn.ravel()] = True
-        if not used.all() and point_values is not None:
-            remap = np.cumsum(used) - 1
-            points = points[used]
-            point_values = point_values[used]
-            surf.conn = {t: remap[c] for t, c in surf.conn.items()}
+        points, point_values, surf.conn = _used_nodes(points, point_values, surf.conn)
 
     tri = surf.conn.get("tri3", np.empty((0, 3), np.int64))
     faces = {t: surf.conn[t] for t in OTHER_FACE_TYPES if t in surf.conn}
@@ -269,10 +317,7 @@ def _contact(
         values = np.concatenate([vals[t] for t in order if t in surf.conn]) if vals else np.empty(0)
     side = _scaled_sidecar(at_step(read_sidecar(path), path, raw.step, len(raw.steps)), units)
     reaction = None if side is None else side.get("reaction_z")
-    time = raw.time
-    if time is not None and units is not None:
-        time *= units.time
-    names = tuple(a.name for a in catalogue)
+    scale = 1.0 if units is None else units.time
     # every array here was made by this reader from the file: shared with the field, not copied
     return ContactField(
         source=source,
@@ -282,15 +327,28 @@ def _contact(
         location=choice.location,  # type: ignore[arg-type]
         field=choice.label,
         step=raw.step,
-        time=time,
+        time=None if raw.time is None else raw.time * scale,
         reaction_z=None if reaction is None else float(reaction),
-        arrays=names,
+        arrays=tuple(a.name for a in catalogue),
         sidecar=side,
         faces={t: adopted(np.ascontiguousarray(c, dtype=np.int64)) for t, c in faces.items()},
         reactions=_reactions(raw, units),
-        steps=tuple(t * (1.0 if units is None else units.time) for t in raw.steps),
+        steps=tuple(t * scale for t in raw.steps),
         body=surf.body,
         units=units,
         notes=tuple(n for n in notes if n),
         format=raw.format,
     )
+
+
+def _used_nodes(
+    points: np.ndarray, point_values: np.ndarray | None, conn: dict[str, np.ndarray]
+) -> tuple[np.ndarray, np.ndarray | None, dict[str, np.ndarray]]:
+    """Only the nodes the faces use (a volume mesh's interior nodes dropped), renumbered."""
+    used = np.zeros(len(points), bool)
+    for c in conn.values():
+        used[c.ravel()] = True
+    if used.all() or point_values is None:
+        return points, point_values, conn
+    remap = np.cumsum(used) - 1
+    return points[used], point_values[used], {t: remap[c] for t, c in conn.items()}

@@ -9,6 +9,11 @@ store component names; there an unnamed 6-component ``CONTACT`` array is read
 with that same ccx2paraview layout (:data:`CCX_CONTACT`), and the result says
 so.
 
+When a file holds a contact-pressure name (``CPRESS``, ``contact_pressure``, ...)
+and the generic ``pressure`` (often a fluid or inflation pressure), the contact
+name is taken and the choice is stated in the result's notes; two contact names
+are an error that lists them.
+
 ``--field NAME`` names an array, ``NAME:K`` its component K, and a component
 name (``CPRESS``) is accepted too.
 """
@@ -16,7 +21,7 @@ name (``CPRESS``) is accepted too.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..errors import FieldError
 
@@ -33,6 +38,9 @@ PRESSURE_NAMES = (
     "contactnormalpressure",
     "pressure",
 )
+#: Normalised names that may mean another pressure (fluid, inflation): a contact-pressure name
+#: (CPRESS, contact_pressure, ...) in the same file is preferred to them, with a note.
+GENERIC_NAMES = ("pressure",)
 #: Normalised names taken as nodal displacement (3 components).
 DISPLACEMENT_NAMES = ("displacement", "displacements", "displ", "disp", "u")
 #: ccx2paraview's component layout of CalculiX's ``CONTACT`` output (used when a file names none).
@@ -118,9 +126,15 @@ def pick_field(source: str, catalogue: list[ArrayInfo], field: str | None) -> Fi
             f"{_listing(catalogue)}; name one with --field"
         )
     if len(hits) > 1:
-        specific = [h for h in hits if norm(h.label.split(":")[-1]) != "pressure"]
+        specific = [h for h in hits if norm(h.label.split(":")[-1]) not in GENERIC_NAMES]
         if len(specific) == 1:
-            return specific[0]
+            chosen = specific[0]
+            generic = ", ".join(repr(h.label) for h in hits if h is not chosen)
+            note = (
+                f"pressure taken from {chosen.label!r}, a contact-pressure name, preferred over the "
+                f"generic {generic}; choose another with --field"
+            )
+            return replace(chosen, note="; ".join(n for n in (chosen.note, note) if n))
         cand = ", ".join(f"{h.label} ({h.location})" for h in hits)
         raise FieldError(
             f"{source}: several candidate contact-pressure arrays: {cand}; choose one with --field"

@@ -94,6 +94,27 @@ def _named_surface(
     )
 
 
+def loaded_surfaces(
+    raw: RawMesh, point_values: np.ndarray | None, cell_values: list[np.ndarray] | None
+) -> list[str]:
+    """Labels of the side sets and element blocks whose faces carry positive pressure.
+
+    For the refusal of a ``--surface`` that carries none: it names where the pressure is.
+    """
+    out = []
+    keys = [ss.name or str(ss.id) for ss in raw.side_sets]
+    keys += [str(b.label) for b in raw.blocks if SPECS[b.cell_type].dim >= 2 and len(b.conn)]
+    for key in keys:
+        conn, vals, label = _named_surface(raw, key, cell_values)
+        if point_values is not None:
+            peaks = [np.nanmax(point_values[c]) for c in conn.values() if len(c)]
+        else:
+            peaks = [np.nanmax(v) for v in (vals or {}).values() if len(v)]
+        if peaks and max(peaks) > 0 and label not in out:
+            out.append(label)
+    return out
+
+
 def select_surface(
     raw: RawMesh,
     location: str,
@@ -321,4 +342,4 @@ def _rough_load(points, conn, ftype, point_values, surf, sel) -> float:
     return float(np.sum(area * mean))
 
 
-__all__ = ["FACE_TYPES", "Surface", "select_surface"]
+__all__ = ["FACE_TYPES", "Surface", "loaded_surfaces", "select_surface"]
