@@ -113,7 +113,7 @@ def test_time_steps_and_a_step_without_contact(tmp_path):
     assert [(s.index, s.time) for s in steps] == [(0, 0.0), (1, 1.0)]
     with pytest.raises(
         PressureError,
-        match=r"pair\.e: pressure array 'contact_pressure' is zero or negative "
+        match=r"pair\.e: pressure array 'contact_pressure' is zero "
         r"everywhere at step 0 \(t = 0\) \(no contact\); contact pressure is "
         r"positive at step\(s\) 1 \(t = 1\): choose one with --step",
     ):

@@ -42,6 +42,7 @@ if TYPE_CHECKING:
 
 VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm", ".vts", ".vtr", ".pvtu", ".pvtp")
 EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
+XDMF_SUFFIXES = (".xdmf", ".xmf")
 #: Values that mean "no contact data" rather than a pressure (MOOSE writes −99999).
 SENTINELS = (-99999.0, -999999.0, -9999.0, -1.0e30, -1.0e20)
 
@@ -62,7 +63,7 @@ __all__ = [
 
 
 def supported_suffixes() -> tuple[str, ...]:
-    return VTK_SUFFIXES + EXODUS_SUFFIXES
+    return VTK_SUFFIXES + EXODUS_SUFFIXES + XDMF_SUFFIXES
 
 
 def _missing(path: Path, exc: OSError) -> InputFileError:
@@ -188,6 +189,10 @@ def _steps_here(path: Path) -> tuple[float, ...] | None:
         from .exodus import read_steps
 
         return read_steps(path)
+    if path.suffix.lower() in XDMF_SUFFIXES:
+        from .xdmf import read_steps as xdmf_steps
+
+        return xdmf_steps(path)
     return None
 
 

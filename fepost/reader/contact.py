@@ -26,6 +26,7 @@ from .sidecar import at_step, read_sidecar
 from .surface import Surface, loaded_surfaces, select_surface
 from .units import UnitSystem
 from .vtkfile import read_vtk
+from .xdmf import XDMF_SUFFIXES, read_xdmf
 
 EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
 #: Values that mean "no contact data" rather than a pressure.
@@ -63,6 +64,8 @@ def read_raw(path: Path, step: int | None) -> RawMesh:
     """The file's content (Exodus by netCDF4, VTK files by VTK's readers)."""
     if path.suffix.lower() in EXODUS_SUFFIXES:
         return read_exodus(path, step)
+    if path.suffix.lower() in XDMF_SUFFIXES:
+        return read_xdmf(path, step)
     if step is not None:
         raise InputFileError(f"{path}: --step applies to Exodus time series, not to {path.suffix} files")
     return read_vtk(path)
