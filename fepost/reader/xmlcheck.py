@@ -216,7 +216,10 @@ class Xml:
                 raise bad_file(self.path, f"{whole} file refers to itself")
             if not sub.is_file():
                 raise bad_file(self.path, f"{what} {ref!r} not found")
-            counts.connectivity += check_xml(sub, self.depth + 1).connectivity
+            try:
+                counts.connectivity += check_xml(sub, self.depth + 1).connectivity
+            except InputFileError as exc:
+                raise InputFileError(f"{self.path}: {what} {ref!r} refused: {exc}") from None
         return counts
 
     # -- array lengths --
