@@ -102,7 +102,7 @@ def test_parallel_file_structure(base, tmp_path, capsys):
     # hostile pieces: entity expansion, truncation, a piece declaring more points than it holds
     piece = path.parent / first
     good = piece.read_bytes()
-    for name, data, pattern in (
+    for _name, data, pattern in (
         ("laughs", LAUGHS.encode(), r"piece '.*' refused: .*DOCTYPE/ENTITY"),
         ("truncated", good[: len(good) // 2], r"piece '.*' refused: .*(truncated|not closed)"),
         (

@@ -55,7 +55,11 @@ def test_meshio_time_series(mesh, original, tmp_path, monkeypatch):
         w.write_points_cells(mesh.points, mesh.cells)
         for t in (0.0, 0.5, 1.0):
             w.write_data(
-                t, point_data={"CPRESS": mesh.point_data["CPRESS"] * t, "displacement": mesh.point_data["displacement"]}
+                t,
+                point_data={
+                    "CPRESS": mesh.point_data["CPRESS"] * t,
+                    "displacement": mesh.point_data["displacement"],
+                },
             )
     assert [(s.index, s.time) for s in time_steps(path)] == [(0, 0.0), (1, 0.5), (2, 1.0)]
     assert _values(path) == pytest.approx(original, rel=TOL)  # the last step by default
@@ -83,8 +87,9 @@ DOLFINX = """<?xml version="1.0"?>
 FUNCTION = """    <Grid Name="{f}" GridType="Collection" CollectionType="Temporal">
 {steps}
     </Grid>"""
+INCLUDE = "xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]/*[self::Topology or self::Geometry])"
 STEP = """      <Grid Name="{f}" GridType="Uniform">
-        <xi:include xpointer="xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]/*[self::Topology or self::Geometry])" />
+        <xi:include xpointer="{include}" />
         <Time Value="{t}" />
         <Attribute Name="{f}" AttributeType="{kind}" Center="Node">
           <DataItem Dimensions="{n} {c}" Format="HDF">{h5}:/Function/{f}/{k}</DataItem>
@@ -110,7 +115,8 @@ def write_dolfinx_like(path: Path, mesh, times=(0.0, 1.0)) -> Path:
         FUNCTION.format(
             f=name,
             steps="\n".join(
-                STEP.format(f=name, t=t, kind=kind, n=n, c=c, h5=h5.name, k=k) for k, t in enumerate(times)
+                STEP.format(f=name, t=t, kind=kind, n=n, c=c, h5=h5.name, k=k, include=INCLUDE)
+                for k, t in enumerate(times)
             ),
         )
         for name, kind, c in (("p", "Scalar", 1), ("u", "Vector", 3))

@@ -30,6 +30,7 @@ import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from .checks import MAX_COUNT, MAX_DEPTH, bad_file, inside_folder
 
@@ -38,7 +39,9 @@ HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 #: Largest XDMF (XML) file read: the heavy data belongs in the HDF5 file.
 MAX_XML_BYTES = 256 << 20
 _XINCLUDE = tuple(
-    f"{{{scheme}://www.w3.org/{year}/XInclude}}include" for scheme in ("http", "https") for year in (2001, 2003)
+    f"{{{scheme}://www.w3.org/{year}/XInclude}}include"
+    for scheme in ("http", "https")
+    for year in (2001, 2003)
 )
 
 
@@ -81,7 +84,8 @@ class _Heavy:
     """The HDF5 files an XDMF file names, each opened once (structure only)."""
 
     def __init__(self, path: Path):
-        self.path, self.files = path, {}
+        self.path = path
+        self.files: dict[Path, Any] = {}
 
     def size(self, ref: str, dataset: str) -> int:
         import h5py
@@ -132,7 +136,7 @@ def _item(path: Path, item: ET.Element, heavy: _Heavy) -> None:
             )
     elif fmt == "Binary":
         raise bad_file(
-            path, "refused: Format=\"Binary\" data (a raw file named from the working directory); write HDF5"
+            path, 'refused: Format="Binary" data (a raw file named from the working directory); write HDF5'
         )
     else:
         raise bad_file(path, f"DataItem Format={fmt!r} is not XML, HDF or Binary")
@@ -141,7 +145,9 @@ def _item(path: Path, item: ET.Element, heavy: _Heavy) -> None:
 def _tree(path: Path) -> ET.Element:
     size = path.stat().st_size
     if size > MAX_XML_BYTES:
-        raise bad_file(path, f"refused: {size} bytes of XML (at most {MAX_XML_BYTES}; heavy data goes to HDF5)")
+        raise bad_file(
+            path, f"refused: {size} bytes of XML (at most {MAX_XML_BYTES}; heavy data goes to HDF5)"
+        )
     data = path.read_bytes()
     first = data.find(b"<Xdmf")
     prologue = data[: first if first >= 0 else 1 << 16]
@@ -186,7 +192,9 @@ def check_xdmf(path: Path) -> XdmfLayout:
     if domain is None:
         raise bad_file(path, "no Domain element")
     layout.temporal = sum(
-        1 for g in domain.findall("Grid") if g.get("GridType") == "Collection" and g.get("CollectionType") == "Temporal"
+        1
+        for g in domain.findall("Grid")
+        if g.get("GridType") == "Collection" and g.get("CollectionType") == "Temporal"
     )
     return layout
 
