@@ -1,27 +1,32 @@
-"""Read FE contact results into a :class:`~fepost.field.ContactField`.
+"""Read FE contact results into a `fepost.field.ContactField`.
 
 Formats are chosen by suffix; every format is read by a well-kept library,
 never by a hand-written parser:
 
-========================= ===================================================
-suffix                    reader
-========================= ===================================================
-``.vtu .vtp .vtk .vtm``   VTK's XML / legacy readers (:mod:`.vtkfile`),
-                          after the checks of :mod:`.vtkcheck`
-                          (:mod:`.xmlcheck`, :mod:`.legacycheck`)
-``.e .exo .ex2 .exii``    the netCDF container read with netCDF4 (:mod:`.exodus`)
-========================= ===================================================
+=============================== =============================================
+suffix                          reader
+=============================== =============================================
+``.vtu .vtp .vtk .vtm``         VTK's XML / legacy readers (`vtkfile`),
+                                after the checks of `vtkcheck`
+                                (`xmlcheck`, `legacycheck`)
+``.vts .vtr``                   VTK's structured-grid readers (`vtkfile`),
+                                the boundary taken as for volume meshes
+``.pvtu .pvtp``                 VTK's parallel readers, piece by piece,
+                                joined by `pieces`
+``.e .exo .ex2 .exii``          the netCDF container read with netCDF4 (`exodus`)
+``.xdmf .xmf`` (+ ``.h5``)      meshio (`xdmf`), after the checks of `xdmfcheck`
+=============================== =============================================
 
-Every file is read in a forked child process (:mod:`.isolate`): a file that
+Every file is read in a forked child process (`isolate`): a file that
 crashes or hangs a C library becomes a one-line
-:class:`~fepost.errors.InputFileError`, never a dead process.
+`fepost.errors.InputFileError`, never a dead process.
 
-Modules, one concern each: :mod:`.cells` (element types, faces, boundary),
-:mod:`.surface` (which body's faces carry the pressure), :mod:`.names`
-(which array is the pressure), :mod:`.units` (unit systems, scale checks),
-:mod:`.sidecar` (the ``<stem>.json`` beside a file), :mod:`.quadratic`
+Modules, one concern each: `cells` (element types, faces, boundary),
+`surface` (which body's faces carry the pressure), `names`
+(which array is the pressure), `units` (unit systems, scale checks),
+`sidecar` (the ``<stem>.json`` beside a file), `quadratic`
 (shape functions, exact integrals and refinement of curved faces),
-:mod:`.contact` (the steps in order). ``docs/reading.md`` describes the rules.
+`contact` (the steps in order). ``docs/reading.md`` describes the rules.
 """
 
 from __future__ import annotations
@@ -115,17 +120,19 @@ def read_contact(
     Parameters
     ----------
     path : file path
-        ``.vtu``, ``.vtp``, ``.vtk`` (legacy), ``.vtm`` or Exodus II ``.e``/``.exo``.
+        ``.vtu``, ``.vtp``, ``.vtk`` (legacy), ``.vtm``, ``.vts``, ``.vtr``, ``.pvtu``,
+        ``.pvtp``, Exodus II ``.e``/``.exo`` or XDMF ``.xdmf`` (with its ``.h5``).
     field : str, optional
         Name of the pressure array (``NAME:k`` for component k, or a component
-        name such as ``CPRESS``). Default: found by name among :data:`PRESSURE_NAMES`.
+        name such as ``CPRESS``). Default: found by name among `PRESSURE_NAMES`.
     step : int, optional
-        Exodus time step (0-based; negative counts from the end). Default: last.
+        Time step of an Exodus file or an XDMF time series (0-based; negative counts
+        from the end). Default: last.
     displacement : str or None
         ``"auto"`` (default): add the displacement array if one is found;
         a name: add that array; ``None``: use the coordinates as written.
     units : str, optional
-        The model's unit system (:data:`~fepost.reader.units.SYSTEMS`, e.g.
+        The model's unit system (`fepost.reader.units.SYSTEMS`, e.g.
         ``"mm-N-MPa"``); everything is converted to SI. Default: SI, assumed
         (implausible scales are then refused downstream).
     surface : str, optional
@@ -155,10 +162,10 @@ def start_reading(
     units: str | UnitSystem | None = None,
     surface: str | None = None,
 ) -> isolate.Pending:
-    """Start :func:`read_contact` in the reading child and return at once.
+    """Start `read_contact` in the reading child and return at once.
 
-    ``.result()`` on the returned object gives the :class:`~fepost.field.ContactField`
-    (or raises what :func:`read_contact` raises); ``.cancel()`` abandons the read.
+    ``.result()`` on the returned object gives the `fepost.field.ContactField`
+    (or raises what `read_contact` raises); ``.cancel()`` abandons the read.
     Meanwhile the caller may import, compute, or start reading a second file.
     A missing file, an unknown suffix or an unknown unit system raise at once.
     """
@@ -199,10 +206,10 @@ def _steps_here(path: Path) -> tuple[float, ...] | None:
 def time_steps(path: str | Path, units: str | UnitSystem | None = None) -> tuple[TimeStep, ...]:
     """The states stored in an FE export, in order.
 
-    Exodus files list every time step (``TimeStep(k, t_k)``; an Exodus file
-    without steps gives one ``TimeStep(None, None)``); VTK files hold one state
-    (``TimeStep(None, None)``). ``units`` scales the times (``mm-kg-ms``: ms).
-    Pass ``step=ts.index`` to :func:`read_contact` / :func:`fepost.analyse`.
+    Exodus files and XDMF time series list every time step (``TimeStep(k, t_k)``;
+    an Exodus file without steps gives one ``TimeStep(None, None)``); VTK files and
+    single-grid XDMF files hold one state (``TimeStep(None, None)``). ``units`` scales the times (``mm-kg-ms``: ms).
+    Pass ``step=ts.index`` to `read_contact` / `fepost.analyse`.
     """
     path, size = _checked(path)
     system = unit_system(units)

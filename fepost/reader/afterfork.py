@@ -19,7 +19,7 @@ reading child meets:
 * **The buffered streams' locks** (``sys.stdout``, ``sys.stderr``): a thread
   writing to them at the fork leaves the child unable to flush them.
 
-:func:`settle` therefore forgets the import machinery's per-module locks and
+`settle` therefore forgets the import machinery's per-module locks and
 the modules that another thread was still initialising (the child imports them
 afresh, whole), and gives the child new ``sys.stdout``/``sys.stderr`` objects
 on the descriptors it redirects, never flushing the inherited ones (what they

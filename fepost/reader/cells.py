@@ -2,14 +2,14 @@
 
 Every reader maps the element types it meets onto the canonical types below,
 with the **Exodus II node ordering** (corners first, then one node per edge in
-the order of :attr:`CellSpec.edges`, then face centres, then the volume
+the order of `CellSpec.edges`, then face centres, then the volume
 centre). VTK orderings differ for some quadratic types and are permuted on
-reading (:data:`VTK_TYPES`); the permutations are checked against VTK's own
+reading (`VTK_TYPES`); the permutations are checked against VTK's own
 cell definitions in the tests.
 
 The faces of an element are written as *face types* ``tri3 tri6 tri7 quad4
 quad8 quad9``: corners, then the mid-edge nodes of edges (c0 c1), (c1 c2),
-(c2 c3|c0), …, then the face centre. :mod:`fepost.reader.quadratic` holds the
+(c2 c3|c0), …, then the face centre. `fepost.reader.quadratic` holds the
 shape functions of those face types.
 
 Why hand-written: the boundary of a volume mesh must keep every face node
@@ -207,7 +207,7 @@ class Faces:
 
     ``conn[t]`` (m, k) node indices of the faces of type ``t``; ``cell[t]`` (m,)
     the index of the element each face belongs to, within the list of
-    elements handed to :func:`boundary_faces` (for cell data).
+    elements handed to `boundary_faces` (for cell data).
     """
 
     conn: dict[str, np.ndarray]
@@ -231,7 +231,7 @@ def boundary_faces(blocks: list[tuple[str, np.ndarray]]) -> Faces:
     ``blocks``: (canonical type, (m, k) connectivity) pairs. Surface elements
     are faces themselves; the faces of volume elements shared by two elements
     (interior faces, block interfaces) are dropped. Lines and points are
-    ignored. Element indices in :attr:`Faces.cell` run over the blocks in
+    ignored. Element indices in `Faces.cell` run over the blocks in
     order.
     """
     chunks: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]] = []  # face type, nodes, corner key, cell

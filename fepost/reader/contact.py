@@ -1,11 +1,11 @@
-"""From a file's content to a :class:`~fepost.field.ContactField` (runs inside the reading child).
+"""From a file's content to a `fepost.field.ContactField` (runs inside the reading child).
 
 Order of the steps, each in its own module: read the file
-(:mod:`~fepost.reader.vtkfile` / :mod:`~fepost.reader.exodus`), refuse 2-D
-models, choose the pressure array (:mod:`~fepost.reader.names`), mask
-sentinels, add the displacement, convert to SI (:mod:`~fepost.reader.units`),
-choose the loaded surface (:mod:`~fepost.reader.surface`), attach the solver's
-reactions and the sidecar (:mod:`~fepost.reader.sidecar`).
+(`fepost.reader.vtkfile` / `fepost.reader.exodus`), refuse 2-D
+models, choose the pressure array (`fepost.reader.names`), mask
+sentinels, add the displacement, convert to SI (`fepost.reader.units`),
+choose the loaded surface (`fepost.reader.surface`), attach the solver's
+reactions and the sidecar (`fepost.reader.sidecar`).
 """
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ def read_here(
     units: UnitSystem | None = None,
     surface: str | None = None,
 ) -> ContactField:
-    """:func:`fepost.reader.read_contact` without the child process (see there)."""
+    """`fepost.reader.read_contact` without the child process (see there)."""
     raw = read_raw(path, step)
     try:
         return _contact(raw, path, field, displacement, units, surface)

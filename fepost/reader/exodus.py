@@ -173,7 +173,7 @@ def vector_groups(names: list[str]) -> dict[str, tuple[str, ...]]:
 
 
 def read_exodus(path: Path, step: int | None) -> RawMesh:
-    """Read an Exodus II file into a :class:`~fepost.reader.raw.RawMesh` at ``step`` (default: last)."""
+    """Read an Exodus II file into a `fepost.reader.raw.RawMesh` at ``step`` (default: last)."""
     ds = _open(path)
     try:
         return _read_exodus(ds, path, step)

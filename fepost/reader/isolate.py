@@ -6,34 +6,34 @@ VTK's readers and the netCDF/HDF5 libraries are C/C++ code: a corrupt or
 hostile file can make them dereference a wild pointer (SIGSEGV), abort
 (SIGABRT), allocate without bound or loop for ever. No amount of checking in
 Python catches that inside the process. fepost validates what it can before
-handing a file to those libraries (:mod:`fepost.reader.vtkcheck`,
-:mod:`fepost.reader.exodus`) and, in addition, reads every file in a forked
+handing a file to those libraries (`fepost.reader.vtkcheck`,
+`fepost.reader.exodus`) and, in addition, reads every file in a forked
 child: a crash, a hang or an exhausted memory limit in the child becomes one
-:class:`~fepost.errors.InputFileError` in the caller.
+`fepost.errors.InputFileError` in the caller.
 
 How
 ---
-* ``os.fork`` (not :mod:`multiprocessing`): the child inherits the already
+* ``os.fork`` (not `multiprocessing`): the child inherits the already
   imported modules, starts in milliseconds, and works inside daemonic
   processes (Dask workers), where ``multiprocessing`` refuses to start children.
 * The child first lets go of what the caller's other threads held at the fork
-  (per-module import locks, the streams' locks; :mod:`fepost.reader.afterfork`):
+  (per-module import locks, the streams' locks; `fepost.reader.afterfork`):
   a Dask worker imports on one thread while another forks a reader.
 * The child's file descriptors 1 and 2 are redirected to an anonymous memory
   file, so the C libraries' chatter is captured at the descriptor level; the
   first error line is quoted in the message, nothing reaches the terminal.
-* The child's address space is limited (:data:`MEMORY_BUDGET` beyond what it
+* The child's address space is limited (`MEMORY_BUDGET` beyond what it
   holds at the fork), so a header declaring 10¹² points fails fast.
 * The result travels back as a pickle (protocol 5) whose large numpy buffers
   go out of band into one anonymous private map in the caller (the caller's
   arrays are views of it), copied straight out of the waiting child where
-  Linux allows it, else through the pipe (:mod:`fepost.reader.transfer`).
-* The parent waits with a deadline (:func:`timeout_for`); a child that misses
+  Linux allows it, else through the pipe (`fepost.reader.transfer`).
+* The parent waits with a deadline (`timeout_for`); a child that misses
   it is killed. A child that has sent its whole answer is reaped in the
   background: its exit (freeing its memory) is not waited for.
 * Warnings the child issues are recorded and re-issued in the caller (fepost
   warnings only); exceptions are re-raised (fepost errors as they are, anything
-  else as a one-line :class:`~fepost.errors.InputFileError` whose cause holds
+  else as a one-line `fepost.errors.InputFileError` whose cause holds
   the child's traceback, shown by ``fepost --debug``).
 
 Where ``os.fork`` does not exist, or with ``FEPOST_READ_ISOLATION=off``, the
@@ -58,9 +58,9 @@ from . import afterfork, transfer
 
 #: Environment variable: ``off`` reads in the calling process (no child).
 ISOLATION_ENV = "FEPOST_READ_ISOLATION"
-#: Environment variable: the read timeout in seconds (overrides :func:`timeout_for`).
+#: Environment variable: the read timeout in seconds (overrides `timeout_for`).
 TIMEOUT_ENV = "FEPOST_READ_TIMEOUT"
-#: Base read timeout, s, plus :data:`TIMEOUT_PER_MB` per MB of file.
+#: Base read timeout, s, plus `TIMEOUT_PER_MB` per MB of file.
 TIMEOUT_BASE = 60.0
 TIMEOUT_PER_MB = 2.0
 #: Address space the child may add to what it holds at the fork: max of this and 64 × the file size, bytes.
@@ -108,7 +108,7 @@ def call(
     nbytes : int
         Its size in bytes (sets the deadline and the memory budget).
     timeout : float, optional
-        Deadline in s (default :func:`timeout_for`).
+        Deadline in s (default `timeout_for`).
 
     Raises
     ------
@@ -121,7 +121,7 @@ def call(
 
 
 class Pending:
-    """A call started by :func:`start`: :meth:`result` waits for it, :meth:`cancel` abandons it."""
+    """A call started by `start`: `result` waits for it, `cancel` abandons it."""
 
     def __init__(self, what: str, value: Any = None, error: BaseException | None = None, child=None):
         self.what = what
@@ -134,7 +134,7 @@ class Pending:
 
     @property
     def running(self) -> bool:
-        """True while a child computes the value (False once :meth:`result` has collected it)."""
+        """True while a child computes the value (False once `result` has collected it)."""
         return self._child is not None
 
     def result(self) -> Any:
@@ -173,7 +173,7 @@ def start(
     timeout: float | None = None,
     **kwargs: Any,
 ) -> Pending:
-    """Start ``func(*args, **kwargs)`` in a forked child and return at once (see :func:`call`).
+    """Start ``func(*args, **kwargs)`` in a forked child and return at once (see `call`).
 
     The caller can go on with other work (imports, a second file) while the
     child reads; without isolation the function runs here and now.

@@ -1,4 +1,4 @@
-"""Checks of legacy VTK files (``.vtk``, ASCII or binary) before VTK reads them (see :mod:`.vtkcheck`)."""
+"""Checks of legacy VTK files (``.vtk``, ASCII or binary) before VTK reads them (see `vtkcheck`)."""
 
 from __future__ import annotations
 

@@ -1,12 +1,12 @@
 """Which array holds the contact pressure (and the displacement): names and components.
 
 The pressure is found by name, case-insensitively and ignoring punctuation
-(:data:`PRESSURE_NAMES`), as a whole scalar array or as a **named component**
+(`PRESSURE_NAMES`), as a whole scalar array or as a **named component**
 of a vector array: CalculiX results converted by ccx2paraview hold the contact
 output in one 6-component array ``CONTACT`` whose components are named
 ``COPEN CSLIP1 CSLIP2 CPRESS CSHEAR1 CSHEAR2``. Legacy ``.vtk`` files cannot
 store component names; there an unnamed 6-component ``CONTACT`` array is read
-with that same ccx2paraview layout (:data:`CCX_CONTACT`), and the result says
+with that same ccx2paraview layout (`CCX_CONTACT`), and the result says
 so.
 
 When a file holds a contact-pressure name (``CPRESS``, ``contact_pressure``, ...)

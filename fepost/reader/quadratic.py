@@ -1,25 +1,25 @@
 """Element faces with their own shape functions: exact load and a refinement into triangles.
 
-Face types (node order of :mod:`fepost.reader.cells`): ``tri3``, ``tri6``,
+Face types (node order of `fepost.reader.cells`): ``tri3``, ``tri6``,
 ``tri7`` on the reference triangle (ξ, η ≥ 0, ξ + η ≤ 1) and ``quad4``
 (bilinear), ``quad8`` (serendipity), ``quad9`` (Lagrange) on [−1, 1]². The
 same shape functions carry the geometry (isoparametric: a quadratic face is
 curved) and the pressure.
 
-* :func:`face_loads` – the exact load of each face in a given plane,
+* `face_loads` – the exact load of each face in a given plane,
   ∬ σ (n·z) dA = ∬ σ(ξ, η) det ∂(x, y)/∂(ξ, η) dξ dη with in-plane x, y: a
   polynomial for these elements, integrated exactly by Gauss rules of
-  :data:`GAUSS_POINTS` points a side (tensor rule on quads, collapsed
+  `GAUSS_POINTS` points a side (tensor rule on quads, collapsed
   conical-product rule on triangles: degree ≥ 8).
-* :func:`surface_integrals` – ∬ σ dA and ∬ σ n dA over the curved surface
+* `surface_integrals` – ∬ σ dA and ∬ σ n dA over the curved surface
   (3-D Jacobian), for checks.
-* :func:`refine` – each face cut into linear triangles whose nodes are
+* `refine` – each face cut into linear triangles whose nodes are
   evaluated with the shape functions (position and pressure): ``level`` L cuts
   a quad into L × L sub-quads, each split along a diagonal into two triangles,
   and a triangle into L² sub-triangles. The error of the linear sub-triangles
-  falls as L⁻² (measured in the tests), and :func:`fepost.patch.build_patch`
+  falls as L⁻² (measured in the tests), and `fepost.patch.build_patch`
   doubles L until the triangles carry the exact element load to
-  :data:`fepost.patch.REFINE_TOL` (a ``quad4`` mesh of near-parallelograms
+  `fepost.patch.REFINE_TOL` (a ``quad4`` mesh of near-parallelograms
   stops at L = 1: the plain two-triangle split).
 
 A quadratic interpolant of non-negative nodal pressures may dip below zero

@@ -1,6 +1,6 @@
 """What a format reader hands on: nodes, element blocks, arrays, side sets, time.
 
-A :class:`RawMesh` is the file's content in canonical form (Exodus node
+A `RawMesh` is the file's content in canonical form (Exodus node
 ordering, 0-based indices, SI not yet applied), before any choice is made
 about which surface carries the contact. Arrays may be loaded lazily
 (Exodus variables are read only when asked for).

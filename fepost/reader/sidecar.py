@@ -3,10 +3,10 @@
 A sidecar is a JSON object whose keys describe the run (``reaction_z``: the
 solver's total normal reaction, in the model's force unit; ``inflation_pressure``;
 ``deflection``; …). It is checked before use: an object at the top, at most
-:data:`MAX_BYTES`, no ``NaN``/``Infinity`` literals, and every key fepost reads
-(:data:`NUMBER_KEYS`) either absent, null, a finite number (not a boolean) or,
+`MAX_BYTES`, no ``NaN``/``Infinity`` literals, and every key fepost reads
+(`NUMBER_KEYS`) either absent, null, a finite number (not a boolean) or,
 for a file with time steps, a list of finite numbers, one per step:
-:func:`at_step` then takes the value of the step read, so what the rest of
+`at_step` then takes the value of the step read, so what the rest of
 fepost sees is always one number per key.
 """
 

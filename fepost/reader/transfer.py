@@ -1,4 +1,4 @@
-"""How the reading child's answer travels to the caller (:mod:`fepost.reader.isolate`).
+"""How the reading child's answer travels to the caller (`fepost.reader.isolate`).
 
 The answer is a pickle (protocol 5) whose large numpy buffers go out of band.
 The child writes, through a pipe, a header (the pickle's length, then the size
@@ -14,7 +14,7 @@ transparent huge pages where the system offers them; the caller's arrays are
 views of it. (A shared map made before the fork cost 2-3x as much: its pages
 fault one by one in both processes and are slow to free.)
 
-``process_vm_readv`` is reached through :mod:`ctypes`: neither the standard
+``process_vm_readv`` is reached through `ctypes`: neither the standard
 library nor numpy wraps it.
 """
 

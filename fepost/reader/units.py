@@ -2,7 +2,7 @@
 
 FE solvers have no units: a model is written in one *consistent* system, and
 its results come out in it. fepost reports SI; ``--units`` names the system a
-model was written in (:data:`SYSTEMS`), and the reader scales lengths,
+model was written in (`SYSTEMS`), and the reader scales lengths,
 pressures, forces and times to SI on reading.
 
 =================  =========  ===========  ==============  ========
@@ -18,13 +18,13 @@ system             length     force        pressure        time
 ``ft-lbf-psf``     ft         lbf          lbf/ft²         s (mass in slug; also ``ft-lbf-s``)
 =================  =========  ===========  ==============  ========
 
-**Scale check.** A contact patch is between :data:`RADIUS_RANGE` in radius
-and its peak pressure within :data:`PRESSURE_RANGE`; outside those a model
+**Scale check.** A contact patch is between `RADIUS_RANGE` in radius
+and its peak pressure within `PRESSURE_RANGE`; outside those a model
 was almost surely read in the wrong units (a tire model in millimetres read as
 metres has R ≈ 100 m). Without ``--units`` that is an error
-(:class:`~fepost.errors.ScaleError`) naming the likely system; with
+(`fepost.errors.ScaleError`) naming the likely system; with
 ``--units`` given explicitly the user has vouched for the scale and it is a
-:class:`~fepost.errors.ScaleWarning`.
+`fepost.errors.ScaleWarning`.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Checks of VTK files before VTK reads them: declared sizes against the data, hostile XML.
 
-:func:`check_file` dispatches to :mod:`.xmlcheck` (XML) and :mod:`.legacycheck` (legacy).
+`check_file` dispatches to `xmlcheck` (XML) and `legacycheck` (legacy).
 
 VTK's readers trust a file's header: a piece declaring fewer cells than its
 arrays hold is read as that many cells (a silently partial result), declared
@@ -12,9 +12,9 @@ its data, before VTK sees it:
 
 XML (``.vtu .vtp .vtm``)
     no DOCTYPE or ENTITY declarations (entity expansion), tags nested at most
-    :data:`MAX_DEPTH` deep and balanced, the root type matching the suffix,
+    `MAX_DEPTH` deep and balanced, the root type matching the suffix,
     ``NumberOfPoints``/``NumberOfCells`` (``NumberOf{Verts,Lines,Strips,Polys}``)
-    non-negative and within :data:`MAX_COUNT`, every data array's length
+    non-negative and within `MAX_COUNT`, every data array's length
     (from its binary header — plain or compressed blocks, inline base64 or
     appended raw/base64 — or its ASCII token count) equal to what the piece
     declares, and the bytes it announces present in the file. A ``.vtm``'s
@@ -29,7 +29,7 @@ The structure is VTK's documented file format ("VTK File Formats", VTK User's
 Guide); nothing here is used to *read* data, only to decide whether VTK may.
 Corruption inside the data (a bad zlib block, wild connectivity) is left to
 VTK's own errors, to the connectivity check after reading, and to the child
-process the file is read in (:mod:`fepost.reader.isolate`).
+process the file is read in (`fepost.reader.isolate`).
 """
 
 from __future__ import annotations

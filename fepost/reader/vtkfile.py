@@ -7,11 +7,11 @@ dropped, then joined by `fepost.reader.pieces`) and legacy ``.vtk``.
 
 VTK's readers are used directly (``vtkmodules``, not pyvista: the same
 readers, a third of the import time). Each file is first checked by
-:mod:`fepost.reader.vtkcheck` (declared sizes against the data, hostile XML);
+`fepost.reader.vtkcheck` (declared sizes against the data, hostile XML);
 VTK's error messages are collected through a string output window and any
 error fails the read (VTK goes on after many errors and returns partial data).
-The cells are grouped by type into :class:`~fepost.reader.raw.Block` s with the
-canonical node ordering of :mod:`fepost.reader.cells`; the pieces of a
+The cells are grouped by type into `fepost.reader.raw.Block` s with the
+canonical node ordering of `fepost.reader.cells`; the pieces of a
 multi-block file are kept apart (never merged: two bodies in contact share
 node positions).
 """
