@@ -285,3 +285,76 @@ def test_mutated_hdf5_data(base, tmp_path, capsys):
         path.with_name(path.name + ".json").unlink()
     h5.write_bytes(saved)
     assert seen["refused"] > 0
+
+
+# ------------------------------------------------------------------------------ binary legacy FIELD blocks
+
+
+def _legacy_fields(path: Path) -> Path:
+    """A binary legacy file whose FIELD block holds several arrays, METADATA between them."""
+    import numpy as np
+    from vtkmodules.vtkIOLegacy import vtkUnstructuredGridWriter
+
+    pts = np.array([[0, 0, 0], [0.2, 0, 0], [0.2, 0.2, 0], [0, 0.2, 0]], float)
+    g = pv.UnstructuredGrid(np.r_[4, 0, 1, 2, 3], np.array([pv.CellType.QUAD]), pts)
+    contact = np.zeros((4, 6))
+    contact[:, 3] = 1e5
+    g.point_data["CONTACT"] = contact
+    g.point_data["extra"] = np.ones((4, 2))
+    g.point_data["temp"] = np.ones(4)
+    for name, comps in (
+        ("CONTACT", ("COPEN", "CSLIP1", "CSLIP2", "CPRESS", "CSHEAR1", "CSHEAR2")),
+        ("extra", "ab"),
+    ):
+        arr = g.GetPointData().GetArray(name)
+        for k, c in enumerate(comps):
+            arr.SetComponentName(k, c)
+    w = vtkUnstructuredGridWriter()
+    w.SetInputData(g)
+    w.SetFileName(str(path))
+    w.SetFileTypeToBinary()
+    w.Write()
+    return path
+
+
+def test_binary_legacy_field_blocks(tmp_path, capsys):
+    from fepost.reader import read_contact
+
+    path = _legacy_fields(tmp_path / "fields.vtk")
+    data = path.read_bytes()
+    assert data.count(b"METADATA") >= 2 and re.search(rb"FIELD FieldData [2-9]", data)
+    fld = read_contact(path)
+    assert fld.field == "CONTACT:CPRESS"
+    assert _ok_or_refused(path, capsys, 1e5 * 0.04) == "ok"
+    count = int(re.search(rb"FIELD FieldData (\d)", data).group(1))
+    name = re.search(rb"FIELD FieldData \d\n(\w+) (\d+) (\d+) (\w+)\n", data)
+    n_comp, n_tup = int(name.group(2)), int(name.group(3))
+    cases = [
+        (
+            "more_arrays",
+            data.replace(b"FIELD FieldData %d" % count, b"FIELD FieldData %d" % (count + 1)),
+            "FIELD arrays end early|bad FIELD array line|fewer bytes",
+        ),
+        (
+            "more_tuples",
+            data.replace(name.group(0), name.group(0).replace(b" %d " % n_tup, b" %d " % (n_tup + 1))),
+            "fewer bytes than a section declares|binary data where a section keyword belongs"
+            "|bad FIELD array line",
+        ),
+        (
+            "fewer_tuples",
+            data.replace(name.group(0), name.group(0).replace(b" %d " % n_tup, b" %d " % (n_tup - 1))),
+            "binary data where a section keyword belongs|bad FIELD array line|disagrees",
+        ),
+        ("cut", data[: len(data) - 20], "fewer bytes than a section declares"),
+        (
+            "type",
+            data.replace(name.group(0), name.group(0).replace(name.group(4), b"quaternion")),
+            "unknown data type 'quaternion'",
+        ),
+    ]
+    assert n_comp >= 1
+    for case, body, pattern in cases:
+        bad = tmp_path / f"{case}.vtk"
+        bad.write_bytes(body)
+        _refused(bad, capsys, pattern)
