@@ -134,3 +134,13 @@ def test_dolfinx_layout_two_functions(mesh, original, tmp_path):
     assert analyse(path, grid=GRID, field="p", step=0).static_patch.N_fe == pytest.approx(
         0.25 * original[0], rel=TOL
     )
+
+
+def test_the_read_budget_counts_the_heavy_data(mesh, tmp_path):
+    """The deadline and memory budget of the reading child follow the .h5's size, not the small XML's."""
+    from fepost.reader import data_size
+
+    path = tmp_path / "map.xdmf"
+    meshio.write(path, mesh)
+    xml, h5 = path.stat().st_size, path.with_suffix(".h5").stat().st_size
+    assert data_size(path, xml) == xml + h5

@@ -82,6 +82,42 @@ def _missing(path: Path, exc: OSError) -> InputFileError:
     return InputFileError(f"{path}: cannot open ({exc.strerror or exc})")
 
 
+#: Files a format names beside it (pieces, heavy data): their sizes count for the read's budget.
+_COMPANIONS = {
+    ".pvtu": (".vtu",),
+    ".pvtp": (".vtp",),
+    ".vtm": (".vtu", ".vtp", ".vtm"),
+    ".xdmf": (".h5",),
+    ".xmf": (".h5",),
+}
+#: Most folder entries looked at for companion files.
+_MAX_ENTRIES = 10_000
+
+
+def data_size(path: Path, size: int) -> int:
+    """``size`` plus the sizes of the files beside ``path`` its format names (by their stem).
+
+    Only the deadline and the memory budget of the read depend on it; no file is parsed here
+    (that happens in the reading child).
+    """
+    kinds = _COMPANIONS.get(path.suffix.lower())
+    if not kinds:
+        return size
+    total = size
+    for folder in (path.parent, path.parent / path.stem):
+        try:
+            with os.scandir(folder) as entries:
+                for k, entry in enumerate(entries):
+                    if k >= _MAX_ENTRIES:
+                        break
+                    name = entry.name
+                    if name.startswith(path.stem) and Path(name).suffix.lower() in kinds and entry.is_file():
+                        total += entry.stat().st_size
+        except OSError:
+            continue
+    return total
+
+
 def _checked(path: str | Path) -> tuple[Path, int]:
     path = Path(path)
     try:
@@ -103,7 +139,7 @@ def _checked(path: str | Path) -> tuple[Path, int]:
         raise InputFileError(f"{path}: cannot open ({exc.strerror or exc})") from None
     if size == 0:
         raise InputFileError(f"{path}: empty file")
-    return path, size
+    return path, data_size(path, size)
 
 
 def read_contact(
@@ -208,7 +244,8 @@ def time_steps(path: str | Path, units: str | UnitSystem | None = None) -> tuple
 
     Exodus files and XDMF time series list every time step (``TimeStep(k, t_k)``;
     an Exodus file without steps gives one ``TimeStep(None, None)``); VTK files and
-    single-grid XDMF files hold one state (``TimeStep(None, None)``). ``units`` scales the times (``mm-kg-ms``: ms).
+    single-grid XDMF files hold one state (``TimeStep(None, None)``). ``units`` scales
+    the times (``mm-kg-ms``: ms).
     Pass ``step=ts.index`` to `read_contact` / `fepost.analyse`.
     """
     path, size = _checked(path)
