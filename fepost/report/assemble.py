@@ -298,7 +298,7 @@ PATCH_ROWS = (
 
 
 def _row(key, label, kind, definition, value, prefix):
-    from . import units
+    from ..figures import units
 
     unit = units.UNITS[kind] if kind and kind != "fraction" else ""
     return {

@@ -19,7 +19,8 @@ from ..table1 import DEFAULT_SEED, table1
 from . import samples
 from .assemble import _check_inflation_option, friction_curves, page_context, resolve_inflation_pressure
 from .figures import Figure, save_matplotlib, save_plotter
-from .sections import DEFAULT_SECTIONS, ReportData, SectionProvider, run_providers
+from .providers import DEFAULT_SECTIONS
+from .sections import ReportData, SectionProvider, run_providers
 
 Progress = Callable[[int, int, str, float], None]
 
@@ -126,7 +127,7 @@ def build_report(
         ``progress(k, n, step, seconds)``, called after each step.
     sections : sequence of section providers
         Optional sections (:mod:`fepost.report.sections`), default
-        :data:`~fepost.report.sections.DEFAULT_SECTIONS`.
+        :data:`~fepost.report.providers.DEFAULT_SECTIONS`.
 
     Raises
     ------

@@ -10,8 +10,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..report.units import display_unit
-from .trends import QUANTITIES, PowerLaw, groups
+from ..sweep.trends import QUANTITIES, PowerLaw, groups
+from .units import display_unit
 
 #: Panels of the time-step figure: column, label, unit.
 TIME_PANELS = (
@@ -54,7 +54,7 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
     import matplotlib.pyplot as plt
     from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
 
-    from ..figures.theme import mpl_style
+    from .theme import mpl_style
 
     quantities = [q for q in QUANTITIES if any(r.get(q[0]) is not None for r in rows)]
     with mpl_style():
@@ -121,7 +121,7 @@ def plot_time_trends(series: Mapping[str, Sequence[Mapping]]):
     """Panels of N, R, M0, aspect, aR², m/R² against time for each multi-step run."""
     import matplotlib.pyplot as plt
 
-    from ..figures.theme import mpl_style
+    from .theme import mpl_style
 
     with mpl_style():
         fig, axes = plt.subplots(2, 3, figsize=(12.6, 6.8), squeeze=False)
