@@ -50,9 +50,12 @@ class Analysis:
     @cached_property
     def model_summary(self):
         """The generalised friction model of these maps (:mod:`fepost.friction.summary`)."""
+        from .friction.law import FrictionLaw
         from .friction.summary import summarise
 
-        return summarise(self)
+        c, p = self.coefficients, self.static_patch
+        return summarise(self.static_map, c, FrictionLaw(f=c.f), rolling_map=self.rolling_map,
+                         circular=p.circular, aspect=p.aspect)  # fmt: skip
 
     def to_dict(self, model: bool = True) -> dict:
         """The coefficients JSON (SI units, keys in docs/formats.md), with provenance.

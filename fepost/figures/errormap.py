@@ -8,7 +8,7 @@ spin (ε = 0) to pure sliding (ε = ∞). One logarithmic colour scale for all
 panels, so the panels compare honestly; a contour marks the 3 % goal and each
 panel's title gives its largest error. The module computes nothing physical:
 the data come from :func:`fepost.friction.sphere.error_map`
-(:func:`fepost.friction.summary.analysis_error_map` for an analysed FE map).
+(`fepost.friction.summary.model_error_map` for an FE map).
 """
 
 from __future__ import annotations

@@ -229,13 +229,19 @@ def build_report(
 
         def error_maps():
             from ..figures.errormap import plot_error_map
-            from ..friction.summary import analysis_error_map
+            from ..friction.law import FrictionLaw
+            from ..friction.summary import model_error_map
 
             made, docs = {}, {}
             for stem, rolling in (("error_map", False), ("error_map_rolling", True)):
                 if rolling and a.rolling_map is None:
                     continue
-                em = analysis_error_map(a, rolling=rolling, **ERROR_MAP_GRID)
+                pmap = a.rolling_map if rolling else a.static_map
+                model = a.model_summary.rolling if rolling else a.model_summary.static
+                law = FrictionLaw(f=a.coefficients.f)
+                em = model_error_map(
+                    pmap, a.coefficients, law, model=model, rolling=rolling, **ERROR_MAP_GRID
+                )
                 key = stem.replace("_", "-")
                 alt = (
                     f"Error map of the {'rolling' if rolling else 'static'} map: "
