@@ -62,9 +62,9 @@ from .facegroups import (
 )
 from .facesums import FaceSums, face_loads, face_sums, load_outside, triangle_areas
 from .field import ContactField
-from .frame import Frame, _axes, _plane
+from .frame import Frame, fit_plane, patch_axes
 from .reader.units import check_scale
-from .regions import FRAGMENT_SHARE, _components, _separate_surfaces
+from .regions import FRAGMENT_SHARE, check_single_surface, loaded_regions
 from .regions import GAP_FRACTION as GAP_FRACTION  # the patch rules' tolerances, documented here
 
 DEFAULT_THRESHOLD = 1e-6
@@ -321,7 +321,7 @@ def build_patch(
             w = np.ones(len(pts_sel))
         if np.count_nonzero(w) < 3:
             raise PatchError(f"{src}: the contact patch has fewer than 3 loaded nodes")
-        c, normal, var = _plane(pts_sel, w)
+        c, normal, var = fit_plane(pts_sel, w)
         hz = np.abs(pts_sel @ normal - c @ normal)[w > 0]
         flat = bool(hz.max() <= 1e-9 * np.sqrt(var[2]))
         if var[1] <= LINE_TOL**2 * var[2]:
@@ -329,7 +329,7 @@ def build_patch(
                 f"{src}: the loaded nodes lie on one line: the contact is a line, not a patch "
                 "(a 2-D plane or axisymmetric model written as 3-D?); fepost needs a contact area"
             )
-        axes, axis_note = _axes(normal, rolling_axis, src)
+        axes, axis_note = patch_axes(normal, rolling_axis, src)
         if axis_note:
             notes.append(axis_note)
         base = Frame(origin=c, axes=axes)
@@ -388,7 +388,7 @@ def build_patch(
         previous = err
         level *= 2
 
-    ncomp, labels = _components(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)
+    ncomp, labels = loaded_regions(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)
     dropped = 0
     if ncomp > 1:
         loads = face_loads(geo.xy, geo.triangles, geo.values, fld.location)
@@ -461,7 +461,7 @@ def build_patch(
     r_equiv = float(np.sqrt(area / np.pi))
     rms = float(np.sqrt((weights @ (height * height)) / weights.sum()))
     if rms > PLANARITY_TOL * r_equiv:
-        _separate_surfaces(fld, groups, hot, points)
+        check_single_surface(fld, groups, hot, points)
         plane = "its best-fit plane" if frame is None else "the given frame's plane (the static patch's)"
         raise PatchError(
             f"{src}: the contact patch is not planar (RMS distance from {plane} "

@@ -58,7 +58,14 @@ LEGEND_SIZE = (0.36, 0.13)
 _NICE = (1.0, 2.0, 2.5, 5.0)
 
 
-def _check_pressure(inflation_pressure: float) -> float:
+def check_pressure(inflation_pressure: float) -> float:
+    """The inflation pressure P* (Pa) of a figure's p/P* axis, as a float.
+
+    Raises
+    ------
+    ArgumentError
+        ``inflation_pressure`` is not a finite positive number.
+    """
     p = float(inflation_pressure)
     if not (np.isfinite(p) and p > 0):
         raise ArgumentError(
@@ -79,7 +86,7 @@ def patch_mesh(
     """
     import pyvista as pv
 
-    p_star = _check_pressure(inflation_pressure)
+    p_star = check_pressure(inflation_pressure)
     xy = np.asarray(patch.xy, float)
     nodes = np.asarray(patch.node_values(), float) / p_star
     pts = np.column_stack([xy, height_scale * nodes])
@@ -155,7 +162,7 @@ def nice_ceil(x: float) -> float:
 def default_height_scale(*patches: Patch, inflation_pressure: float = DEFAULT_INFLATION_PRESSURE) -> float:
     """m of height per unit σ/P* so that the tallest of ``patches`` rises to
     :data:`HEIGHT_FRACTION` × its r_max."""
-    p_star = _check_pressure(inflation_pressure)
+    p_star = check_pressure(inflation_pressure)
     peak = max(float(np.max(p.node_values())) for p in patches) / p_star
     r = max(p.r_max for p in patches)
     return HEIGHT_FRACTION * r / peak if peak > 0 else 1.0
@@ -322,7 +329,7 @@ def pressure_surface(
     """
     import pyvista as pv
 
-    p_star = _check_pressure(inflation_pressure)
+    p_star = check_pressure(inflation_pressure)
     if not isinstance(patch, Patch):
         raise ArgumentError(f"patch must be a Patch, got {type(patch).__name__}")
     hs = (

@@ -16,7 +16,7 @@ from .._arrays import frozen
 from ..errors import ArgumentError
 from ..patch import Patch
 from . import theme
-from .render import DEFAULT_INFLATION_PRESSURE, _check_pressure, patch_mesh
+from .render import DEFAULT_INFLATION_PRESSURE, check_pressure, patch_mesh
 
 #: Points per diameter.
 N_SECTION = 401
@@ -85,7 +85,7 @@ def diameter_sections(
     ``half_length`` (m) of the diameters (default 1.1 × the largest distance of a
     patch node from the origin, so the curves reach zero).
     """
-    p_star = _check_pressure(inflation_pressure)
+    p_star = check_pressure(inflation_pressure)
     if int(n) != n or n < 3:
         raise ArgumentError(f"n must be an integer >= 3, got {n!r}")
     patches = [static] + ([rolling] if rolling is not None else [])

@@ -17,7 +17,7 @@ from ..analysis import analyse
 from ..output import staged_folder, to_json
 from ..table1 import DEFAULT_SEED, table1
 from . import samples
-from .assemble import _check_inflation_option, friction_curves, page_context, resolve_inflation_pressure
+from .assemble import check_inflation_option, friction_curves, page_context, resolve_inflation_pressure
 from .figures import Figure, save_matplotlib, save_plotter
 from .providers import DEFAULT_SECTIONS
 from .sections import ReportData, SectionProvider, run_providers
@@ -150,7 +150,7 @@ def build_report(
         static, rolling = samples.sample_inputs()
     out = Path(out)
     if inflation_pressure is not None:
-        _check_inflation_option(inflation_pressure)
+        check_inflation_option(inflation_pressure)
     has_roll = rolling is not None
     steps = _Steps(total=12 + (1 if has_roll else 0), progress=progress)
     inputs = [Path(p) for p in (static, rolling) if isinstance(p, str | os.PathLike)]
