@@ -237,6 +237,96 @@ def _validate(curves: TestCurves, N) -> float:
     return N
 
 
+def _problem(curves: TestCurves, form) -> _Problem:
+    """The three curves as one least-squares problem, with their data scales."""
+    n1, n2 = curves.psi.size, curves.upsilon.size
+    slices = (slice(0, n1), slice(n1, n1 + n2), slice(n1 + n2, n1 + 2 * n2))
+    y = np.concatenate([curves.f_parallel, curves.torque, curves.f_perp])
+    scales = [float(np.max(np.abs(y[s]))) for s in slices]
+    return _Problem(
+        curves.psi,
+        curves.upsilon,
+        y,
+        slices,
+        curves.R,
+        sF=scales[0] if scales[0] > 0 else 1.0,
+        sM=scales[1] if scales[1] > 0 else 1.0,
+        form=PAPER if form is None else form,
+    )
+
+
+@dataclass(frozen=True)
+class _Weighted:
+    """The fit with the converged weights: the solver's result, the weights per point, each
+    curve's noise level σ_c and share h_c of the parameters, the model evaluations."""
+
+    result: Any
+    weights: np.ndarray
+    sigma: np.ndarray
+    share: np.ndarray
+    nfev: int
+
+
+def _weighted_fit(prob: _Problem, *, max_nfev: int | None) -> _Weighted:
+    """Fit and σ_c iterated to a fixed point, then the final solve with the converged weights."""
+    y, slices = prob.y, prob.slices
+    scales = [float(np.max(np.abs(y[s]))) for s in slices]
+    theta = _initial(prob)
+    floor = np.array([SIGMA_FLOOR * (s if s > 0 else 1.0) for s in scales])
+    counts = np.array([s.stop - s.start for s in slices], float)
+    # Starting weights: each curve's own RSS at the initial guess.
+    r0 = prob.model(theta) - y
+    sigma = np.maximum([math.sqrt(np.mean(r0[s] ** 2)) for s in slices], floor)
+    nfev = 0
+    for _ in range(REWEIGHT_MAX):
+        w = np.concatenate([np.full(int(c), 1.0 / sg) for c, sg in zip(counts, sigma, strict=True)])
+        res = _solve(prob, theta, w, max_nfev)
+        theta, nfev = res.x, nfev + res.nfev
+        h = leverage(res.jac)
+        r = prob.model(theta) - y
+        share = np.array([h[s].sum() for s in slices])
+        dof_c = np.maximum(counts - share, 0.5)
+        new = np.maximum(
+            [math.sqrt(np.sum(r[s] ** 2) / d) for s, d in zip(slices, dof_c, strict=True)], floor
+        )
+        done = np.all(np.abs(new - sigma) <= REWEIGHT_RTOL * sigma)
+        sigma = new
+        if done:
+            break
+    # Final solve with the converged weights (so the fit and the weights agree).
+    w = np.concatenate([np.full(int(c), 1.0 / sg) for c, sg in zip(counts, sigma, strict=True)])
+    res = _solve(prob, theta, w, max_nfev)
+    return _Weighted(res, w, sigma, share, nfev + res.nfev)
+
+
+def _profile_bounds(
+    prob: _Problem, *, theta, w, chi2: float, delta: float, wald, ci, max_nfev: int | None
+) -> tuple[dict[str, tuple[float, float]], dict[str, bool]]:
+    """Profile-likelihood 95 % bounds of a and m, and whether each agrees with its Wald interval."""
+    lo_t, hi_t = wald
+    prof: dict[str, tuple[float, float]] = {}
+    agree: dict[str, bool] = {}
+    for j, name in ((2, "a"), (3, "m")):
+        try:
+            lo, hi = _profile(prob, theta, w, j, chi2, delta, (lo_t[j], hi_t[j]), max_nfev)
+        except FitError as exc:
+            warnings.warn(
+                f"profile bounds of {name} not computed (a re-fit failed: {exc}); set to NaN",
+                FitWarning,
+                stacklevel=3,
+            )
+            prof[name], agree[name] = (math.nan, math.nan), False
+            continue
+        plo, phi = (
+            math.exp(lo) if np.isfinite(lo) else 0.0,
+            math.exp(hi) if np.isfinite(hi) else math.inf,
+        )
+        prof[name] = (plo, phi)
+        half = 0.5 * (ci[j, 1] - ci[j, 0])
+        agree[name] = bool(max(abs(plo - ci[j, 0]), abs(phi - ci[j, 1])) <= PROFILE_TOLERANCE * half)
+    return prof, agree
+
+
 def fit_table1(
     curves: TestCurves,
     N: float,
@@ -262,46 +352,11 @@ def fit_table1(
         raise ArgumentError(
             f"form must be a curve form (PaperCurves, GeneralisedCurves), got {type(form).__name__}"
         )
-    n1, n2 = curves.psi.size, curves.upsilon.size
-    slices = (slice(0, n1), slice(n1, n1 + n2), slice(n1 + n2, n1 + 2 * n2))
-    y = np.concatenate([curves.f_parallel, curves.torque, curves.f_perp])
-    scales = [float(np.max(np.abs(y[s]))) for s in slices]
-    prob = _Problem(
-        curves.psi,
-        curves.upsilon,
-        y,
-        slices,
-        curves.R,
-        sF=scales[0] if scales[0] > 0 else 1.0,
-        sM=scales[1] if scales[1] > 0 else 1.0,
-        form=PAPER if form is None else form,
-    )
-    theta = _initial(prob)
-    floor = np.array([SIGMA_FLOOR * (s if s > 0 else 1.0) for s in scales])
-    counts = np.array([n1, n2, n2], float)
-    # Starting weights: each curve's own RSS at the initial guess.
-    r0 = prob.model(theta) - y
-    sigma = np.maximum([math.sqrt(np.mean(r0[s] ** 2)) for s in slices], floor)
-    nfev = 0
-    for _ in range(REWEIGHT_MAX):
-        w = np.concatenate([np.full(int(c), 1.0 / sg) for c, sg in zip(counts, sigma, strict=True)])
-        res = _solve(prob, theta, w, max_nfev)
-        theta, nfev = res.x, nfev + res.nfev
-        h = leverage(res.jac)
-        r = prob.model(theta) - y
-        share = np.array([h[s].sum() for s in slices])
-        dof_c = np.maximum(counts - share, 0.5)
-        new = np.maximum(
-            [math.sqrt(np.sum(r[s] ** 2) / d) for s, d in zip(slices, dof_c, strict=True)], floor
-        )
-        done = np.all(np.abs(new - sigma) <= REWEIGHT_RTOL * sigma)
-        sigma = new
-        if done:
-            break
-    # Final solve with the converged weights (so the fit and the weights agree).
-    w = np.concatenate([np.full(int(c), 1.0 / sg) for c, sg in zip(counts, sigma, strict=True)])
-    res = _solve(prob, theta, w, max_nfev)
-    theta, nfev = res.x, nfev + res.nfev
+    prob = _problem(curves, form)
+    y, slices = prob.y, prob.slices
+    weighted = _weighted_fit(prob, max_nfev=max_nfev)
+    res, w, sigma, share = weighted.result, weighted.weights, weighted.sigma, weighted.share
+    theta, nfev = res.x, weighted.nfev
     J = res.jac
     n, p = y.size, len(PARAMETERS)
     dof = n - p
@@ -328,25 +383,9 @@ def fit_table1(
             stacklevel=2,
         )
     elif profile:
-        delta = s2 * tq**2
-        for j, name in ((2, "a"), (3, "m")):
-            try:
-                lo, hi = _profile(prob, theta, w, j, chi2, delta, (lo_t[j], hi_t[j]), max_nfev)
-            except FitError as exc:
-                warnings.warn(
-                    f"profile bounds of {name} not computed (a re-fit failed: {exc}); set to NaN",
-                    FitWarning,
-                    stacklevel=2,
-                )
-                prof[name], agree[name] = (math.nan, math.nan), False
-                continue
-            plo, phi = (
-                math.exp(lo) if np.isfinite(lo) else 0.0,
-                math.exp(hi) if np.isfinite(hi) else math.inf,
-            )
-            prof[name] = (plo, phi)
-            half = 0.5 * (ci[j, 1] - ci[j, 0])
-            agree[name] = bool(max(abs(plo - ci[j, 0]), abs(phi - ci[j, 1])) <= PROFILE_TOLERANCE * half)
+        prof, agree = _profile_bounds(
+            prob, theta=theta, w=w, chi2=chi2, delta=s2 * tq**2, wald=(lo_t, hi_t), ci=ci, max_nfev=max_nfev
+        )
     resid = {name: -res.fun[s] / w[s] for name, s in zip(CURVES, slices, strict=True)}
     return Identification(
         values=values,
