@@ -121,7 +121,7 @@ def cut_faces(fld: ContactField, *, values: np.ndarray, thr: float, groups, base
     while True:
         pts, tri, vals, parent = _triangles(fld, values=values, thr=thr, groups=groups, level=level)
         geo = project_faces(src, pts, tri, vals, fld.location, thr, base)
-        if parent is None:
+        if parent is None or xy_native is None:  # linear triangles as read (then both are None)
             break
         exact = exact_load(groups, xy_native, values, fld.location)
         err = abs(geo.sums.N / exact[0] - 1.0)
@@ -169,7 +169,7 @@ def drop_fragments(fld: ContactField, *, cut: Cut, values: np.ndarray, thr: floa
         groups = [g.subset(np.isin(g.ids, kept_ids)) for g in groups]
         groups = [g for g in groups if len(g.conn)]
     geo = project_faces(src, geo.points, tri_kept, vals_kept, fld.location, thr, base)
-    if cut.parent is not None:
+    if cut.parent is not None and cut.xy_native is not None:
         exact = exact_load(groups, cut.xy_native, values, fld.location)
     return cut._replace(geo=geo, groups=groups, exact=exact, dropped=dropped)
 

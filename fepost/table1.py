@@ -351,7 +351,13 @@ def table1(
     truth = {"F0": c.F0, "M0": c.M0, "a": c.a, "m": c.m, "k_x": kx, "R": c.R, "N": c.N}
     quad = PressureQuadrature.from_polar(analysis.static_map)
     # the experiment's design: the same points, noise and seed for every set of curves
-    design = {"n_points": n_points, "span": span, "noise": noise, "amplitude": amplitude, "seed": seed}
+    design: dict[str, Any] = {
+        "n_points": n_points,
+        "span": span,
+        "noise": noise,
+        "amplitude": amplitude,
+        "seed": seed,
+    }
     curves = make_test_curves(source, truth, quad=quad, rolling_quad=rolling_quad, **design)
     fit = fit_table1(curves, c.N, profile=profile)
     report = approximation_bias(truth, quad, rolling_quad=rolling_quad, **design) if bias else None

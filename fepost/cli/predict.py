@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     kin = read_kinematics(args.kinematics)  # bad CSV: fail before the FE work
     result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
     rolling = result.rolling_map is not None
-    pmap = result.rolling_map if rolling else result.static_map
+    pmap = result.rolling_map if result.rolling_map is not None else result.static_map
     law = FrictionLaw(f=result.coefficients.f)
     c = result.coefficients
     pred = predict(kin.vx, kin.vy, kin.wz, pmap=pmap, coefficients=c, law=law, rolling=rolling)

@@ -314,7 +314,7 @@ def _add_axes(plotter, *, ext: float, z_range: float, z_step: float, hs: float, 
     tick = 0.04 * ext
     xy_ticks = nice_ticks(-ext, ext)
     label, head, legend = placed
-    occupied = (text_box(label, renderer), text_box(head, renderer))
+    occupied: tuple = (text_box(label, renderer), text_box(head, renderer))
     occupied += (viewport_box(legend, renderer), viewport_box(plotter.scalar_bar, renderer))
 
     def axis(ticks, occupied, start, direction, outward, offset, h, v, scale=1.0):

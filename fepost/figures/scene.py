@@ -53,7 +53,7 @@ def tick_labels(values) -> list[str]:
     """Labels of round tick ``values`` with the fewest decimals that tell them apart
     (``0`` for zero, a true minus sign)."""
     values = np.asarray(values, float)
-    for decimals in range(0, 7):
+    for decimals in range(7):
         texts = [f"{v:.{decimals}f}" for v in values]
         if all(abs(float(t) - v) <= 1e-9 * max(1.0, abs(v)) for t, v in zip(texts, values, strict=True)):
             break

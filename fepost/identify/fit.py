@@ -32,6 +32,12 @@ Statistics (all from scipy; nothing hand-rolled in the fit)
 
 The form is the paper's closed forms by default, or the generalised model
 (:class:`~fepost.identify.forms.GeneralisedCurves`).
+
+Why scipy and not lmfit: the fit needs the weighted Jacobian itself (its SVD for
+the covariance and the condition check, its hat matrix for each curve's share
+h_c of the parameters) and re-fits with fixed weights for the profile bounds;
+lmfit would wrap the same ``least_squares`` solver and keep the Jacobian out of
+reach, so fepost does not depend on it.
 """
 
 from __future__ import annotations
