@@ -201,6 +201,20 @@ def analyse(
     or block) are passed to :func:`fepost.reader.read_contact`. N_fe is checked
     against the solver's reaction where the export carries one (warning above
     :data:`REACTION_TOL`).
+
+    Examples
+    --------
+    >>> import fepost
+    >>> res = fepost.analyse("meshes/static.vtu")   # the CalculiX sample of the repository
+    >>> c = res.coefficients
+    >>> round(c.N), round(c.R, 4)                    # normal load (N), R = r_max (m)
+    (12900, 0.1202)
+    >>> round(c.N / res.static_field.reaction_z, 3)  # against the solver's own reaction
+    1.0
+    >>> round(float(c.F0 / c.N), 6)                  # F0 = f N, default f = 0.3
+    0.3
+    >>> bool(res.static_patch.circular), round(res.static_patch.aspect, 2)
+    (False, 1.16)
     """
     grid = grid or PolarGrid.make()
     units = unit_system(units)

@@ -159,11 +159,15 @@ def predict(
     >>> import fepost
     >>> from fepost.friction.law import FrictionLaw
     >>> from fepost.friction.predict import predict
-    >>> an = fepost.analyse("meshes/static.vtu", grid=fepost.PolarGrid.make(12, 24))
+    >>> an = fepost.analyse("meshes/static.vtu")
     >>> pred = predict([0.1, 0.0], [0.0, 0.0], [0.0, 1.0], pmap=an.static_map,
     ...                coefficients=an.coefficients, law=FrictionLaw(f=0.3))
-    >>> pred.map, sorted(pred.columns())[:3]
-    ('static', ['Fx_exact', 'Fx_model', 'Fx_paper'])
+    >>> pred.map
+    'static'
+    >>> round(float(pred.exact.Fx[0] / an.coefficients.F0), 6)   # pure sliding: exactly −f N
+    -1.0
+    >>> round(float(pred.exact.Mz[1] / an.coefficients.M0), 6)   # pure spin: exactly −M0
+    -1.0
     """
     from .summary import check_map_values, map_model, paper_k_x
 
