@@ -1,5 +1,5 @@
-"""The figures' rough edges a new user met: the error map's heading, the sweep's legends,
-Figure 3's r_max lines."""
+"""The rough edges a new user met: the error map's heading, the sweep's legends,
+Figure 3's r_max lines, the model builder without its extra."""
 
 from __future__ import annotations
 
@@ -145,3 +145,19 @@ def test_figure3_static_only_draws_one_radius(aircraft):
     fig = plot_sections(sec)
     gids = {ln.get_gid() for ax in fig.axes for ln in ax.get_lines()}
     assert "rmax_x_plus" in gids and not any(g and g.startswith("rmax_rolling") for g in gids)
+
+
+def test_model_builder_without_gmsh_names_the_extra(monkeypatch, capsys, tmp_path):
+    """Tutorial step 1 after `make demo` (no 'model' extra): one line that says what to install."""
+    import sys
+
+    from scripts.tiremodel import __main__ as tiremodel
+
+    monkeypatch.setitem(sys.modules, "gmsh", None)  # as if gmsh were not installed
+    monkeypatch.setattr(tiremodel, "find_ccx", lambda: "ccx")  # the solver is not what is missing
+    code = tiremodel.main(["build", "--case", "static", "--coarse", "--out", str(tmp_path / "tire")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1 and err[-1] == (
+        "tiremodel: error: no Python module 'gmsh': install the model extra: pip install -e '.[model]'"
+    )
+    assert not (tmp_path / "tire").exists()
