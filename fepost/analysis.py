@@ -54,8 +54,10 @@ class Analysis:
         from .friction.summary import summarise
 
         c, p = self.coefficients, self.static_patch
-        return summarise(self.static_map, c, FrictionLaw(f=c.f), rolling_map=self.rolling_map,
-                         circular=p.circular, aspect=p.aspect)  # fmt: skip
+        law = FrictionLaw(f=c.f)
+        return summarise(
+            self.static_map, c, law, rolling_map=self.rolling_map, circular=p.circular, aspect=p.aspect
+        )
 
     def to_dict(self, model: bool = True) -> dict:
         """The coefficients JSON (SI units, keys in docs/formats.md), with provenance.
