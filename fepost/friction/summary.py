@@ -204,8 +204,22 @@ def summarise(
 ) -> ModelSummary:
     """The `ModelSummary` of a static map (and of its rolling map, when given).
 
-    ``circular`` and ``aspect`` describe the static patch (they choose the
-    recommendation). Builds the models with `map_model`: about a second.
+    Builds the models with `map_model`: about a second.
+
+    Parameters
+    ----------
+    static_map : PolarMap
+        The static map.
+    coefficients : Coefficients
+        The paper's coefficients of the maps.
+    law : FrictionLaw
+        The friction law.
+    rolling_map : PolarMap, optional
+        The rolling map in the static patch's frame.
+    circular, aspect : bool, float
+        The static patch's circularity verdict and aspect (they choose the recommendation).
+    order : "auto" or (K, L)
+        Order of the models' correction.
     """
     static = map_model(static_map, coefficients, law, order=order)
     rolling = None
@@ -233,10 +247,26 @@ def model_error_map(
     """The error of the paper's closed forms, the generalised base and ``model`` over the
     kinematic sphere of the map ``pmap``, scaled by the coefficients' F0 and M0.
 
-    ``model`` is the generalised model of ``pmap`` (`map_model`, or the one of
-    an analysis's ``model_summary``); ``rolling``: ``pmap`` is the rolling map
-    (the closed forms include k_x). Returns a ``fepost.friction.sphere.ErrorMap``
-    (the data of ``fepost.figures.errormap.plot_error_map``).
+    Parameters
+    ----------
+    pmap : PolarMap
+        The static map, or the rolling map in the static patch's frame.
+    coefficients : Coefficients
+        The paper's coefficients (F0, M0, a, m, k_x, R).
+    law : FrictionLaw
+        The friction law of the exact integrals.
+    model : GeneralisedModel
+        The generalised model of ``pmap`` (`map_model`, or the one of an
+        analysis's ``model_summary``).
+    rolling : bool
+        ``pmap`` is the rolling map: the closed forms include k_x.
+    n_beta, n_t : int
+        Points of the grid over the sliding direction and over ε.
+
+    Returns
+    -------
+    ErrorMap
+        ``fepost.friction.sphere.ErrorMap``: the data of ``fepost.figures.errormap.plot_error_map``.
     """
     from .sphere import error_map
 
