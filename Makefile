@@ -69,8 +69,10 @@ test: $(TEST_STAMP) system-deps-test
 docs: $(TEST_STAMP)
 	$(VENV)/bin/mkdocs build --strict --site-dir site
 
+# ruff (rules and the reasons for each ignored one in pyproject.toml), the formatting, mypy
 lint: $(TEST_STAMP)
 	$(VENV)/bin/ruff check fepost tests scripts benchmarks docs
+	$(VENV)/bin/ruff format --check fepost tests scripts benchmarks
 	$(VENV)/bin/mypy fepost
 
 bench: $(TEST_STAMP)

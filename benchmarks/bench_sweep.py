@@ -112,22 +112,24 @@ def in_process(paths: list[Path], scratch: Path) -> Timer:
 
 
 def sweep(paths: list[Path], out: Path, pids=None, **kw) -> Timer:
+    from fepost.report.sweeppage import write_trends
     from fepost.sweep import run_sweep
 
     shutil.rmtree(out, ignore_errors=True)
     with Timer(pids or [os.getpid()]) as t:
-        res = run_sweep([str(p) for p in paths], out, progress=False, **kw)
+        res = run_sweep([str(p) for p in paths], out, progress=False, trends=write_trends, **kw)
     assert res.ok and res.computed == len(paths), res.to_dict()
     return t
 
 
 def whole_command(paths: list[Path], out: Path, workers: int) -> Timer:
     """``run_sweep(workers=N)``: cluster start, sweep, stop. CPU: this process and its waited children."""
+    from fepost.report.sweeppage import write_trends
     from fepost.sweep import run_sweep
 
     shutil.rmtree(out, ignore_errors=True)
     t0, w0 = os.times(), time.perf_counter()
-    res = run_sweep([str(p) for p in paths], out, progress=False, workers=workers)
+    res = run_sweep([str(p) for p in paths], out, progress=False, workers=workers, trends=write_trends)
     t1 = os.times()
     assert res.ok and res.computed == len(paths), res.to_dict()
     t = Timer()

@@ -50,9 +50,14 @@ class Analysis:
     @cached_property
     def model_summary(self):
         """The generalised friction model of these maps (:mod:`fepost.friction.summary`)."""
+        from .friction.law import FrictionLaw
         from .friction.summary import summarise
 
-        return summarise(self)
+        c, p = self.coefficients, self.static_patch
+        law = FrictionLaw(f=c.f)
+        return summarise(
+            self.static_map, c, law, rolling_map=self.rolling_map, circular=p.circular, aspect=p.aspect
+        )
 
     def to_dict(self, model: bool = True) -> dict:
         """The coefficients JSON (SI units, keys in docs/formats.md), with provenance.
@@ -198,6 +203,20 @@ def analyse(
     or block) are passed to :func:`fepost.reader.read_contact`. N_fe is checked
     against the solver's reaction where the export carries one (warning above
     :data:`REACTION_TOL`).
+
+    Examples
+    --------
+    >>> import fepost
+    >>> res = fepost.analyse("meshes/static.vtu")   # the CalculiX sample of the repository
+    >>> c = res.coefficients
+    >>> round(c.N), round(c.R, 4)                    # normal load (N), R = r_max (m)
+    (12900, 0.1202)
+    >>> round(c.N / res.static_field.reaction_z, 3)  # against the solver's own reaction
+    1.0
+    >>> round(float(c.F0 / c.N), 6)                  # F0 = f N, default f = 0.3
+    0.3
+    >>> bool(res.static_patch.circular), round(res.static_patch.aspect, 2)
+    (False, 1.16)
     """
     grid = grid or PolarGrid.make()
     units = unit_system(units)

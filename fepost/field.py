@@ -56,6 +56,10 @@ class ContactField:
         The unit system the file was read in (None: SI assumed, not given).
     notes : tuple[str, ...]
         What the reader chose or assumed (shown beside the results).
+    format : str
+        The file format read.
+    displacement : str | None
+        The nodal displacement array added to the coordinates (None: none was).
     """
 
     source: str
@@ -76,6 +80,7 @@ class ContactField:
     units: Any = None
     notes: tuple[str, ...] = ()
     format: str = ""
+    displacement: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", frozen(self.points))

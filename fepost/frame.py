@@ -47,12 +47,27 @@ def _fmt(v) -> str:
     return "(" + ", ".join(f"{float(x):.3g}" for x in a) + ")"
 
 
-def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Weighted least-squares plane through ``points`` (n, 3): (centroid, unit normal, variances).
+def fit_plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Weighted least-squares plane through ``points``.
 
     The second moments are accumulated column by column (one (n,) temporary)
-    about a node of the patch, so large global offsets cost no precision. The
-    variances (ascending) are those along the normal and the two in-plane axes.
+    about a node of the patch, so large global offsets cost no precision.
+
+    Parameters
+    ----------
+    points : ndarray, shape (n, 3)
+        The points (global coordinates).
+    weights : ndarray, shape (n,)
+        Non-negative weights (the patch uses the nodal loads); their sum must be positive.
+
+    Returns
+    -------
+    centroid : ndarray, shape (3,)
+        The weighted centroid.
+    normal : ndarray, shape (3,)
+        Unit normal of the plane, its largest component positive.
+    variances : ndarray, shape (3,)
+        Weighted variances, ascending: along the normal, then the two in-plane axes.
     """
     w = weights / weights.sum()
     ref = points[int(np.argmax(weights))]
@@ -77,8 +92,32 @@ def _plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndar
 _AXIS_NAMES = ("x", "y", "z")
 
 
-def _axes(normal: np.ndarray, rolling_axis, source: str = "") -> tuple[np.ndarray, str]:
-    """Rows x, y, z of the patch frame, and a note when the default axis had to be replaced."""
+def patch_axes(normal: np.ndarray, rolling_axis, source: str = "") -> tuple[np.ndarray, str]:
+    """The patch frame's axes for a plane of unit ``normal``.
+
+    Parameters
+    ----------
+    normal : ndarray, shape (3,)
+        Unit normal of the patch plane (the frame's z).
+    rolling_axis : array_like of 3 floats or None
+        The rolling direction (projected into the plane); None: global x, or
+        the global axis closest to the plane when x is normal to it (then a
+        `PatchWarning` is issued and returned as the note).
+    source : str
+        Names the map in the warning.
+
+    Returns
+    -------
+    axes : ndarray, shape (3, 3)
+        Rows x, y, z of the patch frame (right-handed, orthonormal).
+    note : str
+        Why the default axis was replaced ("" when it was not).
+
+    Raises
+    ------
+    ArgumentError
+        ``rolling_axis`` is not a non-zero finite 3-vector, or is (nearly) normal to the plane.
+    """
     note = ""
     if rolling_axis is None:
         ax = np.array([1.0, 0.0, 0.0])

@@ -34,7 +34,7 @@ Rejected (:class:`~fepost.errors.PatchError` / :class:`~fepost.errors.PressureEr
 all-zero pressure, NaN inside the patch, negative nodal pressures below −1 % of
 the peak, several patches each carrying more than 1 % of the load (side by side,
 or on parallel surfaces), a patch whose RMS distance from its plane exceeds
-:data:`PLANARITY_TOL` × r_equiv, loaded nodes on one line (a line contact), and
+:data:`PLANARITY_TOL` × R (R = r_max, as documented), loaded nodes on one line (a line contact), and
 implausible scales (:func:`fepost.reader.units.check_scale`).
 Repaired with a warning: NaN away from the patch and small negative values
 (set to zero), fragments under 1 % of the load (dropped).
@@ -49,33 +49,26 @@ from typing import NamedTuple
 import numpy as np
 
 from ._arrays import frozen, sealed
-from .errors import ArgumentError, DimensionError, PatchError, PatchWarning, PressureError, PressureWarning
-from .facegroups import (
-    STEEP_DEG,
-    drop_edge_faces,
-    exact_load,
-    folded_faces,
-    loaded_groups,
-    next_triangles,
-    only_triangles,
-    refine,
-)
-from .facesums import FaceSums, face_loads, face_sums, load_outside, triangle_areas
+from .errors import ArgumentError, DimensionError, PatchError, PressureError, PressureWarning
+from .facegroups import STEEP_DEG, drop_edge_faces, loaded_groups
+from .facesums import FaceSums, load_outside, triangle_areas
 from .field import ContactField
-from .frame import Frame, _axes, _plane
+from .frame import Frame, fit_plane, patch_axes
+
+# the patch rules' tolerances, documented here
+from .patchfaces import REFINE_MAX_TRIANGLES as REFINE_MAX_TRIANGLES
+from .patchfaces import REFINE_TOL as REFINE_TOL
+from .patchfaces import cut_faces, drop_fragments, patch_load
+from .reader.names import DISPLACEMENT_NAMES, norm
 from .reader.units import check_scale
-from .regions import FRAGMENT_SHARE, _components, _separate_surfaces
-from .regions import GAP_FRACTION as GAP_FRACTION  # the patch rules' tolerances, documented here
+from .regions import GAP_FRACTION as GAP_FRACTION
+from .regions import check_single_surface
 
 DEFAULT_THRESHOLD = 1e-6
 ASPECT_TOL = 0.10
 RMAX_TOL = 1.15
 PLANARITY_TOL = 0.02
 NEGATIVE_TOL = 0.01
-#: Largest |load of the triangles / exact element load − 1| before the faces are cut finer.
-REFINE_TOL = 1e-4
-#: Most triangles the cut of curved faces may make (the finest level stays within it).
-REFINE_MAX_TRIANGLES = 4_000_000
 #: Loaded nodes spanning less than this fraction of their length across are on a line.
 LINE_TOL = 1e-6
 
@@ -235,38 +228,114 @@ def _validate_values(fld: ContactField) -> tuple[np.ndarray, float]:
     return (v if v is fld.values else sealed(v)), peak
 
 
-class _Geometry(NamedTuple):
-    points: np.ndarray
-    triangles: np.ndarray
-    values: np.ndarray
-    xy: np.ndarray  # (n, 2) in-plane coordinates in the base frame (m)
-    z: np.ndarray  # distance from the base plane (m)
-    weights: np.ndarray  # per node: the pressure where loaded, else 0 (face data: 1)
-    sums: FaceSums
+class _Plane(NamedTuple):
+    """The base frame of the patch: fitted (origin on the plane) or given."""
+
+    frame: Frame
+    flat: bool  # every loaded node on the plane to round-off
+    note: str  # why the default rolling axis was replaced ("" when it was not)
 
 
-def _geometry(source, points, tri, vals, location, thr, base: Frame) -> _Geometry:
-    """Compact the nodes of ``tri``, project them into ``base`` and integrate."""
-    used_mask = np.zeros(len(points), bool)
-    used_mask[tri.ravel()] = True
-    if used_mask.all():
-        pts, tri_local, nvals = points, tri, vals
+def _hot_nodes(fld: ContactField, values: np.ndarray, thr: float, groups) -> np.ndarray:
+    """Nodes loaded above the threshold (face data: the nodes of the loaded faces)."""
+    if fld.location == "point":
+        return values > thr
+    hot = np.zeros(fld.n_points, bool)
+    for g in groups:
+        hot[g.conn.ravel()] = True
+    return hot
+
+
+def _fit_frame(fld: ContactField, *, values: np.ndarray, thr: float, groups, rolling_axis) -> _Plane:
+    """The plane of the loaded nodes (their pressure as weights) and its axes."""
+    src, points = fld.source, fld.points
+    if len(groups) == 1 and len(groups[0].conn) == len(fld.triangles) and fld.location == "point":
+        sel = None  # every face loaded: weigh all nodes (zero weight off the patch)
     else:
-        used = np.flatnonzero(used_mask)
-        remap = np.cumsum(used_mask) - 1
-        tri_local = sealed(remap[tri])  # new here: the patch shares it
-        pts = points[used]
-        nvals = vals[used] if location == "point" else vals
-    w = np.where(nvals > thr, nvals, 0.0) if location == "point" else np.ones(len(pts))
-    # patch coordinates: (pts − o)·e_k = pts·e_k − o·e_k
-    xy = pts @ base.axes[:2].T
-    xy -= base.origin @ base.axes[:2].T
-    z = pts @ base.axes[2]
-    z -= base.origin @ base.axes[2]
-    sums = face_sums(xy[:, 0], xy[:, 1], tri_local, nvals, location)
-    if not sums.N > 0:
-        raise PatchError(f"{source}: the contact patch carries no load")
-    return _Geometry(pts, tri_local, nvals, xy, z, w, sums)
+        mask = np.zeros(fld.n_points, bool)
+        for g in groups:
+            mask[g.conn.ravel()] = True
+        sel = np.flatnonzero(mask)
+    pts_sel = points if sel is None else points[sel]
+    if fld.location == "point":
+        vs = values if sel is None else values[sel]
+        w = np.where(vs > thr, vs, 0.0)
+    else:
+        w = np.ones(len(pts_sel))
+    if np.count_nonzero(w) < 3:
+        raise PatchError(f"{src}: the contact patch has fewer than 3 loaded nodes")
+    c, normal, var = fit_plane(pts_sel, w)
+    hz = np.abs(pts_sel @ normal - c @ normal)[w > 0]
+    flat = bool(hz.max() <= 1e-9 * np.sqrt(var[2]))
+    if var[1] <= LINE_TOL**2 * var[2]:
+        raise DimensionError(
+            f"{src}: the loaded nodes lie on one line: the contact is a line, not a patch "
+            "(a 2-D plane or axisymmetric model written as 3-D?); fepost needs a contact area"
+        )
+    axes, axis_note = patch_axes(normal, rolling_axis, src)
+    return _Plane(Frame(origin=c, axes=axes), flat, axis_note)
+
+
+class _Ellipse(NamedTuple):
+    semi: np.ndarray  # major, minor semi-axis (m)
+    angle: float  # of the major axis to x, in (−π/2, π/2]
+    aspect: float
+
+
+def _ellipse(sums: FaceSums) -> _Ellipse:
+    """The best-fit ellipse: the same second moments of area as the loaded faces."""
+    evals, evecs = np.linalg.eigh(sums.covariance())
+    evals = np.clip(evals, 0.0, None)
+    semi = 2.0 * np.sqrt(evals[::-1])  # major, minor
+    major = evecs[:, 1]
+    angle = float(np.arctan2(major[1], major[0]))
+    angle = (angle + np.pi / 2) % np.pi - np.pi / 2
+    aspect = float(semi[0] / semi[1]) if semi[1] > 0 else np.inf
+    return _Ellipse(semi, angle, aspect)
+
+
+def _not_planar_hint(fld: ContactField, *, given_frame: bool) -> str:
+    """What a non-planar patch most likely means, from what the reader did with displacements."""
+    if fld.displacement is None:
+        named = [a for a in fld.arrays if norm(a) in DISPLACEMENT_NAMES]
+        if named:
+            return f"are the coordinates undeformed? try --displacement {named[0]}"
+        done = "the file has no displacement array to apply"
+    else:
+        done = f"the displacements {fld.displacement!r} were applied"
+    if given_frame:
+        return (
+            f"{done}: is the rolling map at the static map's deflection, in the same coordinates, "
+            "on a flat road?"
+        )
+    return (
+        f"{done}: the contact surface itself is curved (e.g. a cylindrical interface); fepost needs "
+        "a flat tire-road contact patch"
+    )
+
+
+def _check_planar(fld: ContactField, *, rms: float, r_max: float, given_frame: bool, groups, hot) -> None:
+    """Refuse a patch farther from its plane than `PLANARITY_TOL` × R (R = r_max, the
+    documented patch radius); loaded faces on several surfaces are named as such first."""
+    if rms <= PLANARITY_TOL * r_max:
+        return
+    check_single_surface(fld, groups, hot, fld.points)
+    plane = "the given frame's plane (the static patch's)" if given_frame else "its best-fit plane"
+    raise PatchError(
+        f"{fld.source}: the contact patch is not planar (RMS distance from {plane} "
+        f"{rms:.3g} m = {rms / r_max:.1%} of R = r_max {r_max:.4g} m, limit {PLANARITY_TOL:.0%}); "
+        + _not_planar_hint(fld, given_frame=given_frame)
+    )
+
+
+def _in_frame(xy: np.ndarray, *, cop: np.ndarray, centroid: np.ndarray, base: Frame, given: bool):
+    """(frame, in-plane coordinates, centre of pressure, centroid) in the patch frame: a fitted
+    base frame moves to the centre of pressure; a given frame stays (the centre of pressure is
+    then reported relative to it)."""
+    if given:
+        return base, xy, (float(cop[0]), float(cop[1])), centroid
+    fr = Frame(origin=base.to_global(cop[None, :])[0], axes=base.axes)  # on the plane: local z = 0
+    return fr, xy - cop, (0.0, 0.0), centroid - cop
 
 
 def build_patch(
@@ -280,6 +349,8 @@ def build_patch(
 
     Parameters
     ----------
+    fld : ContactField
+        The FE contact-pressure field (``fepost.reader.read_contact``).
     threshold : float
         Relative pressure threshold (fraction of the peak) that defines "loaded".
     rolling_axis : 3-vector, optional
@@ -287,6 +358,11 @@ def build_patch(
     frame : Frame, optional
         Use this frame (e.g. the static patch's, for a rolling map) instead of
         fitting one; the centre of pressure is then reported relative to it.
+
+    Returns
+    -------
+    Patch
+        The loaded region in its frame, with R = r_max, N_fe and the circularity check.
     """
     if not (0.0 <= threshold < 1.0):
         raise ArgumentError(f"threshold must be a fraction of the peak pressure in [0, 1), got {threshold!r}")
@@ -296,184 +372,34 @@ def build_patch(
     groups = loaded_groups(fld, v, thr)
     if not groups:
         raise PatchError(f"{src}: no element face carries pressure above the threshold")
-    notes = list(fld.notes)
-    points = fld.points
-    hot = v > thr if fld.location == "point" else None
-    if hot is None:
-        hot = np.zeros(fld.n_points, bool)
-        for g in groups:
-            hot[g.conn.ravel()] = True
-
-    # the plane of the loaded nodes (their pressure as weights)
+    hot = _hot_nodes(fld, v, thr, groups)
     if frame is None:
-        if len(groups) == 1 and len(groups[0].conn) == len(fld.triangles) and fld.location == "point":
-            sel = None  # every face loaded: weigh all nodes (zero weight off the patch)
-        else:
-            mask = np.zeros(fld.n_points, bool)
-            for g in groups:
-                mask[g.conn.ravel()] = True
-            sel = np.flatnonzero(mask)
-        pts_sel = points if sel is None else points[sel]
-        if fld.location == "point":
-            vs = v if sel is None else v[sel]
-            w = np.where(vs > thr, vs, 0.0)
-        else:
-            w = np.ones(len(pts_sel))
-        if np.count_nonzero(w) < 3:
-            raise PatchError(f"{src}: the contact patch has fewer than 3 loaded nodes")
-        c, normal, var = _plane(pts_sel, w)
-        hz = np.abs(pts_sel @ normal - c @ normal)[w > 0]
-        flat = bool(hz.max() <= 1e-9 * np.sqrt(var[2]))
-        if var[1] <= LINE_TOL**2 * var[2]:
-            raise DimensionError(
-                f"{src}: the loaded nodes lie on one line: the contact is a line, not a patch "
-                "(a 2-D plane or axisymmetric model written as 3-D?); fepost needs a contact area"
-            )
-        axes, axis_note = _axes(normal, rolling_axis, src)
-        if axis_note:
-            notes.append(axis_note)
-        base = Frame(origin=c, axes=axes)
+        plane = _fit_frame(fld, values=v, thr=thr, groups=groups, rolling_axis=rolling_axis)
     else:
-        base = frame
-        flat = False
-    groups, n_edge = drop_edge_faces(groups, points, hot, base.axes[2], fld.location, flat=flat)
-    if n_edge:
-        notes.append(
-            f"{n_edge} loaded face(s) steeper than {STEEP_DEG:g} deg to the patch plane, touching the "
-            "contact only at its edge (sides of the loaded body), are not part of the patch"
-        )
-
-    def cut(groups, level):
-        if only_triangles(groups):
-            tri = groups[0].conn if len(groups) == 1 else np.concatenate([g.conn for g in groups])
-            if fld.location == "point":
-                return points, tri, v, None
-            fv = groups[0].values if len(groups) == 1 else np.concatenate([g.values for g in groups])
-            return points, tri, fv, None
-        pts, tri, vals, ids, linear = refine(groups, points, v, fld.location, level)
-        if fld.location == "point":
-            # a linear or bilinear piece with no node above the threshold carries (almost) nothing:
-            # leave it out of the loaded area, as for linear triangles
-            hot_t = (vals > thr)[tri]
-            keep = ~linear | hot_t[:, 0] | hot_t[:, 1] | hot_t[:, 2]
-            if not keep.all():
-                tri, ids = tri[keep], ids[keep]
-        return pts, tri, vals, ids
-
-    level = 1
-    exact = None
-    previous = np.inf
-    if not only_triangles(groups):
-        xy_native = points @ base.axes[:2].T - base.origin @ base.axes[:2].T
-        bad = folded_faces(groups, xy_native)
-        if bad:
-            raise PatchError(
-                f"{src}: {bad} loaded element face(s) fold over in the patch plane (repeated or "
-                "crossed corner nodes): corrupt or inverted elements"
-            )
-    while True:
-        pts, tri, vals, parent = cut(groups, level)
-        geo = _geometry(src, pts, tri, vals, fld.location, thr, base)
-        if parent is None:
-            break
-        exact = exact_load(groups, xy_native, v, fld.location)
-        err = abs(geo.sums.N / exact[0] - 1.0)
-        # finer until the triangles carry the element load, while that converges (error / 4 per level)
-        if (
-            err <= REFINE_TOL
-            or next_triangles(groups, 2 * level) > REFINE_MAX_TRIANGLES
-            or err > 0.5 * previous
-        ):
-            break
-        previous = err
-        level *= 2
-
-    ncomp, labels = _components(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)
-    dropped = 0
-    if ncomp > 1:
-        loads = face_loads(geo.xy, geo.triangles, geo.values, fld.location)
-        share = np.bincount(labels, weights=loads, minlength=ncomp) / geo.sums.N
-        big = np.flatnonzero(share > FRAGMENT_SHARE)
-        if big.size > 1:
-            parts = ", ".join(f"{s:.0%}" for s in sorted(share[big], reverse=True))
-            raise PatchError(
-                f"{src}: {big.size} separate contact patches (load shares {parts}); "
-                "dual wheels or a split patch? fepost analyses one patch at a time: crop the mesh"
-            )
-        main = int(np.argmax(share))
-        keep = labels == main
-        dropped = int(ncomp - 1)
-        warnings.warn(
-            f"{src}: dropped {dropped} small loaded fragment(s) carrying {1 - share[main]:.2%} of the load",
-            PatchWarning,
-            stacklevel=2,
-        )
-        tri_kept = geo.triangles[keep]
-        vals_kept = geo.values if fld.location == "point" else geo.values[keep]
-        if parent is not None:
-            kept_ids = np.unique(parent[np.flatnonzero(keep)])  # compaction keeps the order
-            groups = [g.subset(np.isin(g.ids, kept_ids)) for g in groups]
-            groups = [g for g in groups if len(g.conn)]
-        geo = _geometry(src, geo.points, tri_kept, vals_kept, fld.location, thr, base)
-        if parent is not None:
-            exact = exact_load(groups, xy_native, v, fld.location)
-    _, tri_local, nvals, xy, height, weights, sums = geo
-    if exact is None:
-        N, cop = sums.N, sums.centre_of_pressure
-        refine_err = 0.0
-    else:
-        N, cop = float(exact[0]), exact[1:] / exact[0]
-        refine_err = float(sums.N / exact[0] - 1.0)
-        if abs(refine_err) > REFINE_TOL:
-            notes.append(
-                f"element faces cut into triangles carry {refine_err:+.2e} of the exact element load "
-                f"(finest cut within {REFINE_MAX_TRIANGLES:,} triangles)"
-            )
-        lobes = -float(face_loads(xy, tri_local, np.minimum(nvals, 0.0), fld.location).sum()) / N
-        if fld.location == "point" and lobes > 1e-4:
-            notes.append(
-                f"the quadratic interpolation dips below zero between nodes ({lobes:.2%} of the load): "
-                "kept, as the element's own field (not a sign error)"
-            )
-    if frame is None:
-        origin = base.to_global(cop[None, :])[0]  # on the plane: local z = 0
-        fr = Frame(origin=origin, axes=base.axes)
-        xy -= cop  # the geometry's own array: shifted in place
-        cop_rel = (0.0, 0.0)
-        cen = sums.centroid - cop
-    else:
-        fr = frame
-        cop_rel = (float(cop[0]), float(cop[1]))
-        cen = sums.centroid
+        plane = _Plane(frame, False, "")
+    base = plane.frame
+    groups, n_edge = drop_edge_faces(groups, fld.points, hot, base.axes[2], fld.location, flat=plane.flat)
+    cut = cut_faces(fld, values=v, thr=thr, groups=groups, base=base)
+    cut = drop_fragments(fld, cut=cut, values=v, thr=thr, base=base)
+    N, cop, refine_err, load_notes = patch_load(cut, location=fld.location)
+    _, tri_local, nvals, xy, height, weights, sums = cut.geo
+    fr, xy, cop_rel, cen = _in_frame(xy, cop=cop, centroid=sums.centroid, base=base, given=frame is not None)
     xy = sealed(xy)
     height = sealed(height)
     x, y = xy[:, 0], xy[:, 1]
-    area = sums.A
-    evals, evecs = np.linalg.eigh(sums.covariance())
-    evals = np.clip(evals, 0.0, None)
-    semi = 2.0 * np.sqrt(evals[::-1])  # major, minor
-    major = evecs[:, 1]
-    angle = float(np.arctan2(major[1], major[0]))
-    angle = (angle + np.pi / 2) % np.pi - np.pi / 2
-    aspect = float(semi[0] / semi[1]) if semi[1] > 0 else np.inf
+    ellipse = _ellipse(sums)
     r2 = x * x + y * y
     r_max = float(np.sqrt(np.max(r2)))
-    r_equiv = float(np.sqrt(area / np.pi))
+    r_equiv = float(np.sqrt(sums.A / np.pi))
     rms = float(np.sqrt((weights @ (height * height)) / weights.sum()))
-    if rms > PLANARITY_TOL * r_equiv:
-        _separate_surfaces(fld, groups, hot, points)
-        plane = "its best-fit plane" if frame is None else "the given frame's plane (the static patch's)"
-        raise PatchError(
-            f"{src}: the contact patch is not planar (RMS distance from {plane} "
-            f"{rms:.3g} m = {rms / r_equiv:.1%} of its radius, limit {PLANARITY_TOL:.0%}); "
-            "are the coordinates undeformed? try --displacement NAME"
-        )
+    _check_planar(fld, rms=rms, r_max=r_max, given_frame=frame is not None, groups=cut.groups, hot=hot)
     check_scale(src, r_max, peak, fld.units)
     outside = load_outside(x, y, tri_local, nvals, fld.location, r_equiv, sums, r2=r2)
-    circular = bool(aspect <= 1.0 + ASPECT_TOL and r_max / r_equiv <= RMAX_TOL)
+    circular = bool(ellipse.aspect <= 1.0 + ASPECT_TOL and r_max / r_equiv <= RMAX_TOL)
+    notes = [*fld.notes, *([plane.note] if plane.note else []), *_edge_note(n_edge), *load_notes]
     if not circular:
         notes.append(
-            f"patch is not circular (aspect {aspect:.3f}, r_max/r_equiv {r_max / r_equiv:.3f}); "
+            f"patch is not circular (aspect {ellipse.aspect:.3f}, r_max/r_equiv {r_max / r_equiv:.3f}); "
             "the paper's closed forms assume a circle"
         )
     return Patch(
@@ -488,24 +414,33 @@ def build_patch(
         threshold=thr,
         N_fe=N,
         centre_of_pressure=cop_rel,
-        area=float(area),
+        area=float(sums.A),
         r_max=r_max,
         r_equiv=r_equiv,
-        ellipse_axes=(float(semi[0]), float(semi[1])),
-        ellipse_angle=angle,
+        ellipse_axes=(float(ellipse.semi[0]), float(ellipse.semi[1])),
+        ellipse_angle=ellipse.angle,
         ellipse_centre=(float(cen[0]), float(cen[1])),
-        aspect=aspect,
+        aspect=ellipse.aspect,
         load_outside=outside,
         planarity_rms=rms,
         circular=circular,
         reaction_z=fld.reaction_z,
-        dropped_fragments=dropped,
+        dropped_fragments=cut.dropped,
         max_edge=sums.max_edge,
         notes=tuple(notes),
-        n_element_faces=sum(len(g.conn) for g in groups),
-        face_types=tuple(sorted({g.ftype for g in groups})),
-        refine_level=0 if exact is None else level,
+        n_element_faces=sum(len(g.conn) for g in cut.groups),
+        face_types=tuple(sorted({g.ftype for g in cut.groups})),
+        refine_level=0 if cut.exact is None else cut.level,
         refine_error=refine_err,
         dropped_edge_faces=n_edge,
         body=fld.body,
+    )
+
+
+def _edge_note(n_edge: int) -> tuple[str, ...]:
+    if not n_edge:
+        return ()
+    return (
+        f"{n_edge} loaded face(s) steeper than {STEEP_DEG:g} deg to the patch plane, touching the "
+        "contact only at its edge (sides of the loaded body), are not part of the patch",
     )

@@ -1,6 +1,6 @@
 """How many contact patches the loaded faces make: side by side in the plane, or on different surfaces.
 
-The regions side by side are counted on a small raster (:func:`_components`),
+The regions side by side are counted on a small raster (`loaded_regions`),
 dilated and labelled here with numpy (:func:`dilate`, :func:`label`) rather
 than with ``scipy.ndimage``, whose import alone (~0.3-0.6 s) would be a quarter
 of a million-node ``fepost coefficients`` run; the two agree cell for cell
@@ -89,9 +89,27 @@ def label(occupied: np.ndarray) -> tuple[np.ndarray, int]:
     return labels, int(number[-1])
 
 
-def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
-    """Separate loaded regions: (count, label per face).
+def loaded_regions(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -> tuple[int, np.ndarray]:
+    """Separate loaded regions of a patch in its plane: (count, label per face).
 
+    Parameters
+    ----------
+    x, y : ndarray, shape (n,)
+        In-plane coordinates of the nodes.
+    tri : ndarray, shape (m, 3)
+        The loaded triangles (node indices).
+    sums : FaceSums
+        Their area and longest loaded edge (``fepost.facesums``).
+
+    Returns
+    -------
+    count : int
+        Number of separate regions.
+    labels : ndarray of int, shape (m,)
+        Region of each triangle, 0 to count − 1.
+
+    Notes
+    -----
     Regions closer than a gap of about :data:`GAP_FRACTION` × √area (tread
     grooves, sparse contact at the edge) belong to one patch; regions farther
     apart (dual wheels) are separate. The nodes are binned on a raster of cell
@@ -117,10 +135,24 @@ def _components(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums) -
     return int(count), labels[i[first], j[first]] - 1
 
 
-def _separate_surfaces(fld: ContactField, groups: list[FaceGroup], hot: np.ndarray, points) -> None:
-    """Raise when the loaded faces form several patches (e.g. on parallel surfaces).
+def check_single_surface(fld: ContactField, groups: list[FaceGroup], hot: np.ndarray, points) -> None:
+    """Raise a `PatchError` when the loaded faces form several patches (e.g. on parallel surfaces).
 
-    Faces are connected when they share a node loaded above the threshold, so a
+    Parameters
+    ----------
+    fld : ContactField
+        The field (its values and source name).
+    groups : list of FaceGroup
+        The faces of the contact surface, by type.
+    hot : ndarray of bool
+        Nodes loaded above the threshold.
+    points : ndarray, shape (n, 3)
+        Node coordinates.
+
+    Notes
+    -----
+    Patches carrying less than `FRAGMENT_SHARE` of the load are fragments, not
+    patches. Faces are connected when they share a node loaded above the threshold, so a
     side face touching two patches at its unloaded middle does not join them.
     """
     from scipy.sparse import coo_matrix

@@ -27,6 +27,7 @@ from types import MappingProxyType
 from typing import Any
 
 from .analysis import Analysis
+from .coefficients import Coefficients
 from .errors import ArgumentError
 from .friction.quadrature import PressureQuadrature
 from .identify import (
@@ -346,50 +347,64 @@ def table1(
     if not isinstance(analysis, Analysis):
         raise ArgumentError(f"analysis must be an Analysis, got {type(analysis).__name__}")
     c = analysis.coefficients
+    kx, kx_source, rolling_quad = _k_x_choice(analysis, k_x)
+    truth = {"F0": c.F0, "M0": c.M0, "a": c.a, "m": c.m, "k_x": kx, "R": c.R, "N": c.N}
+    quad = PressureQuadrature.from_polar(analysis.static_map)
+    # the experiment's design: the same points, noise and seed for every set of curves
+    design: dict[str, Any] = {
+        "n_points": n_points,
+        "span": span,
+        "noise": noise,
+        "amplitude": amplitude,
+        "seed": seed,
+    }
+    curves = make_test_curves(source, truth, quad=quad, rolling_quad=rolling_quad, **design)
+    fit = fit_table1(curves, c.N, profile=profile)
+    report = approximation_bias(truth, quad, rolling_quad=rolling_quad, **design) if bias else None
+    gen = _generalised_table(analysis, quad, rolling_quad, kx, **design) if generalised else None
+    theory = {"f": c.f, **{k: truth[k] for k in ("F0", "M0", "a", "m", "k_x")}}
+    return Table1(
+        rows=_rows(fit, theory),
+        identification=fit,
+        curves=curves,
+        bias=report,
+        k_x_source=kx_source,
+        notes=_notes(c, source=source, kx_source=kx_source),
+        seed=seed,
+        source=source,
+        noise=noise,
+        amplitude=float(amplitude),
+        n_points=int(n_points),
+        span=float(span),
+        R=float(c.R),
+        N=float(c.N),
+        generalised=gen,
+    )
+
+
+def _k_x_choice(analysis: Analysis, k_x: float | None) -> tuple[float, str, PressureQuadrature | None]:
+    """The k_x of the experiment, where it came from, and the rolling map's quadrature (None
+    without a rolling map: then k_x is the given or the paper's value)."""
+    c = analysis.coefficients
     if c.k_x is not None:
         if k_x is not None:
             raise ArgumentError("k_x must be None when the analysis has a rolling map (k_x comes from it)")
-        kx, kx_source = float(c.k_x), "rolling map, k_x = R x_c / <x^2>"
         rolling_map = analysis.rolling_map
         if rolling_map is None:
             raise ArgumentError("analysis has k_x but no rolling_map; run analyse with the rolling map")
-        rolling_quad = PressureQuadrature.from_polar(rolling_map)
-    else:
-        kx = PAPER_K_X if k_x is None else float(k_x)
-        if not math.isfinite(kx):
-            raise ArgumentError(f"k_x must be finite, got {k_x!r}")
-        kx_source = (
-            f"assumed {kx:g} (no rolling map{'; the paper value' if k_x is None else ''}): "
-            "the k_x row tests the procedure only"
-        )
-        rolling_quad = None
-    truth = {"F0": c.F0, "M0": c.M0, "a": c.a, "m": c.m, "k_x": kx, "R": c.R, "N": c.N}
-    quad = PressureQuadrature.from_polar(analysis.static_map)
-    curves = make_test_curves(
-        source,
-        truth,
-        quad=quad,
-        rolling_quad=rolling_quad,
-        n_points=n_points,
-        span=span,
-        noise=noise,
-        amplitude=amplitude,
-        seed=seed,
+        return float(c.k_x), "rolling map, k_x = R x_c / <x^2>", PressureQuadrature.from_polar(rolling_map)
+    kx = PAPER_K_X if k_x is None else float(k_x)
+    if not math.isfinite(kx):
+        raise ArgumentError(f"k_x must be finite, got {k_x!r}")
+    kx_source = (
+        f"assumed {kx:g} (no rolling map{'; the paper value' if k_x is None else ''}): "
+        "the k_x row tests the procedure only"
     )
-    fit = fit_table1(curves, c.N, profile=profile)
-    report = None
-    if bias:
-        report = approximation_bias(
-            truth,
-            quad,
-            rolling_quad=rolling_quad,
-            n_points=n_points,
-            span=span,
-            noise=noise,
-            amplitude=amplitude,
-            seed=seed,
-        )
-    theory = {"f": c.f, **{k: truth[k] for k in ("F0", "M0", "a", "m", "k_x")}}
+    return kx, kx_source, None
+
+
+def _rows(fit: Identification, theory: dict[str, float]) -> tuple[Row, ...]:
+    """One row per coefficient: theory, fitted value, bounds, the paper's row."""
     rows = []
     for name in ROW_NAMES:
         prof = fit.profile_ci95.get(name)
@@ -405,19 +420,11 @@ def table1(
                 paper=PAPER_TABLE1[name],
             )
         )
-    gen = None
-    if generalised:
-        gen = _generalised_table(
-            analysis,
-            quad,
-            rolling_quad,
-            kx,
-            n_points=n_points,
-            span=span,
-            noise=noise,
-            amplitude=amplitude,
-            seed=seed,
-        )
+    return tuple(rows)
+
+
+def _notes(c: Coefficients, *, source: str, kx_source: str) -> tuple[str, ...]:
+    """What the table's numbers mean and where they came from."""
     notes = [
         f"theory: a, m from the moments (asymptotic values), R = r_max = {c.R:.5g} m; f = F0/N with N known",
         "bounds: Wald, t-quantile on the covariance (theta = F0, M0, ln a, ln m, k_x; "
@@ -429,23 +436,7 @@ def table1(
     if c.k_x is None:
         notes.append(f"k_x: {kx_source}")
     notes.extend(PAPER_NOTES)
-    return Table1(
-        rows=tuple(rows),
-        identification=fit,
-        curves=curves,
-        bias=report,
-        k_x_source=kx_source,
-        notes=tuple(notes),
-        seed=seed,
-        source=source,
-        noise=noise,
-        amplitude=float(amplitude),
-        n_points=int(n_points),
-        span=float(span),
-        R=float(c.R),
-        N=float(c.N),
-        generalised=gen,
-    )
+    return tuple(notes)
 
 
 def _generalised_table(

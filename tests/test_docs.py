@@ -118,9 +118,14 @@ def tutorial_steps() -> list[tuple[str, str]]:
     return steps
 
 
+#: Where the tutorial writes everything (git-ignored): the repository root stays clean.
+TUTORIAL_OUT = "out"
+
+
 @pytest.fixture(scope="module")
 def tutorial(tmp_path_factory):
-    """Run the tutorial's commands in a scratch folder holding the repository's meshes/."""
+    """Run the tutorial's commands in a scratch folder holding the repository's meshes/;
+    returns the folder the tutorial writes into."""
     work = tmp_path_factory.mktemp("tutorial")
     (work / "meshes").symlink_to(REPO / "meshes")
     env = {**os.environ, "PYTHONPATH": str(REPO)}
@@ -129,20 +134,36 @@ def tutorial(tmp_path_factory):
             cmd = [sys.executable, "-c", step]
         else:
             argv = shlex.split(step)
-            assert argv[0] == "fepost", step
-            cmd = [sys.executable, "-m", "fepost", *argv[1:]]
+            if argv == ["mkdir", "-p", TUTORIAL_OUT]:
+                cmd = argv
+            else:
+                assert argv[0] == "fepost", step
+                cmd = [sys.executable, "-m", "fepost", *argv[1:]]
         proc = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True, timeout=600)
         assert proc.returncode == 0, (step, proc.stderr[-2000:])
-    return work
+    return work / TUTORIAL_OUT
 
 
 def test_tutorial_has_the_steps_it_promises():
     steps = tutorial_steps()
-    commands = [s.split()[1] for k, s in steps if k == "console"]
+    commands = [s.split()[1] for k, s in steps if k == "console" and s.startswith("fepost ")]
     assert commands == ["coefficients", "report", "predict", "sweep", "diagnose"]
+    assert steps[0] == ("console", f"mkdir -p {TUTORIAL_OUT}")
     assert [k for k, _ in steps].count("python") == 2
     report = next(s for k, s in steps if k == "console" and s.split()[1] == "report")
-    assert shlex.split(report)[2:] == ["--out", "report", "--force"]  # the demo's case: no inputs
+    # the demo's case: no inputs
+    assert shlex.split(report)[2:] == ["--out", f"{TUTORIAL_OUT}/report", "--force"]
+
+
+@pytest.mark.slow
+def test_tutorial_writes_only_into_an_ignored_folder(tutorial):
+    """Run from the repository's root, the tutorial leaves nothing untracked there: every
+    file goes into out/, which .gitignore lists."""
+    work = tutorial.parent
+    assert sorted(p.name for p in work.iterdir()) == ["meshes", TUTORIAL_OUT]
+    assert any(p.is_file() for p in tutorial.rglob("*"))
+    ignored = (REPO / ".gitignore").read_text(encoding="utf-8").splitlines()
+    assert f"/{TUTORIAL_OUT}/" in ignored
 
 
 @pytest.mark.slow

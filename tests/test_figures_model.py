@@ -13,8 +13,9 @@ from fepost.analysis import analyse
 from fepost.errors import ArgumentError
 from fepost.figures.curves import CurveData, curve_table, mathtext, plot_curve
 from fepost.figures.errormap import plot_error_map
+from fepost.friction.law import FrictionLaw
 from fepost.friction.sphere import ErrorMap
-from fepost.friction.summary import analysis_error_map
+from fepost.friction.summary import model_error_map
 
 matplotlib.use("Agg")
 MESHES = Path(__file__).resolve().parents[1] / "meshes"
@@ -132,7 +133,8 @@ def test_error_map_rejects_bad_input():
 
 def test_error_map_of_the_calculix_sample():
     an = analyse(MESHES / "static.vtu")
-    em = analysis_error_map(an, n_beta=7, n_t=25)
+    law = FrictionLaw(f=an.coefficients.f)
+    em = model_error_map(an.static_map, an.coefficients, law, model=an.model_summary.static, n_beta=7, n_t=25)
     assert set(em.names) == {"paper", "base", "model"}
     assert em.worst("paper")["force"] > 0.10 and em.worst("paper")["torque"] > 0.15
     assert em.worst("model")["force"] <= 0.03 and em.worst("model")["torque"] <= 0.03

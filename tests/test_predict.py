@@ -105,7 +105,8 @@ def test_columns_rows_and_each_model(rolling_run, kin_csv):
 def test_without_rolling_the_static_map_is_used(kin_csv, tmp_path):
     path, vx, vy, wz = kin_csv
     an = analyse(STATIC)
-    pred = predict(an, vx[:8], vy[:8], wz[:8])
+    law = FrictionLaw(f=an.coefficients.f)
+    pred = predict(vx[:8], vy[:8], wz[:8], pmap=an.static_map, coefficients=an.coefficients, law=law)
     assert pred.map == "static"
     ex = friction_resultants(PressureQuadrature.from_polar(an.static_map), vx[:8], vy[:8], wz[:8])
     np.testing.assert_allclose(pred.exact.Mz, ex.Mz, rtol=1e-12)

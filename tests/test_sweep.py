@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 from fepost.cli import main
+from fepost.report.sweeppage import write_trends
 from fepost.sweep import RowOptions, read_table, run_sweep
 from fepost.sweep.store import WORK
 from fepost.sweep.table import NAMES
@@ -146,7 +147,7 @@ def test_rolling_pairs_rule_and_csv(cluster, load_sweep, tmp_path):
     doc = single_file(tmp_path, static, "--rolling", str(rolling))
     assert doc["k_x"] == pytest.approx(0.15, rel=0.05)  # the map's own shift, O(h) on 12 rings
     # naming rule: the rolling map is consumed, not a row of its own
-    res = run_sweep([str(d)], tmp_path / "rule", rolling_pairs="static=rolling", client=cluster, trends=False)
+    res = run_sweep([str(d)], tmp_path / "rule", rolling_pairs="static=rolling", client=cluster)
     assert res.ok, [(r["source"], r["error"]) for r in res.rows if r["status"] != "ok"]
     assert len(res.rows) == 5
     row = next(r for r in res.rows if r["source"].endswith("case3_static.vtu"))
@@ -158,7 +159,7 @@ def test_rolling_pairs_rule_and_csv(cluster, load_sweep, tmp_path):
     pairs.write_text(
         f"# static and rolling maps\nstatic,rolling\n{static},{os.path.relpath(rolling, tmp_path)}\n"
     )
-    res2 = run_sweep([str(static)], tmp_path / "csv", rolling_pairs=str(pairs), client=cluster, trends=False)
+    res2 = run_sweep([str(static)], tmp_path / "csv", rolling_pairs=str(pairs), client=cluster)
     assert_row_equals(dict(res2.rows[0]), doc)
 
 
@@ -263,21 +264,21 @@ def test_resume_after_sigkill(cluster, tmp_path, monkeypatch):
     assert 2 <= len(saved) < len(loads), "the sweep finished before it was killed"
     assert not (out / "coefficients.parquet").exists()  # nothing half-written
     assert not list(rows_dir.glob(".*"))  # no partial row file
-    res = run_sweep([str(d)], out, client=cluster, trends=False)
+    res = run_sweep([str(d)], out, client=cluster)
     assert (res.reused, res.computed) == (len(saved), len(loads) - len(saved))
     for name, mtime in saved.items():
         assert (rows_dir / name).stat().st_mtime_ns == mtime  # not recomputed
     assert res.ok and len(res.rows) == len(loads)
-    fresh = run_sweep([str(d)], tmp_path / "fresh", client=cluster, trends=False)
+    fresh = run_sweep([str(d)], tmp_path / "fresh", client=cluster)
     assert comparable(read_table(res.parquet)) == comparable(read_table(fresh.parquet))
     # a re-run of a finished sweep computes nothing and starts no cluster
     with monkeypatch.context() as m:
         m.setattr("fepost.sweep.engine.Cluster._start_local", lambda self: pytest.fail("cluster started"))
-        again = run_sweep([str(d)], out, workers=1, trends=False)
+        again = run_sweep([str(d)], out, workers=1)
     assert (again.reused, again.computed) == (len(loads), 0)
     # a changed file is a new row; the others are kept
     hertz(d / "r03.vtu", float(loads[3]) * 1.5, n_rings=30)
-    changed = run_sweep([str(d)], out, client=cluster, trends=False)
+    changed = run_sweep([str(d)], out, client=cluster)
     assert (changed.reused, changed.computed) == (len(loads) - 1, 1)
     assert changed.rows[3]["N"] == pytest.approx(1.5 * res.rows[3]["N"], rel=1e-9)
 
@@ -297,7 +298,7 @@ def test_exodus_time_steps(cluster, tmp_path):
     times = list(np.linspace(0.0, 1.1, n))
     series = write_exodus(tmp_path / "ramp.e", pts, cells, data, times=times)
     series.with_suffix(".json").write_text(json.dumps({"load": list(loads), "inflation_pressure": 1.4e6}))
-    res = run_sweep([str(series)], tmp_path / "out", steps="all", client=cluster)
+    res = run_sweep([str(series)], tmp_path / "out", steps="all", client=cluster, trends=write_trends)
     assert res.ok, [(r["source"], r["error"]) for r in res.rows if r["status"] != "ok"]
     assert [r["step"] for r in res.rows] == list(range(n))
     assert [r["time"] for r in res.rows] == pytest.approx(times, rel=1e-12)
@@ -306,7 +307,7 @@ def test_exodus_time_steps(cluster, tmp_path):
         assert_row_equals(dict(res.rows[k]), single_file(tmp_path, series, "--step", str(k)))
     assert (tmp_path / "out" / "trends" / "time_trends.png").is_file()
     # the default is the last step, with its own per-step sidecar value
-    last = run_sweep([str(series)], tmp_path / "last", client=cluster, trends=False)
+    last = run_sweep([str(series)], tmp_path / "last", client=cluster)
     assert comparable(last.rows) == comparable([res.rows[-1]])
 
 
@@ -318,7 +319,7 @@ def test_trends_on_hertz_maps(cluster, load_sweep, tmp_path):
     """
     d, files, _ = load_sweep
     out = tmp_path / "out"
-    res = run_sweep([str(f) for f in files], out, client=cluster)
+    res = run_sweep([str(f) for f in files], out, client=cluster, trends=write_trends)
     fits = {f["quantity"]: f for f in json.loads((out / "trends.json").read_text())["fits"]}
     for q, alpha in (("R", 1 / 3), ("M0", 4 / 3), ("aR2", 2 / 3), ("m_over_R2", -2 / 3)):
         assert fits[q]["exponent"] == pytest.approx(alpha, abs=1e-9), q
@@ -364,17 +365,17 @@ def test_cli_option_errors(cluster, tmp_path, capsys, monkeypatch):
 def test_options_reach_every_row(cluster, tmp_path):
     f = hertz(tmp_path / "a.vtu", 1e4)
     opts = RowOptions(friction=0.45, nr=24, nphi=48, rule="trapezoid")
-    res = run_sweep([str(f)], tmp_path / "o", options=opts, client=cluster, trends=False)
+    res = run_sweep([str(f)], tmp_path / "o", options=opts, client=cluster)
     doc = single_file(tmp_path, f, "--friction", "0.45", "--nr", "24", "--nphi", "48", "--rule", "trapezoid")
     assert_row_equals(dict(res.rows[0]), doc)
     # other options are other rows: nothing reused
-    res2 = run_sweep([str(f)], tmp_path / "o", client=cluster, trends=False)
+    res2 = run_sweep([str(f)], tmp_path / "o", client=cluster)
     assert (res2.reused, res2.computed) == (0, 1)
 
 
 def test_report_section_in_process(load_sweep, tmp_path):
     """The report's one call: a sweep on one in-process worker thread, its section and files."""
-    from fepost.sweep import sweep_report_section
+    from fepost.report.sweepembed import sweep_report_section
 
     d, files, _ = load_sweep
     html, written = sweep_report_section([str(d / "*_static.vtu")], tmp_path, heading_level=3)
@@ -409,7 +410,7 @@ def test_worker_crash_is_an_error_row(cluster, tmp_path):
     """
     f = hertz(tmp_path / "crash.vtu", 1e4)
     cluster.run(_crash_on, str(f))
-    res = run_sweep([str(f)], tmp_path / "out", client=cluster, trends=False)
+    res = run_sweep([str(f)], tmp_path / "out", client=cluster)
     assert [r["status"] for r in res.rows] == ["error"]
     assert (
         res.rows[0]["error"] == f"{f}: the worker process died while analysing it (a crash, or out of memory)"
@@ -464,7 +465,7 @@ def test_report_section_provider(tmp_path):
     from types import SimpleNamespace
 
     from fepost.report.html import environment
-    from fepost.sweep.reportsection import sweep_provider
+    from fepost.report.sweepsection import sweep_provider
 
     d = tmp_path / "aircraft"
     d.mkdir()

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from fepost import analytic
-from fepost.sweep import fit_power_law, load_trends, sweep_section
+from fepost.report.sweeppage import sweep_section
+from fepost.sweep import fit_power_law, load_trends
 from fepost.sweep.trends import MIN_POINTS, groups
 
 
@@ -139,7 +140,7 @@ def test_figures_and_page_write_symbols_and_units_in_the_reports_style(tmp_path)
     no unit for dimensionless quantities: never the literal column names."""
     import matplotlib.pyplot as plt
 
-    from fepost.sweep.figures import plot_load_trends, plot_time_trends
+    from fepost.figures.sweep import plot_load_trends, plot_time_trends
 
     rows = hertz_rows([1e4, 2e4, 4e4, 8e4])
     for k, r in enumerate(rows):

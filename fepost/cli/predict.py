@@ -43,13 +43,18 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..analysis import analyse
+    from ..friction.law import FrictionLaw
     from ..friction.predict import predict, read_kinematics
     from ..output import write_text_atomic
     from ._common import analysis_kwargs
 
     kin = read_kinematics(args.kinematics)  # bad CSV: fail before the FE work
     result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
-    pred = predict(result, kin.vx, kin.vy, kin.wz)
+    rolling = result.rolling_map is not None
+    pmap = result.rolling_map if result.rolling_map is not None else result.static_map
+    law = FrictionLaw(f=result.coefficients.f)
+    c = result.coefficients
+    pred = predict(kin.vx, kin.vy, kin.wz, pmap=pmap, coefficients=c, law=law, rolling=rolling)
     write_text_atomic(args.out, pred.to_csv())
     if args.model_json:
         write_text_atomic(args.model_json, pred.model.to_json() + "\n")

@@ -66,6 +66,7 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import ArgumentError
+    from ..report.sweeppage import write_trends
     from ..sweep import RowOptions, run_sweep
     from . import FAILED_INPUTS, OK, Terminated
     from ._common import analysis_kwargs
@@ -86,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
             progress=False if args.no_progress else None,
             fresh=args.fresh,
             force=args.force,
-            trends=not args.no_trends,
+            trends=None if args.no_trends else write_trends,
         )
     except (KeyboardInterrupt, Terminated):
         print(

@@ -8,12 +8,14 @@ spin (ε = 0) to pure sliding (ε = ∞). One logarithmic colour scale for all
 panels, so the panels compare honestly; a contour marks the 3 % goal and each
 panel's title gives its largest error. The module computes nothing physical:
 the data come from :func:`fepost.friction.sphere.error_map`
-(:func:`fepost.friction.summary.analysis_error_map` for an analysed FE map).
+(`fepost.friction.summary.model_error_map` for an FE map).
 """
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
+from pathlib import PurePath
 
 import numpy as np
 
@@ -28,6 +30,8 @@ EPS_TICKS = (0.0, 0.25, 0.5, 1.0, 2.0, 4.0, np.inf)
 GOAL = 0.03
 #: Lower end of the colour scale (errors below it share its colour).
 FLOOR = 1e-3
+#: Longest line of the heading (characters): the narrowest map, one panel wide, holds it.
+TITLE_WIDTH = 48
 #: Panel titles of the usual model names.
 TITLES = {"paper": "paper's closed forms (1.8)", "model": "generalised model", "base": "generalised base"}
 
@@ -80,6 +84,15 @@ def plot_error_map(data: ErrorMap, names: Sequence[str] = ("paper", "model"), fi
             ax.set_xlim(float(data.beta[0]), float(data.beta[-1]))
         cbar = fig.colorbar(mesh, ax=axes, shrink=0.9)
         cbar.set_label(f"error (fraction of F0 or M0); white line: {GOAL:.0%}")
-        src = f" — {data.source}" if data.source else ""
-        fig.suptitle(f"Error over the kinematic sphere, both spin signs{src}", fontsize=10)
+        fig.suptitle(error_map_title(data.source), fontsize=10)
     return fig
+
+
+def error_map_title(source: str) -> str:
+    """The error map's heading: what it shows, then the map's file name (not its whole path,
+    which would not fit), wrapped to lines of at most `TITLE_WIDTH` characters."""
+    head = "Error over the kinematic sphere, both spin signs"
+    name = PurePath(source).name if source else ""
+    if not name:
+        return head
+    return head + "\n" + "\n".join(textwrap.wrap(name, TITLE_WIDTH, break_on_hyphens=False))

@@ -16,7 +16,7 @@ from .._arrays import frozen
 from ..errors import ArgumentError
 from ..patch import Patch
 from . import theme
-from .render import DEFAULT_INFLATION_PRESSURE, _check_pressure, patch_mesh
+from .render import DEFAULT_INFLATION_PRESSURE, check_pressure, patch_mesh
 
 #: Points per diameter.
 N_SECTION = 401
@@ -43,7 +43,9 @@ class SectionData:
     ``s`` (m) is the position along each diameter; ``static_x``, ``static_y``
     (and ``rolling_x``, ``rolling_y`` when a rolling map is given) are σ/P* along
     y = 0 and x = 0 respectively. ``inflation_pressure`` P* in Pa; ``R`` (m) the
-    static r_max.
+    static r_max (the R of the coefficients); ``R_rolling`` (m) the rolling map's
+    r_max about the same origin, the static centre of pressure (None without a
+    rolling map): the rolling map reaches further forward.
     """
 
     s: np.ndarray
@@ -53,6 +55,7 @@ class SectionData:
     rolling_y: np.ndarray | None
     inflation_pressure: float
     R: float
+    R_rolling: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("s", "static_x", "static_y", "rolling_x", "rolling_y"):
@@ -69,6 +72,8 @@ class SectionData:
         if self.rolling_x is not None and self.rolling_y is not None:
             d.update({"rolling_x": self.rolling_x.tolist(), "rolling_y": self.rolling_y.tolist()})
         d.update({"inflation_pressure": self.inflation_pressure, "R": self.R})
+        if self.R_rolling is not None:
+            d["R_rolling"] = self.R_rolling
         return d
 
 
@@ -85,7 +90,7 @@ def diameter_sections(
     ``half_length`` (m) of the diameters (default 1.1 × the largest distance of a
     patch node from the origin, so the curves reach zero).
     """
-    p_star = _check_pressure(inflation_pressure)
+    p_star = check_pressure(inflation_pressure)
     if int(n) != n or n < 3:
         raise ArgumentError(f"n must be an integer >= 3, got {n!r}")
     patches = [static] + ([rolling] if rolling is not None else [])
@@ -102,13 +107,27 @@ def diameter_sections(
     rx = ry = None
     if rolling is not None:
         rx, ry = along(rolling)
-    return SectionData(s, sx, sy, rx, ry, p_star, static.r_max)
+    r_rolling = None if rolling is None else rolling.r_max
+    return SectionData(s, sx, sy, rx, ry, p_star, static.r_max, r_rolling)
 
 
 def plotted_values(data: SectionData) -> np.ndarray:
     """Every σ/P* value Figure 3 plots (the y-limits must hold all of them)."""
     series = [data.static_x, data.static_y, data.rolling_x, data.rolling_y]
     return np.concatenate([np.asarray(v) for v in series if v is not None])
+
+
+def _radius_lines(ax, axis: str, data: SectionData) -> None:
+    """Dotted lines at ±R (the static r_max) and, with a rolling map, at ± its own r_max
+    about the same origin, which the rolling curve reaches."""
+    radii = [("static", data.R, theme.RMAX_COLOUR, "±R = r_max, static (the R of the coefficients)")]
+    if data.R_rolling is not None:
+        radii.append(("rolling", data.R_rolling, theme.ROLLING_COLOUR, "±r_max, rolling map"))
+    for which, radius, colour, label in radii:
+        for sgn in (-1, 1):
+            side = "minus" if sgn < 0 else "plus"
+            gid = f"rmax_{axis}_{side}" if which == "static" else f"rmax_rolling_{axis}_{side}"
+            ax.axvline(sgn * radius, color=colour, lw=0.8, ls=":", label=label if sgn < 0 else None, gid=gid)
 
 
 def plot_sections(data: SectionData, axes=None):
@@ -142,15 +161,7 @@ def plot_sections(data: SectionData, axes=None):
                     label="rolling",
                     gid=f"rolling_{axis}",
                 )
-            for sgn in (-1, 1):
-                ax.axvline(
-                    sgn * data.R,
-                    color=theme.RMAX_COLOUR,
-                    lw=0.8,
-                    ls=":",
-                    label="±r_max" if sgn < 0 else None,
-                    gid=f"rmax_{axis}_{'minus' if sgn < 0 else 'plus'}",
-                )
+            _radius_lines(ax, axis, data)
             other = "y" if axis == "x" else "x"
             ax.set_xlabel(f"{axis} (m), along {other} = 0")
             ax.set_title(f"{axis} diameter" + (" (rolling direction)" if axis == "x" else " (lateral)"))
@@ -160,5 +171,5 @@ def plot_sections(data: SectionData, axes=None):
             ax.set_ylim(0.0, 1.05 * top if top > 0 else 1.0)
         axes[0].set_ylabel(f"p/P* (P* = {data.inflation_pressure / 1e3:.0f} kPa)")
         handles, labels = axes[0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="outside upper center", ncol=len(labels))
+        fig.legend(handles, labels, loc="outside upper center", ncol=min(len(labels), 2))
     return fig

@@ -73,6 +73,16 @@ def components(vx, vy, wz, *, F0: float, M0: float, a: float, m: float, k_x: flo
     - F⊥ acts along y with sign −sgn(ω_z)·sgn(k_x): at pure spin the traction is
       −fσ ê_φ, and a forward pressure shift σ0(1 + k_x x/R) loads the front
       (x > 0), where ê_φ points to +y for ω_z > 0, so F_y = −k_x M0/(2R).
+
+    Examples
+    --------
+    Pure sliding along x gives −F0 along x, pure spin gives −M0:
+
+    >>> from fepost.friction.closed_form import components
+    >>> Fx, Fy, Mz = components([1.0, 0.0], [0.0, 0.0], [0.0, 2.0],
+    ...                         F0=3870.0, M0=277.3, a=0.94, m=9.5, k_x=0.0, radius=0.12)
+    >>> float(Fx[0]), float(Mz[1])
+    (-3870.0, -277.3)
     """
     vx, vy, wz = np.broadcast_arrays(*(np.asarray(q, float) for q in (vx, vy, wz)))
     v = np.hypot(vx, vy)

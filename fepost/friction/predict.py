@@ -28,21 +28,19 @@ from __future__ import annotations
 
 import io
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._arrays import frozen
+from ..coefficients import Coefficients
 from ..csvtable import CsvFormat, CsvTable, parse_table, read_table
 from ..errors import ArgumentError
+from ..polar import PolarMap
 from .closed_form import components
 from .exact import Resultants, friction_resultants
 from .law import FrictionLaw
 from .model import GeneralisedModel
 from .quadrature import PressureQuadrature
-
-if TYPE_CHECKING:
-    from ..analysis import Analysis
 
 COLUMNS = ("vx", "vy", "wz")
 OUTPUT_COLUMNS = COLUMNS + tuple(f"{q}_{m}" for m in ("exact", "paper", "model") for q in ("Fx", "Fy", "Mz"))
@@ -126,34 +124,62 @@ class Prediction:
 
 
 def predict(
-    analysis: Analysis,
     vx,
     vy,
     wz,
     *,
+    pmap: PolarMap,
+    coefficients: Coefficients,
+    law: FrictionLaw,
+    rolling: bool = False,
     model: GeneralisedModel | None = None,
 ) -> Prediction:
     """Exact, paper and generalised resultants for the kinematics (vx, vy in m/s, wz in rad/s).
 
-    ``model``: the generalised model to use (default: built from the analysis's
-    rolling map when it has one, else its static map; see
-    :func:`fepost.friction.summary.map_model`).
-    """
-    from ..analysis import Analysis
-    from .summary import map_model
+    Parameters
+    ----------
+    vx, vy, wz : array_like
+        The kinematic points (broadcast together).
+    pmap : PolarMap
+        The pressure map the exact integrals and the generalised model use: the
+        rolling map (in the static patch's frame) of a rolling tire, else the
+        static map.
+    coefficients : Coefficients
+        The paper's coefficients (F0, M0, a, m, R and k_x).
+    law : FrictionLaw
+        The friction law.
+    rolling : bool
+        ``pmap`` is the rolling map: the closed forms add F⊥ with k_x.
+    model : GeneralisedModel, optional
+        The generalised model to use (default: built from ``pmap``, see
+        ``fepost.friction.summary.map_model``).
 
-    if not isinstance(analysis, Analysis):
-        raise ArgumentError(f"analysis must be an Analysis, got {type(analysis).__name__}")
+    Examples
+    --------
+    >>> import fepost
+    >>> from fepost.friction.law import FrictionLaw
+    >>> from fepost.friction.predict import predict
+    >>> an = fepost.analyse("meshes/static.vtu")
+    >>> pred = predict([0.1, 0.0], [0.0, 0.0], [0.0, 1.0], pmap=an.static_map,
+    ...                coefficients=an.coefficients, law=FrictionLaw(f=0.3))
+    >>> pred.map
+    'static'
+    >>> round(float(pred.exact.Fx[0] / an.coefficients.F0), 6)   # pure sliding: exactly −f N
+    -1.0
+    >>> round(float(pred.exact.Mz[1] / an.coefficients.M0), 6)   # pure spin: exactly −M0
+    -1.0
+    """
+    from .summary import check_map_values, map_model, paper_k_x
+
+    check_map_values(pmap, coefficients, law)
     vx, vy, wz = (np.atleast_1d(np.asarray(a, float)) for a in np.broadcast_arrays(vx, vy, wz))
-    c = analysis.coefficients
-    rolling = analysis.rolling_map is not None
-    pmap = analysis.rolling_map if analysis.rolling_map is not None else analysis.static_map
+    c = coefficients
     if model is None:
-        model = map_model(analysis, rolling)
+        model = map_model(pmap, c, law, rolling=rolling)
     elif not isinstance(model, GeneralisedModel):
         raise ArgumentError(f"model must be a GeneralisedModel, got {type(model).__name__}")
-    exact = friction_resultants(PressureQuadrature.from_polar(pmap), vx, vy, wz, FrictionLaw(f=c.f))
-    k_x = c.k_x if (rolling and c.k_x is not None) else 0.0
+    exact = friction_resultants(PressureQuadrature.from_polar(pmap), vx, vy, wz, law)
+    k_x = paper_k_x(c, rolling=rolling)
     paper = Resultants(*components(vx, vy, wz, F0=c.F0, M0=c.M0, a=c.a, m=c.m, k_x=k_x, radius=c.R))
     return Prediction(
         vx=vx,

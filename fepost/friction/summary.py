@@ -1,65 +1,109 @@
-"""The generalised friction model of an analysed FE map, as ``fepost coefficients`` shows it.
+"""The generalised friction model of a pressure map, as ``fepost coefficients`` shows it.
 
-:func:`analysis_models` builds the model of the static map (and of the rolling
-map, when the analysis has one) with the analysis's R and f, and measures on the
-same check grid how far both the model and the paper's closed forms (with the
-analysis's F0, M0, a, m, k_x) lie from the exact integrals. :class:`ModelSummary`
-turns that into the lines printed beside the paper's coefficients and the
-``model`` block of the coefficients JSON.
+Physics takes values, never the pipeline: every function here takes the polar
+map (``fepost.polar.PolarMap``), the paper's coefficients of that map
+(``fepost.coefficients.Coefficients``: R, F0, M0, a, m, k_x) and the friction
+law (``fepost.friction.law.FrictionLaw``), whoever computed them.
+
+`map_model` builds the model of one map with the coefficients' R and the law,
+and measures on the same check grid how far both the model and the paper's
+closed forms (with F0, M0, a, m, k_x) lie from the exact integrals.
+`summarise` does it for the static map (and the rolling one, when given);
+`ModelSummary` turns that into the lines printed beside the paper's
+coefficients and the ``model`` block of the coefficients JSON.
+`model_error_map` is the error of the closed forms and of a model over the
+whole kinematic sphere (the data of the report's error maps).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
+from ..coefficients import Coefficients
 from ..errors import ArgumentError
+from ..polar import PolarMap
 from .build import build_model
 from .closed_form import paper_model
 from .law import FrictionLaw
 from .model import GeneralisedModel
 from .quadrature import PressureQuadrature
 
-if TYPE_CHECKING:
-    from ..analysis import Analysis
-
 #: Where the model and its export format are explained.
 DOCS = "docs/model.md"
 
 
-def map_model(analysis: Analysis, rolling: bool = False, *, order="auto") -> GeneralisedModel:
-    """The generalised model of the static (or rolling) map of ``analysis``, with its R and f.
+def check_map_values(pmap, coefficients, law) -> None:
+    """Raise a one-line `ArgumentError` when ``pmap``, ``coefficients`` or ``law`` is not a
+    `PolarMap`, `Coefficients` or `FrictionLaw` (the checks of every function here)."""
+    if not isinstance(pmap, PolarMap):
+        raise ArgumentError(f"pmap must be a PolarMap, got {type(pmap).__name__}")
+    if not isinstance(coefficients, Coefficients):
+        raise ArgumentError(f"coefficients must be Coefficients, got {type(coefficients).__name__}")
+    if not isinstance(law, FrictionLaw):
+        raise ArgumentError(f"law must be a FrictionLaw, got {type(law).__name__}")
 
-    The rolling model is built on the rolling map in the static patch's frame
-    (origin at the static centre of pressure). The model's ``accuracy`` also
-    holds the paper's closed forms' errors (``compare_force``,
-    ``compare_torque``; with k_x for the rolling map) on the same check grid.
+
+def paper_k_x(coefficients: Coefficients, *, rolling: bool) -> float:
+    """The k_x of the paper's closed forms for a map: the coefficients' k_x for the
+    rolling map (0 when it is unknown), 0 for the static map."""
+    return coefficients.k_x if (rolling and coefficients.k_x is not None) else 0.0
+
+
+def map_model(
+    pmap: PolarMap,
+    coefficients: Coefficients,
+    law: FrictionLaw,
+    *,
+    rolling: bool = False,
+    order="auto",
+) -> GeneralisedModel:
+    """The generalised model of the pressure map ``pmap``, with the coefficients' R and ``law``.
+
+    Parameters
+    ----------
+    pmap : PolarMap
+        The static map, or the rolling map in the static patch's frame (origin
+        at the static centre of pressure), as ``fepost.analyse`` makes them.
+    coefficients : Coefficients
+        The paper's coefficients of the maps (R, F0, M0, a, m, k_x).
+    law : FrictionLaw
+        The friction law (coefficient f).
+    rolling : bool
+        ``pmap`` is the rolling map: the paper's closed forms it is compared
+        with include k_x.
+    order : "auto" or (K, L)
+        Order of the model's correction (see ``fepost.friction.build.build_model``).
+
+    Returns
+    -------
+    GeneralisedModel
+        Its ``accuracy`` also holds the paper's closed forms' errors
+        (``compare_force``, ``compare_torque``) on the same check grid.
+
+    Examples
+    --------
+    >>> import fepost
+    >>> from fepost.friction.law import FrictionLaw
+    >>> from fepost.friction.summary import map_model
+    >>> an = fepost.analyse("meshes/static.vtu")
+    >>> c = an.coefficients
+    >>> model = map_model(an.static_map, c, FrictionLaw(f=0.3))
+    >>> Fx, Fy, Mz = model([0.1, 0.0], [0.0, 0.0], [0.0, 1.0])   # pure sliding, pure spin
+    >>> round(float(Fx[0] / c.F0), 6), round(float(Mz[1] / c.M0), 6)
+    (-1.0, -1.0)
     """
-    from ..analysis import Analysis
-
-    if not isinstance(analysis, Analysis):
-        raise ArgumentError(f"analysis must be an Analysis, got {type(analysis).__name__}")
-    c = analysis.coefficients
-    pmap = analysis.rolling_map if rolling else analysis.static_map
-    if pmap is None:
-        raise ArgumentError("analysis has no rolling map (give one to analyse)")
-    k_x = c.k_x if (rolling and c.k_x is not None) else 0.0
+    check_map_values(pmap, coefficients, law)
+    c = coefficients
     return build_model(
         PressureQuadrature.from_polar(pmap),
-        FrictionLaw(f=c.f),
+        law,
         radius=c.R,
         order=order,
-        compare=paper_model(c.F0, c.M0, c.a, c.m, k_x, c.R),
+        compare=paper_model(c.F0, c.M0, c.a, c.m, paper_k_x(c, rolling=rolling), c.R),
     )
-
-
-def analysis_models(analysis: Analysis, *, order="auto") -> tuple[GeneralisedModel, GeneralisedModel | None]:
-    """Generalised models of the static and (if any) rolling map of ``analysis`` (:func:`map_model`)."""
-    static = map_model(analysis, order=order)
-    rolling = map_model(analysis, True, order=order) if analysis.rolling_map is not None else None
-    return static, rolling
 
 
 @dataclass(frozen=True)
@@ -148,42 +192,96 @@ def _mat(a: np.ndarray) -> str:
     return f"[[{a[0, 0]:.4g}, {a[0, 1]:.4g}], [{a[1, 0]:.4g}, {a[1, 1]:.4g}]]"
 
 
-def summarise(analysis: Analysis, *, order="auto") -> ModelSummary:
-    """The :class:`ModelSummary` of ``analysis`` (builds the models: about a second)."""
-    static, rolling = analysis_models(analysis, order=order)
-    c = analysis.coefficients
-    p = analysis.static_patch
+def summarise(
+    static_map: PolarMap,
+    coefficients: Coefficients,
+    law: FrictionLaw,
+    *,
+    rolling_map: PolarMap | None = None,
+    circular: bool,
+    aspect: float,
+    order="auto",
+) -> ModelSummary:
+    """The `ModelSummary` of a static map (and of its rolling map, when given).
+
+    Builds the models with `map_model`: about a second.
+
+    Parameters
+    ----------
+    static_map : PolarMap
+        The static map.
+    coefficients : Coefficients
+        The paper's coefficients of the maps.
+    law : FrictionLaw
+        The friction law.
+    rolling_map : PolarMap, optional
+        The rolling map in the static patch's frame.
+    circular, aspect : bool, float
+        The static patch's circularity verdict and aspect (they choose the recommendation).
+    order : "auto" or (K, L)
+        Order of the models' correction.
+    """
+    static = map_model(static_map, coefficients, law, order=order)
+    rolling = None
+    if rolling_map is not None:
+        rolling = map_model(rolling_map, coefficients, law, rolling=True, order=order)
     return ModelSummary(
         static=static,
         rolling=rolling,
-        circular=bool(p.circular),
-        aspect=float(p.aspect),
-        paper={"a": c.a, "m": c.m},
+        circular=bool(circular),
+        aspect=float(aspect),
+        paper={"a": coefficients.a, "m": coefficients.m},
     )
 
 
-def analysis_error_map(analysis: Analysis, *, rolling: bool = False, n_beta: int = 37, n_t: int = 65):
-    """The :class:`~fepost.friction.sphere.ErrorMap` of the paper's closed forms, the
-    generalised base and the generalised model on the static (or rolling) map of
-    ``analysis``, errors scaled by the analysis's F0 and M0 (the data of
-    :func:`fepost.figures.errormap.plot_error_map`)."""
+def model_error_map(
+    pmap: PolarMap,
+    coefficients: Coefficients,
+    law: FrictionLaw,
+    *,
+    model: GeneralisedModel,
+    rolling: bool = False,
+    n_beta: int = 37,
+    n_t: int = 65,
+):
+    """The error of the paper's closed forms, the generalised base and ``model`` over the
+    kinematic sphere of the map ``pmap``, scaled by the coefficients' F0 and M0.
+
+    Parameters
+    ----------
+    pmap : PolarMap
+        The static map, or the rolling map in the static patch's frame.
+    coefficients : Coefficients
+        The paper's coefficients (F0, M0, a, m, k_x, R).
+    law : FrictionLaw
+        The friction law of the exact integrals.
+    model : GeneralisedModel
+        The generalised model of ``pmap`` (`map_model`, or the one of an
+        analysis's ``model_summary``).
+    rolling : bool
+        ``pmap`` is the rolling map: the closed forms include k_x.
+    n_beta, n_t : int
+        Points of the grid over the sliding direction and over ε.
+
+    Returns
+    -------
+    ErrorMap
+        ``fepost.friction.sphere.ErrorMap``: the data of ``fepost.figures.errormap.plot_error_map``.
+    """
     from .sphere import error_map
 
-    summary = analysis.model_summary
-    model = summary.rolling if rolling else summary.static
-    pmap = analysis.rolling_map if rolling else analysis.static_map
-    if model is None or pmap is None:
-        raise ArgumentError("analysis has no rolling map (give one to analyse)")
-    c = analysis.coefficients
-    k_x = c.k_x if (rolling and c.k_x is not None) else 0.0
+    check_map_values(pmap, coefficients, law)
+    if not isinstance(model, GeneralisedModel):
+        raise ArgumentError(f"model must be a GeneralisedModel, got {type(model).__name__}")
+    c = coefficients
     return error_map(
         PressureQuadrature.from_polar(pmap),
         {
-            "paper": paper_model(c.F0, c.M0, c.a, c.m, k_x, c.R),
+            "paper": paper_model(c.F0, c.M0, c.a, c.m, paper_k_x(c, rolling=rolling), c.R),
             "base": model.without_correction(),
             "model": model,
         },
-        law=FrictionLaw(f=c.f),
+        law=law,
         F0=c.F0,
         M0=c.M0,
         R=c.R,

@@ -21,7 +21,7 @@ from .curves import (
     DEFAULT_AMPLITUDE,
     DEFAULT_N_POINTS,
     DEFAULT_SPAN,
-    _coefficient_values,
+    coefficient_values,
     make_test_curves,
     with_noise,
 )
@@ -125,7 +125,7 @@ def approximation_bias(
     fit gives the bias of a, m (and F0, M0, k_x) against their asymptotic values; the
     noisy fit shows whether the paper's 20 % noise would hide it.
     """
-    c = _coefficient_values(coefficients)
+    c = coefficient_values(coefficients)
     clean = make_test_curves(
         "exact",
         c,

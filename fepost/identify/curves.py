@@ -127,8 +127,24 @@ class TestCurves:
         return d
 
 
-def _abscissa(x) -> np.ndarray:
-    """ψ or υ values for evaluating a fitted curve: finite numbers, any shape."""
+def abscissa(x) -> np.ndarray:
+    """ψ or υ values for evaluating a fitted curve: finite numbers, any shape.
+
+    Parameters
+    ----------
+    x : array_like
+        The abscissae.
+
+    Returns
+    -------
+    ndarray of float
+        ``x`` as floats, same shape.
+
+    Raises
+    ------
+    ArgumentError
+        ``x`` is not numeric, or holds a NaN or an infinity (named with its index).
+    """
     try:
         arr = np.asarray(x, dtype=float)
     except (TypeError, ValueError):
@@ -140,8 +156,24 @@ def _abscissa(x) -> np.ndarray:
     return arr
 
 
-def _coefficient_values(coefficients) -> dict[str, float]:
-    """F0, M0, a, m, k_x, R, N from a Coefficients-like object or a mapping."""
+def coefficient_values(coefficients) -> dict[str, float]:
+    """F0, M0, a, m, k_x, R, N from a Coefficients-like object or a mapping.
+
+    Parameters
+    ----------
+    coefficients : Coefficients or mapping
+        Anything with these attributes or keys (e.g. ``fepost.coefficients.Coefficients``).
+
+    Returns
+    -------
+    dict of str to float
+        The seven values, finite floats.
+
+    Raises
+    ------
+    ArgumentError
+        A value is missing (k_x: without a rolling map), not a number or not finite.
+    """
     out = {}
     for key in ("F0", "M0", "a", "m", "k_x", "R", "N"):
         if isinstance(coefficients, Mapping):
@@ -247,7 +279,7 @@ def make_test_curves(
         raise ArgumentError(f"span must be a positive finite ratio, got {span!r}")
     if not (np.isfinite(amplitude) and amplitude >= 0):
         raise ArgumentError(f"amplitude must be a finite fraction >= 0, got {amplitude!r}")
-    c = _coefficient_values(coefficients)
+    c = coefficient_values(coefficients)
     grid = np.linspace(0.0, float(span), int(n_points))
     if source == "closed_form":
         fpar = c["F0"] * f_parallel_ratio(grid, c["a"])

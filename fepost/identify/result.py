@@ -12,7 +12,7 @@ from scipy import special
 
 from .._arrays import frozen
 from ..errors import ArgumentError
-from .curves import CURVES, PARAMETER_UNITS, PARAMETERS, _abscissa
+from .curves import CURVES, PARAMETER_UNITS, PARAMETERS, abscissa
 from .forms import PAPER
 
 #: Confidence level of every interval.
@@ -98,7 +98,7 @@ class Identification:
 
         Units: N for ``"f_parallel"`` and ``"f_perp"``, N·m for ``"torque"``.
         """
-        return frozen(self.form.values(name, _abscissa(x), self.values, self.R))
+        return frozen(self.form.values(name, abscissa(x), self.values, self.R))
 
     def curve_stderr(self, name: str, x) -> np.ndarray:
         """Standard error of the fitted curve at ``x``: √(gᵀΣg) (units of the curve).
@@ -108,7 +108,7 @@ class Identification:
         uncertainty of the *mean* curve; ± t·curve_stderr is its confidence band.
         NaN when the covariance is indeterminate.
         """
-        _, g = self.form(name, _abscissa(x), self.values, self.R)
+        _, g = self.form(name, abscissa(x), self.values, self.R)
         var = np.einsum("...i,ij,...j->...", g, self.covariance, g)
         return frozen(np.sqrt(np.maximum(var, 0.0)))
 
@@ -142,7 +142,7 @@ class Identification:
             raise ArgumentError(f"level must be a probability in (0, 1), got {level!r}")
         if name not in CURVES:
             raise ArgumentError(f"name must be one of {', '.join(CURVES)}, got {name!r}")
-        x = _abscissa(x)
+        x = abscissa(x)
         y = self.curve(name, x)
         var = self.curve_stderr(name, x) ** 2 + self.redchi * self.noise_sigma[name] ** 2
         nu = max(self.residuals[name].size - self.dof_share[name], 0.5)  # as in fit_table1

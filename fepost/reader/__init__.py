@@ -185,6 +185,13 @@ def read_contact(
         A 2-D (plane or axisymmetric) model.
     PressureError
         No positive pressure at the step read (the steps that have some are named).
+
+    Examples
+    --------
+    >>> from fepost.reader import read_contact
+    >>> fld = read_contact("meshes/static.vtu")   # the CalculiX sample of the repository
+    >>> fld.field, fld.location, fld.n_points
+    ('CPRESS', 'point', 2961)
     """
     return start_reading(path, field, step, displacement, units=units, surface=surface).result()
 

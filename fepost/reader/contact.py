@@ -341,6 +341,7 @@ def _contact(
         units=units,
         notes=tuple(n for n in notes if n),
         format=raw.format,
+        displacement=disp,
     )
 
 

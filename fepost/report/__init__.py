@@ -46,7 +46,10 @@ and the generalised model of the FE maps (Table 1's generalised form).
 
 The subpackage, by job: :mod:`.assemble` (the data the page shows),
 :mod:`.figures` (saving and embedding figures), :mod:`.vtkfiles` (VTK output),
-:mod:`.sections` (optional sections), :mod:`.html` (the Jinja2 templates in
+:mod:`.sections` (what an optional section is), :mod:`.providers` (the sections
+the report registers), :mod:`.sweepsection` (a sweep as a section),
+:mod:`.sweeppage` and :mod:`.sweepembed` (a sweep's trends page and its
+embeddable HTML section), :mod:`.html` (the Jinja2 templates in
 ``templates/``), :mod:`.build` (the steps), :mod:`.samples` (the default inputs).
 Names are imported on first use, so ``import fepost.report`` stays cheap.
 """

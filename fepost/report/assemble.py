@@ -29,7 +29,14 @@ DEFAULT_INFLATION_PRESSURE = 200e3
 CURVE_POINTS = 201
 
 
-def _check_inflation_option(option) -> float:
+def check_inflation_option(option) -> float:
+    """The ``--inflation-pressure`` value P* in Pa: a finite positive number.
+
+    Raises
+    ------
+    ArgumentError
+        ``option`` is not a positive finite pressure (the message names the option).
+    """
     try:
         p = float(option)
     except (TypeError, ValueError):
@@ -42,7 +49,7 @@ def _check_inflation_option(option) -> float:
 def resolve_inflation_pressure(option: float | None, analysis: Analysis) -> tuple[float, str]:
     """P* (Pa) and where it came from: the option, the static mesh's sidecar, or the default."""
     if option is not None:
-        return _check_inflation_option(option), "option"
+        return check_inflation_option(option), "option"
     side = analysis.static_field.sidecar or {}
     value = side.get("inflation_pressure")
     if value is not None:
@@ -298,7 +305,7 @@ PATCH_ROWS = (
 
 
 def _row(key, label, kind, definition, value, prefix):
-    from . import units
+    from ..figures import units
 
     unit = units.UNITS[kind] if kind and kind != "fraction" else ""
     return {

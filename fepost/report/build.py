@@ -17,9 +17,10 @@ from ..analysis import analyse
 from ..output import staged_folder, to_json
 from ..table1 import DEFAULT_SEED, table1
 from . import samples
-from .assemble import _check_inflation_option, friction_curves, page_context, resolve_inflation_pressure
+from .assemble import check_inflation_option, friction_curves, page_context, resolve_inflation_pressure
 from .figures import Figure, save_matplotlib, save_plotter
-from .sections import DEFAULT_SECTIONS, ReportData, SectionProvider, run_providers
+from .providers import DEFAULT_SECTIONS
+from .sections import ReportData, SectionProvider, run_providers
 
 Progress = Callable[[int, int, str, float], None]
 
@@ -126,7 +127,7 @@ def build_report(
         ``progress(k, n, step, seconds)``, called after each step.
     sections : sequence of section providers
         Optional sections (:mod:`fepost.report.sections`), default
-        :data:`~fepost.report.sections.DEFAULT_SECTIONS`.
+        :data:`~fepost.report.providers.DEFAULT_SECTIONS`.
 
     Raises
     ------
@@ -149,7 +150,7 @@ def build_report(
         static, rolling = samples.sample_inputs()
     out = Path(out)
     if inflation_pressure is not None:
-        _check_inflation_option(inflation_pressure)
+        check_inflation_option(inflation_pressure)
     has_roll = rolling is not None
     steps = _Steps(total=12 + (1 if has_roll else 0), progress=progress)
     inputs = [Path(p) for p in (static, rolling) if isinstance(p, str | os.PathLike)]
@@ -228,13 +229,19 @@ def build_report(
 
         def error_maps():
             from ..figures.errormap import plot_error_map
-            from ..friction.summary import analysis_error_map
+            from ..friction.law import FrictionLaw
+            from ..friction.summary import model_error_map
 
             made, docs = {}, {}
             for stem, rolling in (("error_map", False), ("error_map_rolling", True)):
                 if rolling and a.rolling_map is None:
                     continue
-                em = analysis_error_map(a, rolling=rolling, **ERROR_MAP_GRID)
+                pmap = a.rolling_map if rolling else a.static_map
+                model = a.model_summary.rolling if rolling else a.model_summary.static
+                law = FrictionLaw(f=a.coefficients.f)
+                em = model_error_map(
+                    pmap, a.coefficients, law, model=model, rolling=rolling, **ERROR_MAP_GRID
+                )
                 key = stem.replace("_", "-")
                 alt = (
                     f"Error map of the {'rolling' if rolling else 'static'} map: "

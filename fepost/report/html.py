@@ -16,7 +16,7 @@ from functools import cache
 
 from markupsafe import Markup
 
-from . import units
+from ..figures import units
 
 
 def cell(value, key: str | None = None, fmt: str = "{:.6g}", scale: float = 1.0) -> Markup:

@@ -4,10 +4,9 @@ A section provider is a function ``provider(data, folder) -> Section | None``:
 it gets the :class:`ReportData` (the analysis, Table 1, the friction curves,
 P*, ...) and the folder being written (to save figures or tables into), and
 returns a :class:`Section`, or ``None`` when it has nothing to show (then the
-report has no trace of it). :data:`DEFAULT_SECTIONS` lists the providers
-``fepost report`` runs, in page order; they come after the friction curves:
-today the load sweep of the sample aircraft tire (:func:`sample_sweep`), shown
-in the report of one of its cases.
+report has no trace of it). This module knows no provider: the report
+registers the ones it runs, in page order, in ``fepost.report.providers``
+(``DEFAULT_SECTIONS``); they come after the friction curves.
 
 A section renders ``templates/sections/<template>`` with the names ``section``
 (the :class:`Section`) and ``figure`` (the figure macro) in scope; the generic
@@ -78,18 +77,6 @@ class Section:
 
 
 SectionProvider = Callable[[ReportData, Path], "Section | None"]
-
-
-def sample_sweep(data: ReportData, folder: Path) -> Section | None:
-    """The load sweep of the sample aircraft tire, in the report of one of its cases
-    (:func:`fepost.sweep.reportsection.sample_sweep_section`; imported when run)."""
-    from ..sweep.reportsection import sample_sweep_section
-
-    return sample_sweep_section(data, folder)
-
-
-#: Providers run by ``fepost report``, in page order.
-DEFAULT_SECTIONS: tuple[SectionProvider, ...] = (sample_sweep,)
 
 
 def run_providers(providers, data: ReportData, folder: Path) -> list[Section]:

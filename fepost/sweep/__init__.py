@@ -21,17 +21,17 @@ Modules, one job each:
 * :mod:`.progress` – the progress bar
 * :mod:`.table` – columns, units, Parquet and CSV
 * :mod:`.run` – :func:`run_sweep`, the steps above in order
-* :mod:`.trends`, :mod:`.figures`, :mod:`.page` – power-law fits, figures,
-  the trends page and :func:`sweep_section` for embedding in a report
-* :mod:`.embed` – :func:`sweep_report_section`: run a sweep and return its
-  HTML section, for any page
-* :mod:`.reportsection` – the sweep as an optional section of ``fepost report``
-  (``sample_sweep_section`` for the sample load sweep in ``meshes/aircraft/``)
+* :mod:`.trends` – power-law fits of the coefficients against the load
+
+The sweep computes; its presentation lives above it: the figures in
+``fepost.figures.sweep``, the trends page and the embeddable section in
+``fepost.report.sweeppage`` (``write_trends``, ``sweep_section``),
+``fepost.report.sweepembed`` (``sweep_report_section``: run a sweep and return
+its HTML section) and ``fepost.report.sweepsection`` (the sweep as an optional
+section of ``fepost report``).
 """
 
-from .embed import sweep_report_section
 from .options import RowOptions
-from .page import sweep_section, write_trends
 from .run import SweepResult, run_sweep
 from .table import COLUMNS, read_table
 from .trends import PowerLaw, fit_power_law, load_trends
@@ -45,7 +45,4 @@ __all__ = [
     "load_trends",
     "read_table",
     "run_sweep",
-    "sweep_report_section",
-    "sweep_section",
-    "write_trends",
 ]

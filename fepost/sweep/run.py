@@ -13,7 +13,9 @@ The steps of a sweep:
    :func:`fepost.analysis.analyse` call each); each row is saved the moment it
    arrives;
 5. the table is written whole (``coefficients.parquet``, ``coefficients.csv``),
-   then the trends page.
+   then, when the caller gives a page writer (``trends``, e.g.
+   ``fepost.report.sweeppage.write_trends``), the trends page. The sweep
+   computes; how a sweep is presented lives in the report and figure packages.
 
 The cluster is started only when something is left to compute.
 """
@@ -21,7 +23,7 @@ The cluster is started only when something is left to compute.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -37,6 +39,9 @@ from .progress import ProgressBar
 from .steps import SERIES_SUFFIXES, time_steps
 from .store import WorkFolder
 from .table import normalise, one_line, write_table
+
+#: A page writer: ``writer(rows, out) -> path of the page`` (``fepost.report.sweeppage.write_trends``).
+TrendsWriter = Callable[[Sequence[Mapping], Path], Path]
 
 
 @dataclass(frozen=True)
@@ -175,7 +180,7 @@ def run_sweep(
     progress: bool | None = None,
     fresh: bool = False,
     force: bool = False,
-    trends: bool = True,
+    trends: TrendsWriter | None = None,
 ) -> SweepResult:
     """Analyse every input (and, with ``steps="all"``, every time step) on Dask.
 
@@ -210,8 +215,10 @@ def run_sweep(
         Forget rows finished by earlier runs.
     force : bool
         Write into a folder that holds other files.
-    trends : bool
-        Write the trends page (figures and power-law fits).
+    trends : callable, optional
+        Writes the trends page (figures and power-law fits) from the table's
+        rows into ``out`` and returns its path: ``fepost.report.sweeppage.write_trends``
+        (what ``fepost sweep`` passes). None (default): the table only.
 
     Returns
     -------
@@ -251,10 +258,8 @@ def run_sweep(
         table = [normalise(r) for r in rows if r is not None]
         parquet, csv = write_table(table, out)
         page = None
-        if trends:
-            from .page import write_trends
-
-            page = write_trends(table, out)
+        if trends is not None:
+            page = trends(table, out)
     frozen = tuple(MappingProxyType(r) for r in table)
     return SweepResult(out, frozen, reused, len(todo), parquet, csv, page)
 

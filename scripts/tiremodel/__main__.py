@@ -121,6 +121,12 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"tiremodel: error: {exc}", file=sys.stderr)
         return 1
+    except ModuleNotFoundError as exc:  # gmsh, ccx2paraview: the 'model' extra
+        if args.debug:
+            raise
+        hint = "install the model extra: pip install -e '.[model]'"
+        print(f"tiremodel: error: no Python module {exc.name!r}: {hint}", file=sys.stderr)
+        return 1
     except Exception as exc:  # noqa: BLE001 - one-line report for the CLI
         if args.debug:
             raise

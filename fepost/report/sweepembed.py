@@ -13,9 +13,9 @@ import shutil
 from collections.abc import Sequence
 from pathlib import Path
 
-from .page import sweep_section
-from .run import run_sweep
-from .store import WORK
+from ..sweep.run import run_sweep
+from ..sweep.store import WORK
+from .sweeppage import sweep_section
 
 
 def sweep_report_section(
@@ -61,7 +61,6 @@ def sweep_report_section(
         client=client,
         processes=processes,
         progress=False,
-        trends=False,
         force=True,
     )
     shutil.rmtree(out / WORK, ignore_errors=True)

@@ -1,6 +1,6 @@
 """The trends page of a sweep (``DIR/trends.html``) and its embeddable section.
 
-HTML comes from Jinja2 templates kept as files in ``fepost/sweep/templates/``:
+HTML comes from Jinja2 templates kept as files in ``fepost/report/templates/sweep/``:
 ``section.html.j2`` (figures, power-law fits, the table) is what
 :func:`sweep_section` returns for embedding in another page (the report);
 ``trends.html.j2`` wraps it into a standalone page.
@@ -17,10 +17,11 @@ from pathlib import Path
 
 import markupsafe
 
+from ..figures.sweep import MAX_SERIES, plot_load_trends, plot_time_trends, transient_series
+from ..figures.units import display_unit
 from ..output import write_json_atomic, write_text_atomic
-from .figures import MAX_SERIES, plot_load_trends, plot_time_trends, transient_series
-from .table import normalise
-from .trends import PowerLaw, load_trends
+from ..sweep.table import normalise
+from ..sweep.trends import PowerLaw, load_trends
 
 #: Heading of the section (on the trends page, and by default when embedded).
 TITLE = "Sweep: coefficients against load"
@@ -50,7 +51,7 @@ def _environment():
     import jinja2
 
     env = jinja2.Environment(
-        loader=jinja2.PackageLoader("fepost.sweep", "templates"),
+        loader=jinja2.PackageLoader("fepost.report", "templates/sweep"),
         autoescape=jinja2.select_autoescape(["html", "j2"]),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
@@ -65,8 +66,6 @@ def _environment():
 def _quantity(fit: PowerLaw):
     """A fit's quantity as the page writes it: symbol with subscripts, unit in the report's
     style in parentheses (none for a dimensionless quantity)."""
-    from ..report.units import display_unit
-
     name = markupsafe.Markup(HTML_LABELS.get(fit.quantity, markupsafe.escape(fit.label)))
     unit = display_unit(fit.unit)
     return name + markupsafe.Markup(" (") + unit + markupsafe.Markup(")") if unit else name

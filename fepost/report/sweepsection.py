@@ -2,7 +2,7 @@
 
 :func:`sample_sweep_section` is the provider for the sample load sweep shipped
 in ``meshes/aircraft/`` (``static_*.vtu``, ``rolling_*.vtu`` paired by
-``static=rolling``), listed in :data:`fepost.report.sections.DEFAULT_SECTIONS`:
+``static=rolling``), registered in ``fepost.report.providers.DEFAULT_SECTIONS``:
 when the report's static map is one of those files (the report of the sample
 tire, as ``fepost report`` without inputs and ``make demo`` write it) it runs
 the sweep, draws the load trends and returns a :class:`fepost.report.Section`;
@@ -18,6 +18,9 @@ figures (PNG, SVG). The row of the report's own case (same static and rolling
 file, same options) is not analysed again: it is made from the report's
 analysis (:func:`fepost.sweep.jobs.analysis_row`) and handed to the sweep as a
 finished row.
+
+The sweep only computes; this module is its presentation in the report (it
+imports the sweep, never the other way round).
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from ..report.sections import ReportData, Section
+    from .sections import ReportData, Section
 
 #: Sub-folder of the report that holds the sweep's files.
 FOLDER = "sweep"
@@ -129,8 +132,8 @@ def sweep_provider(
         if not present:
             return None
         from ..errors import ArgumentError
-        from .inputs import expand_inputs
-        from .pairs import pair_sources, parse_rolling_pairs
+        from ..sweep.inputs import expand_inputs
+        from ..sweep.pairs import pair_sources, parse_rolling_pairs
 
         pairs = None if rolling_pairs is None else parse_rolling_pairs(rolling_pairs)
         sources = expand_inputs(present)
@@ -142,14 +145,14 @@ def sweep_provider(
         own, same = _report_case(data, pairings)
         if only_with_report_case and own is None:
             return None  # decided before the sweep's heavier imports (Dask, pyarrow)
-        from ..report.figures import Figure, png_data_uri
-        from ..report.sections import Section
-        from .jobs import Job, analysis_row
-        from .options import RowOptions
-        from .page import draw_figures
-        from .run import run_sweep
-        from .store import WORK, WorkFolder
-        from .trends import load_trends
+        from ..sweep.jobs import Job, analysis_row
+        from ..sweep.options import RowOptions
+        from ..sweep.run import run_sweep
+        from ..sweep.store import WORK, WorkFolder
+        from ..sweep.trends import load_trends
+        from .figures import Figure, png_data_uri
+        from .sections import Section
+        from .sweeppage import draw_figures
 
         options = RowOptions.from_analysis_kwargs(_analysis_kwargs(data), friction=float(data.friction))
         out = Path(folder) / FOLDER
@@ -167,7 +170,6 @@ def sweep_provider(
             workers=1,
             processes=False,
             progress=False,
-            trends=False,
             force=True,
         )
         shutil.rmtree(out / WORK, ignore_errors=True)
@@ -207,7 +209,7 @@ def sweep_provider(
 def sample_sweep_section(data: ReportData, folder: Path) -> Section | None:
     """The section of the sample load sweep in ``meshes/aircraft/`` in the report of one of
     its cases; None for a report of other files, or when the sample is not there."""
-    from ..report.samples import meshes_folder
+    from .samples import meshes_folder
 
     inputs = [str(meshes_folder() / p) for p in SAMPLE_INPUTS]
     return sweep_provider(inputs, SAMPLE_PAIRS, only_with_report_case=True)(data, folder)

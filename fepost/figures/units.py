@@ -1,4 +1,4 @@
-"""How the report writes numbers and units: one style everywhere.
+"""How the figures and the report write numbers and units: one style everywhere.
 
 * SI units: lengths in m, areas in m², forces in N, torques in N·m; pressures
   in kPa (the JSON files keep Pa); dimensionless values bare.

@@ -10,8 +10,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..report.units import display_unit
-from .trends import QUANTITIES, PowerLaw, groups
+from ..sweep.trends import QUANTITIES, PowerLaw, groups
+from .units import display_unit
 
 #: Panels of the time-step figure: column, label, unit.
 TIME_PANELS = (
@@ -34,6 +34,11 @@ MATH_LABELS = {
 }
 #: Most transient runs drawn in one figure (the legend stays readable).
 MAX_SERIES = 8
+#: Panels per row of the load-trend figure: two, so the report, which shows images at most
+#: 900 px wide, does not shrink the figure's text below the page's small print.
+TREND_COLUMNS = 2
+#: Legend text of the sweep's figures (points): the exponents and intervals must be readable.
+LEGEND_FONTSIZE = 10.5
 _COLOURS = ("#1f4e99", "#c0392b", "#2ca02c", "#e67e22", "#8e44ad", "#16a085", "#7f7f7f", "#b8860b")
 
 
@@ -54,11 +59,11 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
     import matplotlib.pyplot as plt
     from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
 
-    from ..figures.theme import mpl_style
+    from .theme import mpl_style
 
     quantities = [q for q in QUANTITIES if any(r.get(q[0]) is not None for r in rows)]
     with mpl_style():
-        ncol = min(3, len(quantities))
+        ncol = min(TREND_COLUMNS, len(quantities))
         nrow = -(-len(quantities) // ncol)
         fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.4 * nrow), squeeze=False)
         by_group = groups(rows)
@@ -101,7 +106,7 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
             title = symbol if hertz is None else rf"{symbol}   (Hertz: $\propto N^{{{hertz:.3g}}}$)"
             ax.set_title(title, fontsize=10)
             if ax.get_legend_handles_labels()[0]:
-                ax.legend(loc="best")
+                ax.legend(loc="best", fontsize=LEGEND_FONTSIZE)
         for ax in list(axes.flat)[len(quantities) :]:
             ax.set_visible(False)
         fig.tight_layout()
@@ -121,7 +126,7 @@ def plot_time_trends(series: Mapping[str, Sequence[Mapping]]):
     """Panels of N, R, M0, aspect, aR², m/R² against time for each multi-step run."""
     import matplotlib.pyplot as plt
 
-    from ..figures.theme import mpl_style
+    from .theme import mpl_style
 
     with mpl_style():
         fig, axes = plt.subplots(2, 3, figsize=(12.6, 6.8), squeeze=False)
@@ -134,6 +139,6 @@ def plot_time_trends(series: Mapping[str, Sequence[Mapping]]):
         for ax, (q, _label, unit) in zip(axes.flat, TIME_PANELS, strict=True):
             ax.set_xlabel("time (s) or step")
             ax.set_ylabel(axis_label(q, unit))
-        axes[0, 0].legend(loc="best")
+        axes[0, 0].legend(loc="best", fontsize=LEGEND_FONTSIZE)
         fig.tight_layout()
     return fig
