@@ -10,6 +10,7 @@ suffix                    reader
                           after the checks of :mod:`.vtkcheck`
                           (:mod:`.xmlcheck`, :mod:`.legacycheck`)
 ``.e .exo .ex2 .exii``    the netCDF container read with netCDF4 (:mod:`.exodus`)
+``.frd``                  CalculiX results, ASCII or binary (:mod:`.frd`)
 ========================= ===================================================
 
 Every file is read in a forked child process (:mod:`.isolate`): a file that
@@ -40,6 +41,7 @@ if TYPE_CHECKING:
 
 VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm")
 EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
+FRD_SUFFIXES = (".frd",)
 #: Values that mean "no contact data" rather than a pressure (MOOSE writes −99999).
 SENTINELS = (-99999.0, -999999.0, -9999.0, -1.0e30, -1.0e20)
 
@@ -60,7 +62,7 @@ __all__ = [
 
 
 def supported_suffixes() -> tuple[str, ...]:
-    return VTK_SUFFIXES + EXODUS_SUFFIXES
+    return VTK_SUFFIXES + EXODUS_SUFFIXES + FRD_SUFFIXES
 
 
 def _checked(path: str | Path) -> tuple[Path, int]:
@@ -173,6 +175,10 @@ def _steps_here(path: Path) -> tuple[float, ...] | None:
         from .exodus import read_steps
 
         return read_steps(path)
+    if path.suffix.lower() in FRD_SUFFIXES:
+        from .frd import read_steps as frd_steps
+
+        return frd_steps(path)
     return None
 
 
