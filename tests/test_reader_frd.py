@@ -1,0 +1,194 @@
+"""CalculiX ``.frd`` files read directly, checked against the solver's own reaction and ccx2paraview.
+
+Each case solves a small contact model with the ``ccx`` on PATH (a soft block
+pressed on a steel plate, tests/frd_decks.py; under 2 s each) and compares
+
+* fepost's load from the ``.frd`` (N_fe: the exact integral of the nodal CPRESS
+  over the recovered contact faces) with the total reaction CalculiX prints for
+  the plate's fixed bottom (``*NODE PRINT, TOTALS=ONLY``), and
+* the same file converted by ccx2paraview to ``.vtu`` and read by fepost's VTU
+  path: the same numbers to round-off.
+
+Tolerances. Linear elements, node-to-surface penalty: CalculiX's CPRESS is
+each slave node's spring force over its tributary area, which for linear faces
+is the integral of the node's shape function, so the integral of the
+interpolated CPRESS is the sum of the spring forces: equal to the reaction up
+to the five digits of the ASCII values (measured 7e-6; bound 5e-5).
+Quadratic tetrahedra and wedges: the springs sit at the mid-side nodes (the
+corners of a 6-node triangle have no tributary area); measured 0.08 % and
+0.3 %, bound 1 %. Surface-to-surface contact: CPRESS is extrapolated from the
+integration points (measured 0.6 % on 8-node bricks, 0.015 % on 20-node
+bricks); bound 1 %. fepost's N (the polar-grid integral) meets the pressure
+jump along the square patch's edges: measured 0.4 %, bound 1 % as for the
+square patches of tests/test_external.py.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from frd_decks import write_deck
+
+from fepost import analyse
+from fepost.cli import main
+from fepost.errors import FieldError, ReaderWarning
+from fepost.patch import build_patch
+from fepost.reader import read_contact, time_steps
+
+REPO = Path(__file__).resolve().parents[1]
+if str(REPO) not in sys.path:  # scripts/ is a plain folder at the repository root
+    sys.path.insert(0, str(REPO))
+
+HAVE_CCX = shutil.which("ccx") is not None
+pytestmark = [pytest.mark.ccx, pytest.mark.skipif(not HAVE_CCX, reason="CalculiX 'ccx' is not on PATH")]
+ASCII_TOL = 5e-5
+QUADRATIC_TOL = 1e-2
+S2S_TOL = 1e-2
+GRID_TOL = 1e-2
+ROUND_OFF = 1e-6  # float32 points in the converted file
+
+
+def solve(folder: Path, etype: str = "C3D8", **kw) -> tuple[Path, list[tuple[float, float]]]:
+    """Solve the deck in ``folder``; return the .frd and the (time, reaction z) of every increment."""
+    from scripts.tiremodel.frd import read_dat_totals
+    from scripts.tiremodel.solve import find_ccx, run_ccx
+
+    folder.mkdir(parents=True, exist_ok=True)
+    inp = write_deck(folder / "job.inp", etype, **kw)
+    run_ccx(find_ccx(), inp, threads=1, timeout=300)
+    totals = [(t, float(f[2])) for name, t, f in read_dat_totals(folder / "job.dat") if name == "PBOT"]
+    return folder / "job.frd", totals
+
+
+@pytest.fixture(scope="module")
+def cases(tmp_path_factory):
+    root = tmp_path_factory.mktemp("frd")
+    return {
+        "ascii": solve(root / "ascii"),
+        "binary": solve(root / "binary", binary=True),
+        "steps": solve(root / "steps", increments=4, binary=True),
+    }
+
+
+def _n_fe(path, **kw) -> float:
+    return build_patch(read_contact(path, **kw)).N_fe
+
+
+@pytest.mark.parametrize("kind", ["ascii", "binary"])
+def test_load_equals_the_solver_reaction(cases, kind):
+    path, totals = cases[kind]
+    reaction = totals[-1][1]
+    fld = read_contact(path)
+    assert fld.format == f"CalculiX .frd ({'ASCII' if kind == 'ascii' else 'binary'})"
+    assert fld.field == "CONTACT:CPRESS"
+    assert set(fld.faces) == {"quad4"} and len(fld.faces["quad4"]) == 16  # the block's 4 × 4 bottom faces
+    assert set(fld.arrays) == {"CONTACT", "DISP"}
+    patch = build_patch(fld)
+    assert patch.N_fe == pytest.approx(reaction, rel=ASCII_TOL)
+    res = analyse(path)
+    assert res.coefficients.N == pytest.approx(reaction, rel=GRID_TOL)
+
+
+def test_ascii_and_binary_agree(cases):
+    a, b = (read_contact(cases[k][0]) for k in ("ascii", "binary"))
+    np.testing.assert_allclose(a.points, b.points, rtol=0, atol=1e-9)  # ASCII: 6 digits of 5e-2 m
+    np.testing.assert_allclose(a.values, b.values, rtol=1e-5)  # ASCII: 6 significant digits
+    assert _n_fe(cases["ascii"][0]) == pytest.approx(_n_fe(cases["binary"][0]), rel=1e-5)
+
+
+def test_same_numbers_as_the_ccx2paraview_vtu(cases, tmp_path):
+    from ccx2paraview.common import Converter
+
+    frd = tmp_path / "job.frd"
+    shutil.copy(cases["ascii"][0], frd)
+    Converter(str(frd), ["vtu"]).run()
+    vtu = tmp_path / "job.vtu"
+    assert vtu.exists()
+    direct, converted = read_contact(frd), read_contact(vtu)
+    assert converted.field == "CONTACT:CPRESS"
+    # ccx2paraview stores the points in float32 (VTK's default): round-off of 6e-8 relative
+    assert build_patch(direct).N_fe == pytest.approx(build_patch(converted).N_fe, rel=ROUND_OFF)
+    a, b = analyse(frd).coefficients, analyse(vtu).coefficients
+    for key in ("N", "M0", "R", "F0"):
+        assert getattr(a, key) == pytest.approx(getattr(b, key), rel=ROUND_OFF), key
+
+
+@pytest.mark.parametrize(
+    ("etype", "contact", "faces", "tol"),
+    [
+        ("C3D8I", "NODE TO SURFACE", "quad4", ASCII_TOL),
+        ("C3D6", "NODE TO SURFACE", "tri3", ASCII_TOL),
+        ("C3D4", "NODE TO SURFACE", "tri3", ASCII_TOL),
+        ("C3D10", "NODE TO SURFACE", "tri6", QUADRATIC_TOL),
+        ("C3D15", "NODE TO SURFACE", "tri6", QUADRATIC_TOL),
+        ("C3D20", "SURFACE TO SURFACE", "quad8", S2S_TOL),
+        ("C3D8", "SURFACE TO SURFACE", "quad4", S2S_TOL),
+    ],
+)
+def test_element_types(tmp_path, etype, contact, faces, tol):
+    path, totals = solve(tmp_path, etype, contact=contact)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ReaderWarning)
+        fld = read_contact(path)
+    kept = set(fld.faces) | ({"tri3"} if len(fld.triangles) else set())
+    assert kept == {faces}  # quadratic faces keep their mid-side nodes
+    assert build_patch(fld).N_fe == pytest.approx(totals[-1][1], rel=tol)
+
+
+def test_quadratic_node_to_surface_is_flagged(tmp_path):
+    path, _ = solve(tmp_path, "C3D20")
+    with pytest.warns(ReaderWarning, match="node-to-surface contact on quadratic hexahedra"):
+        fld = read_contact(path)
+    assert set(fld.faces) == {"quad8"}
+
+
+def test_every_increment_is_a_time_step(cases, tmp_path, capsys):
+    path, totals = cases["steps"]
+    steps = time_steps(path)
+    assert [s.index for s in steps] == [0, 1, 2, 3]
+    np.testing.assert_allclose([s.time for s in steps], [0.25, 0.5, 0.75, 1.0])
+    np.testing.assert_allclose([t for t, _ in totals], [0.25, 0.5, 0.75, 1.0])
+    loads = [_n_fe(path, step=k) for k in range(4)]
+    for (_, reaction), n in zip(totals, loads, strict=True):
+        assert n == pytest.approx(reaction, rel=ASCII_TOL)
+    assert loads[0] < loads[1] < loads[2] < loads[3]  # the push grows with the increments
+    assert read_contact(path).step == 3 and _n_fe(path) == loads[3]  # the last by default
+    assert read_contact(path, step=-3).time == pytest.approx(0.5)
+    out = tmp_path / "c.json"
+    assert main(["coefficients", str(path), "--step", "1", "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["N_fe"] == pytest.approx(loads[1], rel=1e-9)
+    assert main(["coefficients", str(path), "--step", "7"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("fepost: error:") and "--step 7 out of range (file has 4 time steps)" in err[-1]
+
+
+def test_contact_components_kept(cases):
+    from fepost.reader.frd import read_frd
+
+    raw = read_frd(cases["binary"][0], None)
+    try:
+        assert raw.components["CONTACT"] == ("COPEN", "CSLIP1", "CSLIP2", "CPRESS", "CSHEAR1", "CSHEAR2")
+        contact = raw.point_data["CONTACT"]
+        assert contact.shape == (len(raw.points), 6)
+        assert np.all(contact[:, 3] > 0)  # every face node is in contact here
+        assert np.all(contact[:, 0] < 0)  # and penetrates (penalty): COPEN < 0
+        assert raw.point_data["DISP"].shape == (len(raw.points), 3)
+    finally:
+        raw.close()
+
+
+def test_no_contact_output_is_a_clear_error(cases, tmp_path):
+    text = cases["ascii"][0].read_text(encoding="latin-1")
+    cut = text.index(" -4  CONTACT")
+    head = text.rfind("    1PSTEP", 0, cut)
+    end = text.index(" -3\n", cut) + 4
+    path = tmp_path / "nocontact.frd"
+    path.write_text(text[:head] + text[end:], encoding="latin-1")
+    with pytest.raises(FieldError, match=r"\*CONTACT FILE .* \*CONTACT OUTPUT .* CSTR"):
+        read_contact(path)
