@@ -81,13 +81,21 @@ def _increments(frd: FrdFile) -> list[tuple[int, float]]:
     return list(seen.items())
 
 
+def _release(data) -> None:
+    """Unmap the file; while an error's traceback still holds a view of it, the collector unmaps it later."""
+    try:
+        data.close()
+    except BufferError:
+        pass
+
+
 def read_steps(path: Path) -> tuple[float, ...]:
     """The time of every increment stored in an ``.frd`` file."""
     data = open_frd(path)
     try:
         return tuple(t for _, t in _increments(scan(path, data)))
     finally:
-        data.close()
+        _release(data)
 
 
 def read_frd(path: Path, step: int | None) -> RawMesh:
@@ -97,12 +105,12 @@ def read_frd(path: Path, step: int | None) -> RawMesh:
         frd = scan(path, data)
         raw = _assemble(frd, path, step)
     except (ValueError, IndexError, OverflowError) as exc:
-        data.close()
+        _release(data)
         raise InputFileError(f"{path}: corrupt .frd file ({exc})") from None
     except BaseException:
-        data.close()
+        _release(data)
         raise
-    raw.closer = data.close
+    raw.closer = lambda: _release(data)
     return raw
 
 
@@ -161,7 +169,9 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
         )
     nodes = _Nodes(path, frd.node_ids)
     n = len(frd.node_ids)
-    conn = {t: nodes.rows(c, f"an element of type {t}") for t, c in frd.elem_nodes.items()}
+    conn = {
+        t: nodes.rows(c, f"an element of frd type {t} ({CANONICAL[t]})") for t, c in frd.elem_nodes.items()
+    }
     cids, cvals = block_values(frd, contact)
     rows = nodes.rows(cids, "the CONTACT block")
     carried = np.zeros(n, bool)
