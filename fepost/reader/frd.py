@@ -1,6 +1,6 @@
 """CalculiX ``.frd`` result files read directly, ASCII and binary.
 
-What is read (the records: :mod:`fepost.reader.frdparse`):
+What is read (the records: `fepost.reader.frdparse`):
 
 * the nodes and the elements (``C3D8``/``C3D8R``/``C3D8I`` as frd type 1,
   ``C3D6`` 2, ``C3D4`` 3, ``C3D20``/``C3D20R`` 4, ``C3D15`` 5, ``C3D10`` 6,
@@ -26,7 +26,7 @@ shape function integrates to zero, and those corners hold zero). When
 the block covers every node of the mesh (surface-to-surface contact writes all
 nodes, zeros away from the slave surface) the elements are handed on and the
 faces touching non-zero pressure are found as for any volume mesh
-(:mod:`fepost.reader.surface`). Faces keep their mid-side nodes (``quad8``,
+(`fepost.reader.surface`). Faces keep their mid-side nodes (``quad8``,
 ``tri6``). A model with only surface elements lying in z = 0 is a 2-D model.
 
 Why fepost parses the file itself and not with ccx2paraview (the only
@@ -51,7 +51,7 @@ from .frdparse import FrdFile, ResultBlock, block_values, open_frd, scan
 from .raw import Block, RawMesh
 
 FRD_SUFFIXES = (".frd",)
-#: frd element type → canonical type of :mod:`fepost.reader.cells` (node orders agree).
+#: frd element type → canonical type of `fepost.reader.cells` (node orders agree).
 CANONICAL = {
     1: "hex8",
     2: "wedge6",
@@ -99,7 +99,7 @@ def read_steps(path: Path) -> tuple[float, ...]:
 
 
 def read_frd(path: Path, step: int | None) -> RawMesh:
-    """Read an ``.frd`` file into a :class:`~fepost.reader.raw.RawMesh` at ``step`` (default: last)."""
+    """Read an ``.frd`` file into a `fepost.reader.raw.RawMesh` at ``step`` (default: last)."""
     data = open_frd(path)
     try:
         frd = scan(path, data)

@@ -25,7 +25,7 @@ and binary with ``*NODE OUTPUT`` / ``*ELEMENT OUTPUT`` / ``*CONTACT OUTPUT``
 
 The file is memory-mapped and walked once; every count is checked against the
 bytes left before anything is allocated, and result blocks are only located
-here (their values are read on demand by :func:`block_values`).
+here (their values are read on demand by `block_values`).
 """
 
 from __future__ import annotations
