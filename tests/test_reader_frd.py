@@ -120,19 +120,19 @@ def test_same_numbers_as_the_ccx2paraview_vtu(cases, tmp_path):
 
 
 @pytest.mark.parametrize(
-    ("etype", "contact", "faces", "tol"),
+    ("etype", "contact", "faces", "tol", "binary"),
     [
-        ("C3D8I", "NODE TO SURFACE", "quad4", ASCII_TOL),
-        ("C3D6", "NODE TO SURFACE", "tri3", ASCII_TOL),
-        ("C3D4", "NODE TO SURFACE", "tri3", ASCII_TOL),
-        ("C3D10", "NODE TO SURFACE", "tri6", QUADRATIC_TOL),
-        ("C3D15", "NODE TO SURFACE", "tri6", QUADRATIC_TOL),
-        ("C3D20", "SURFACE TO SURFACE", "quad8", S2S_TOL),
-        ("C3D8", "SURFACE TO SURFACE", "quad4", S2S_TOL),
+        ("C3D8I", "NODE TO SURFACE", "quad4", ASCII_TOL, False),
+        ("C3D6", "NODE TO SURFACE", "tri3", ASCII_TOL, True),  # wedges and the plate's bricks: mixed records
+        ("C3D4", "NODE TO SURFACE", "tri3", ASCII_TOL, False),
+        ("C3D10", "NODE TO SURFACE", "tri6", QUADRATIC_TOL, True),
+        ("C3D15", "NODE TO SURFACE", "tri6", QUADRATIC_TOL, False),
+        ("C3D20", "SURFACE TO SURFACE", "quad8", S2S_TOL, True),
+        ("C3D8", "SURFACE TO SURFACE", "quad4", S2S_TOL, False),
     ],
 )
-def test_element_types(tmp_path, etype, contact, faces, tol):
-    path, totals = solve(tmp_path, etype, contact=contact)
+def test_element_types(tmp_path, etype, contact, faces, tol, binary):
+    path, totals = solve(tmp_path, etype, contact=contact, binary=binary)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ReaderWarning)
         fld = read_contact(path)

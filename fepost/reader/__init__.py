@@ -101,12 +101,12 @@ def read_contact(
     Parameters
     ----------
     path : file path
-        ``.vtu``, ``.vtp``, ``.vtk`` (legacy), ``.vtm`` or Exodus II ``.e``/``.exo``.
+        ``.vtu``, ``.vtp``, ``.vtk`` (legacy), ``.vtm``, Exodus II ``.e``/``.exo`` or CalculiX ``.frd``.
     field : str, optional
         Name of the pressure array (``NAME:k`` for component k, or a component
         name such as ``CPRESS``). Default: found by name among :data:`PRESSURE_NAMES`.
     step : int, optional
-        Exodus time step (0-based; negative counts from the end). Default: last.
+        Exodus time step or ``.frd`` increment (0-based; negative counts from the end). Default: last.
     displacement : str or None
         ``"auto"`` (default): add the displacement array if one is found;
         a name: add that array; ``None``: use the coordinates as written.
@@ -185,7 +185,7 @@ def _steps_here(path: Path) -> tuple[float, ...] | None:
 def time_steps(path: str | Path, units: str | UnitSystem | None = None) -> tuple[TimeStep, ...]:
     """The states stored in an FE export, in order.
 
-    Exodus files list every time step (``TimeStep(k, t_k)``; an Exodus file
+    Exodus files list every time step and ``.frd`` files every increment (``TimeStep(k, t_k)``; a file
     without steps gives one ``TimeStep(None, None)``); VTK files hold one state
     (``TimeStep(None, None)``). ``units`` scales the times (``mm-kg-ms``: ms).
     Pass ``step=ts.index`` to :func:`read_contact` / :func:`fepost.analyse`.

@@ -200,6 +200,9 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
         keep = np.arange(n)
         blocks = _element_blocks(frd, conn)
     points = frd.coords[keep]
+    if not np.all(np.isfinite(points)):
+        bad = int(np.sum(~np.isfinite(points).all(axis=1)))
+        raise InputFileError(f"{path}: {bad} node coordinates are NaN or infinite")
     dim = 3 if solid or not len(points) or np.any(points[:, 2] != 0.0) else 2
     raw = RawMesh(
         path=str(path),

@@ -211,24 +211,8 @@ def _elements(path: str, data, pos: int, count: int, fmt: int):
     if fmt == 2:
         _need(path, data, pos, count * 20, f"the element block ({count} elements)")
         ints = np.frombuffer(data, "<i4", count=(len(data) - pos) // 4, offset=pos)
-        types = np.empty(count, np.int64)
-        mats = np.empty(count, np.int64)
-        starts = np.empty(count, np.int64)
-        i = 0
-        for e in range(count):
-            if i + 4 > len(ints):
-                raise _bad(path, f"the element block ends after {e} of {count} elements")
-            t = int(ints[i + 1])
-            k = NODES_PER_TYPE.get(t)
-            if k is None:
-                raise _bad(path, f"element {int(ints[i])} has the unknown type {t}")
-            types[e], mats[e], starts[e] = t, ints[i + 3], i + 4
-            i += 4 + k
-        if i > len(ints):
-            raise _bad(path, f"the element block ({count} elements) runs past the end of the file")
-        sizes = np.array([NODES_PER_TYPE[int(t)] for t in types], np.int64)
-        flat = np.asarray(ints[np.repeat(starts, sizes) + _ramp(sizes)], np.int64) if count else np.empty(0)
-        return types, mats, flat.astype(np.int64), pos + 4 * i
+        types, mats, flat, used = _binary_elements(path, ints, count)
+        return types, mats, flat, pos + 4 * used
     if fmt != 1:
         raise InputFileError(f"{path}: .frd element block in format {fmt}, which fepost cannot read")
     _need(path, data, pos, count * 28, f"the element block ({count} elements)")
@@ -254,6 +238,36 @@ def _elements(path: str, data, pos: int, count: int, fmt: int):
     if len(flat) != need:
         raise _bad(path, f"the element block lists {len(flat)} nodes for elements needing {need}")
     return types, mats, flat, nxt
+
+
+def _binary_elements(path: str, ints: np.ndarray, count: int):
+    """(types, materials, flat node ids, int32 words used) of ``count`` binary element records."""
+    k0 = NODES_PER_TYPE.get(int(ints[1])) if count and len(ints) > 1 else None
+    if k0 is not None and count * (4 + k0) <= len(ints):
+        rec = ints[: count * (4 + k0)].reshape(count, 4 + k0)
+        if np.all(rec[:, 1] == rec[0, 1]):  # one element type throughout: regular records
+            flat = np.array(rec[:, 4:], np.int64).ravel()
+            return rec[:, 1].astype(np.int64), rec[:, 3].astype(np.int64), flat, count * (4 + k0)
+    types = np.empty(count, np.int64)
+    mats = np.empty(count, np.int64)
+    starts = np.empty(count, np.int64)
+    i = 0
+    for e in range(count):
+        if i + 4 > len(ints):
+            raise _bad(path, f"the element block ends after {e} of {count} elements")
+        t = int(ints[i + 1])
+        k = NODES_PER_TYPE.get(t)
+        if k is None:
+            raise _bad(path, f"element {int(ints[i])} has the unknown type {t}")
+        types[e], mats[e], starts[e] = t, ints[i + 3], i + 4
+        i += 4 + k
+    if i > len(ints):
+        raise _bad(path, f"the element block ({count} elements) runs past the end of the file")
+    sizes = np.array([NODES_PER_TYPE[int(t)] for t in types], np.int64)
+    flat = (
+        np.array(ints[np.repeat(starts, sizes) + _ramp(sizes)], np.int64) if count else np.empty(0, np.int64)
+    )
+    return types, mats, flat, i
 
 
 def _ramp(sizes: np.ndarray) -> np.ndarray:
