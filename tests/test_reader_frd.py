@@ -192,3 +192,23 @@ def test_no_contact_output_is_a_clear_error(cases, tmp_path):
     path.write_text(text[:head] + text[end:], encoding="latin-1")
     with pytest.raises(FieldError, match=r"\*CONTACT FILE .* \*CONTACT OUTPUT .* CSTR"):
         read_contact(path)
+
+
+def test_displacement_missing_at_contact_nodes(cases, tmp_path):
+    """A DISP block written for a node set that leaves out contact nodes: refused, unless not used."""
+    text = cases["ascii"][0].read_text(encoding="latin-1")
+    head = text.index("  100C", text.index("    1PSTEP"))
+    line = text[head : text.index("\n", head)]
+    count = int(line[24:36])
+    first = text.index("\n -1         1", head) + 1
+    cut = text[:first] + text[text.index("\n", first) + 1 :]
+    cut = cut.replace(line, line[:24] + f"{count - 1:12d}" + line[36:], 1)
+    path = tmp_path / "partial.frd"
+    path.write_text(cut, encoding="latin-1")
+    with pytest.raises(
+        FieldError, match=r"DISP block has no values at 1 of the 25 nodes.*--displacement none"
+    ):
+        read_contact(path)
+    fld = read_contact(path, displacement=None)
+    clean = read_contact(cases["ascii"][0], displacement=None)
+    assert build_patch(fld).N_fe == build_patch(clean).N_fe  # the undeformed faces, as in the clean file

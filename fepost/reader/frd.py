@@ -142,11 +142,22 @@ class _Nodes:
         return self.order[pos]
 
 
-def _nodal(frd: FrdFile, nodes: _Nodes, block: ResultBlock, n: int, fill: float) -> np.ndarray:
+def _nodal(frd: FrdFile, nodes: _Nodes, block: ResultBlock, keep: np.ndarray) -> np.ndarray:
+    """The block's values at the nodes ``keep`` (NaN where it has no record; ``DISP`` must cover them)."""
     ids, vals = block_values(frd, block)
-    out = np.full((n, vals.shape[1]), fill)
-    out[nodes.rows(ids, f"result block {block.name}")] = vals
-    return out
+    out = np.full((len(frd.node_ids), vals.shape[1]), np.nan)
+    written = np.zeros(len(frd.node_ids), bool)
+    rows = nodes.rows(ids, f"result block {block.name}")
+    out[rows] = vals
+    written[rows] = True
+    missing = int(np.count_nonzero(~written[keep]))
+    if missing and block.name == "DISP":
+        raise FieldError(
+            f"{frd.path}: the DISP block has no values at {missing} of the {len(keep)} nodes read "
+            "(written for a node set that leaves them out?); "
+            "--displacement none reads the undeformed coordinates"
+        )
+    return out[keep]
 
 
 def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
@@ -221,7 +232,7 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
             continue
 
         def load(b=b) -> np.ndarray:
-            return _nodal(frd, nodes, b, n, np.nan)[keep]
+            return _nodal(frd, nodes, b, keep)
 
         raw.point_data.add(name, load)
         raw.components[name] = b.components
