@@ -70,12 +70,14 @@ class FrdFile:
     node_ids: np.ndarray  # (n,) as in the file
     coords: np.ndarray  # (n, 3)
     elem_types: np.ndarray  # (m,) frd element types
-    elem_mats: np.ndarray  # (m,) material numbers
     elem_nodes: dict[int, np.ndarray]  # frd type -> (k, nodes) node ids, in file order per type
-    elem_rows: dict[int, np.ndarray]  # frd type -> element positions (rows of elem_types)
-    materials: dict[int, str] = field(default_factory=dict)
     blocks: list[ResultBlock] = field(default_factory=list)
     data: mmap.mmap | bytes = b""
+
+
+def _show(raw: bytes) -> str:
+    """Bytes of the file quoted for a message (non-printable characters escaped)."""
+    return repr(raw.decode("latin-1"))
 
 
 def _bad(path: str, what: str) -> InputFileError:
@@ -95,7 +97,7 @@ def _int(path: str, text: bytes, what: str) -> int:
     try:
         return int(text)
     except ValueError:
-        raise _bad(path, f"{what} {text.strip()[:20]!r} is not a number") from None
+        raise _bad(path, f"{what} {_show(text.strip()[:20])} is not a number") from None
 
 
 def _floats(path: str, cols: np.ndarray) -> np.ndarray:
@@ -112,7 +114,7 @@ def _floats(path: str, cols: np.ndarray) -> np.ndarray:
                 try:
                     out.flat[i] = float(_FORTRAN_EXP.sub(rb"\1e\2\3", t))
                 except ValueError:
-                    raise _bad(path, f"value {t[:20]!r} is not a number") from None
+                    raise _bad(path, f"value {_show(t[:20])} is not a number") from None
         return out
 
 
@@ -162,7 +164,7 @@ def _ids(path: str, col: np.ndarray, what: str) -> np.ndarray:
         return col.astype(np.int64)
     except ValueError:
         bad = next(b for b in col if not b.strip().lstrip(b"-").isdigit())
-        raise _bad(path, f"{what}: node number {bad.strip()[:20]!r}") from None
+        raise _bad(path, f"{what}: node number {_show(bad.strip()[:20])}") from None
 
 
 def _slow_records(path: str, lines: list[bytes], nvals: int, what: str) -> tuple[np.ndarray, np.ndarray]:
@@ -176,7 +178,7 @@ def _slow_records(path: str, lines: list[bytes], nvals: int, what: str) -> tuple
         elif tag == b" -2" and rows:
             rows[-1] += [ln[13 + 12 * k : 25 + 12 * k] for k in range((len(ln) - 13) // 12)]
         else:
-            raise _bad(path, f"{what}: unexpected line {ln[:40]!r}")
+            raise _bad(path, f"{what}: unexpected line {_show(ln[:40])}")
     if any(len(r) < nvals for r in rows):
         raise _bad(path, f"{what}: a record holds fewer than {nvals} values")
     cols = np.array([r[:nvals] for r in rows], dtype="S12").reshape(len(rows), nvals)
@@ -207,12 +209,12 @@ def _nodes(path: str, data, pos: int, count: int, fmt: int) -> tuple[np.ndarray,
 
 
 def _elements(path: str, data, pos: int, count: int, fmt: int):
-    """(types, materials, flat node ids, next position) of the element block."""
+    """(types, flat node ids, next position) of the element block."""
     if fmt == 2:
         _need(path, data, pos, count * 20, f"the element block ({count} elements)")
         ints = np.frombuffer(data, "<i4", count=(len(data) - pos) // 4, offset=pos)
-        types, mats, flat, used = _binary_elements(path, ints, count)
-        return types, mats, flat, pos + 4 * used
+        types, flat, used = _binary_elements(path, ints, count)
+        return types, flat, pos + 4 * used
     if fmt != 1:
         raise InputFileError(f"{path}: .frd element block in format {fmt}, which fepost cannot read")
     _need(path, data, pos, count * 28, f"the element block ({count} elements)")
@@ -222,11 +224,10 @@ def _elements(path: str, data, pos: int, count: int, fmt: int):
     body = [ln[3:] for ln in lines if ln[:3] == b" -2"]
     if len(heads) + len(body) != len(lines):
         odd = next(ln for ln in lines if ln[:3] not in (b" -1", b" -2"))
-        raise _bad(path, f"element block: unexpected line {odd[:40]!r}")
+        raise _bad(path, f"element block: unexpected line {_show(odd[:40])}")
     if len(heads) != count:
         raise _bad(path, f"the element block declares {count} elements and holds {len(heads)}")
     types = np.array([_int(path, h[13:18], "element type") for h in heads], np.int64)
-    mats = np.array([_int(path, h[23:28] or b"0", "material number") for h in heads], np.int64)
     unknown = sorted(set(types.tolist()) - set(NODES_PER_TYPE))
     if unknown:
         raise _bad(path, f"element type {unknown[0]} is unknown")
@@ -237,19 +238,18 @@ def _elements(path: str, data, pos: int, count: int, fmt: int):
     need = int(sum(NODES_PER_TYPE[int(t)] for t in types))
     if len(flat) != need:
         raise _bad(path, f"the element block lists {len(flat)} nodes for elements needing {need}")
-    return types, mats, flat, nxt
+    return types, flat, nxt
 
 
 def _binary_elements(path: str, ints: np.ndarray, count: int):
-    """(types, materials, flat node ids, int32 words used) of ``count`` binary element records."""
+    """(types, flat node ids, int32 words used) of ``count`` binary element records."""
     k0 = NODES_PER_TYPE.get(int(ints[1])) if count and len(ints) > 1 else None
     if k0 is not None and count * (4 + k0) <= len(ints):
         rec = ints[: count * (4 + k0)].reshape(count, 4 + k0)
         if np.all(rec[:, 1] == rec[0, 1]):  # one element type throughout: regular records
             flat = np.array(rec[:, 4:], np.int64).ravel()
-            return rec[:, 1].astype(np.int64), rec[:, 3].astype(np.int64), flat, count * (4 + k0)
+            return rec[:, 1].astype(np.int64), flat, count * (4 + k0)
     types = np.empty(count, np.int64)
-    mats = np.empty(count, np.int64)
     starts = np.empty(count, np.int64)
     i = 0
     for e in range(count):
@@ -259,7 +259,7 @@ def _binary_elements(path: str, ints: np.ndarray, count: int):
         k = NODES_PER_TYPE.get(t)
         if k is None:
             raise _bad(path, f"element {int(ints[i])} has the unknown type {t}")
-        types[e], mats[e], starts[e] = t, ints[i + 3], i + 4
+        types[e], starts[e] = t, i + 4
         i += 4 + k
     if i > len(ints):
         raise _bad(path, f"the element block ({count} elements) runs past the end of the file")
@@ -267,7 +267,7 @@ def _binary_elements(path: str, ints: np.ndarray, count: int):
     flat = (
         np.array(ints[np.repeat(starts, sizes) + _ramp(sizes)], np.int64) if count else np.empty(0, np.int64)
     )
-    return types, mats, flat, i
+    return types, flat, i
 
 
 def _ramp(sizes: np.ndarray) -> np.ndarray:
@@ -276,16 +276,15 @@ def _ramp(sizes: np.ndarray) -> np.ndarray:
     return np.arange(int(ends[-1]) if len(ends) else 0) - np.repeat(ends - sizes, sizes)
 
 
-def _group(types: np.ndarray, flat: np.ndarray) -> tuple[dict[int, np.ndarray], dict[int, np.ndarray]]:
+def _group(types: np.ndarray, flat: np.ndarray) -> dict[int, np.ndarray]:
+    """frd type → (k, nodes) node ids of its elements, in file order."""
     sizes = np.array([NODES_PER_TYPE[int(t)] for t in types], np.int64)
     starts = np.cumsum(sizes) - sizes
-    nodes, rows = {}, {}
+    out = {}
     for t in np.unique(types):
         sel = np.flatnonzero(types == t)
-        k = NODES_PER_TYPE[int(t)]
-        nodes[int(t)] = flat[starts[sel][:, None] + np.arange(k)[None, :]]
-        rows[int(t)] = sel
-    return nodes, rows
+        out[int(t)] = flat[starts[sel][:, None] + np.arange(NODES_PER_TYPE[int(t)])[None, :]]
+    return out
 
 
 def _result_header(path: str, data, pos: int, head: bytes, step: int) -> tuple[ResultBlock, int]:
@@ -296,7 +295,9 @@ def _result_header(path: str, data, pos: int, head: bytes, step: int) -> tuple[R
     try:
         time = float(head[12:24])
     except ValueError:
-        raise _bad(path, f"result block time {head[12:24].strip()!r}") from None
+        time = float("nan")
+    if not np.isfinite(time):
+        raise _bad(path, f"result block time {_show(head[12:24].strip())} is not a finite number")
     lines: list[bytes] = []
     for _ in range(1 + 1000):
         eol = data.find(b"\n", pos, pos + MAX_LINE)
@@ -306,7 +307,7 @@ def _result_header(path: str, data, pos: int, head: bytes, step: int) -> tuple[R
         pos = eol + 1
         if len(lines) == 1:
             if lines[0][:3] != b" -4":
-                raise _bad(path, f"result block header: expected a -4 line, found {lines[0][:40]!r}")
+                raise _bad(path, f"result block header: expected a -4 line, found {_show(lines[0][:40])}")
             ncomp = _int(path, lines[0][13:18], "result block component count")
             if not 0 <= ncomp <= 1000:
                 raise _bad(path, f"result block with {ncomp} components")
@@ -316,7 +317,7 @@ def _result_header(path: str, data, pos: int, head: bytes, step: int) -> tuple[R
     comps: list[str] = []
     for ln in lines[1:]:
         if ln[:3] != b" -5":
-            raise _bad(path, f"result block {name}: expected a -5 line, found {ln[:40]!r}")
+            raise _bad(path, f"result block {name}: expected a -5 line, found {_show(ln[:40])}")
         if ln[33:38].strip() != b"1":  # IEXIST = 1: derived (ALL), no values stored
             comps.append(ln[5:13].decode("latin-1").strip())
     if count < 0:
@@ -353,8 +354,7 @@ def scan(path: Path, data) -> FrdFile:
     where = str(path)
     pos, n = 0, len(data)
     nodes = elems = None
-    frd = FrdFile(where, False, np.empty(0, np.int64), np.empty((0, 3)), np.empty(0, np.int64),
-                  np.empty(0, np.int64), {}, {}, data=data)  # fmt: skip
+    frd = FrdFile(where, False, np.empty(0, np.int64), np.empty((0, 3)), np.empty(0, np.int64), {}, data=data)
     step = 0
     while pos < n:
         eol = data.find(b"\n", pos, pos + MAX_LINE)
@@ -368,10 +368,6 @@ def scan(path: Path, data) -> FrdFile:
         if key == b"1":
             if line[5:10] == b"PSTEP" and len(line) >= 60:
                 step = _int(where, line[48:60], "step number")
-            elif line[5:9] == b"UMAT":
-                frd.materials[_int(where, line[9:14], "material number")] = (
-                    line[14:].decode("latin-1").strip()
-                )
         elif key == b"2" and line[5:6] == b"C":
             if nodes is not None:
                 raise _bad(where, "a second node block")
@@ -384,20 +380,19 @@ def scan(path: Path, data) -> FrdFile:
                 raise _bad(where, "a second element block")
             count, fmt = _count_fmt(where, line, "element")
             elems = _elements(where, data, pos, count, fmt)
-            pos = elems[3]
+            pos = elems[2]
         elif key == b"100" and line[5:6] == b"C":
             block, pos = _result_header(where, data, pos, line, step)
             frd.blocks.append(block)
         elif key == b"9999":
             break
         elif line.strip():
-            raise _bad(where, f"unexpected line {line[:40]!r} at byte {pos - len(line) - 1}")
+            raise _bad(where, f"unexpected line {_show(line[:40])} at byte {pos - len(line) - 1}")
     if nodes is None:
         raise InputFileError(f"{where}: not a CalculiX .frd result file (no node block '2C')")
     frd.node_ids, frd.coords = nodes
     if elems is not None:
-        frd.elem_types, frd.elem_mats = elems[0], elems[1]
-        frd.elem_nodes, frd.elem_rows = _group(elems[0], elems[2])
+        frd.elem_types, frd.elem_nodes = elems[0], _group(elems[0], elems[1])
     return frd
 
 
