@@ -221,3 +221,24 @@ def test_duplicate_and_unknown_nodes(bases, tmp_path, capsys):
     (tmp_path / "unknown.frd").write_text(unknown, encoding="latin-1")
     msg = _one_line_error(tmp_path / "unknown.frd", *_run(tmp_path / "unknown.frd", capsys)[:2])
     assert "node 99999" in msg
+
+
+def test_hostile_headers(bases, tmp_path, capsys):
+    data = bases["binary4"].read_bytes()
+    head = data.index(b"  100C")
+    line = data[head : data.index(b"\n", head)]
+    minus4 = data.index(b" -4  ", head)
+    minus4_end = data.index(b"\n", minus4)
+    cases = {
+        "nan_time": (data.replace(line, line[:12] + b"         nan" + line[24:], 1), "not a finite number"),
+        "inf_time": (data.replace(line, line[:12] + b"         inf" + line[24:], 1), "not a finite number"),
+        "format9": (data.replace(line, line[:74] + b"9" + line[75:], 1), "format 9"),
+        "components": (data[:minus4] + b" -4  DISP     9999    1" + data[minus4_end:], "components"),
+        "unknown_key": (data[:head] + b"    7C  what is this\n" + data[head:], "unexpected line"),
+        "long_line": (data[:head] + b"x" * 5000 + data[head:], "no line break"),
+    }
+    for name, (content, words) in cases.items():
+        path = tmp_path / f"{name}.frd"
+        path.write_bytes(content)
+        msg = _one_line_error(path, *_run(path, capsys)[:2])
+        assert words in msg, (name, msg)
