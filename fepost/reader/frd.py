@@ -190,26 +190,7 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
     contact_values = np.zeros((n, len(contact.components)))
     contact_values[rows] = cvals
     solid = [t for t in conn if SPECS[CANONICAL[t]].dim == 3]
-    used_nodes = np.zeros(n, bool)
-    for c in conn.values():
-        used_nodes[c.ravel()] = True
-    faces = None if carried[used_nodes].all() else _contact_faces(conn, carried, n)
-    if faces and any(ftype in ("quad8", "quad9") for ftype, _, _ in faces):
-        warnings.warn(
-            f"{path}: node-to-surface contact on quadratic hexahedra: CalculiX's nodal CPRESS on 8-node "
-            "faces does not integrate to the contact force (its tributary areas are not the shape-function "
-            "integrals: tens of percent off in a test); prefer surface-to-surface contact or linear elements",
-            ReaderWarning,
-            stacklevel=2,
-        )
-    if faces:
-        keep = np.unique(np.concatenate([f.ravel() for _, _, f in faces]))
-        remap = np.full(n, -1, np.int64)
-        remap[keep] = np.arange(len(keep))
-        blocks = _face_blocks(faces, remap)
-    else:
-        keep = np.arange(n)
-        blocks = _element_blocks(frd, conn)
+    keep, blocks = _surface(path, conn, carried, n)
     points = frd.coords[keep]
     if not np.all(np.isfinite(points)):
         bad = int(np.sum(~np.isfinite(points).all(axis=1)))
@@ -240,6 +221,30 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
     return raw
 
 
+def _surface(
+    path: Path, conn: dict[int, np.ndarray], carried: np.ndarray, n: int
+) -> tuple[np.ndarray, list[Block]]:
+    """(nodes kept, blocks): the contact faces when the CONTACT block picks them out, else the elements."""
+    used = np.zeros(n, bool)
+    for c in conn.values():
+        used[c.ravel()] = True
+    faces = [] if carried[used].all() else _contact_faces(conn, carried, n)
+    if not faces:  # every node written (surface-to-surface): faces found from the pressure downstream
+        return np.arange(n), _element_blocks(conn)
+    if any(ftype in ("quad8", "quad9") for ftype, _, _ in faces):
+        warnings.warn(
+            f"{path}: node-to-surface contact on quadratic hexahedra: CalculiX's nodal CPRESS on 8-node "
+            "faces does not integrate to the contact force (its tributary areas are not the shape-function "
+            "integrals: tens of percent off in a test); prefer surface-to-surface contact or linear elements",
+            ReaderWarning,
+            stacklevel=3,
+        )
+    keep = np.unique(np.concatenate([f.ravel() for _, _, f in faces]))
+    remap = np.full(n, -1, np.int64)
+    remap[keep] = np.arange(len(keep))
+    return keep, _face_blocks(faces, remap)
+
+
 def _refuse_step(frd: FrdFile, path: Path, incs: list[tuple[int, float]], chosen: int) -> None:
     with_contact = {b.kode for b in frd.blocks if b.name == "CONTACT"}
     if not with_contact:
@@ -253,7 +258,7 @@ def _refuse_step(frd: FrdFile, path: Path, incs: list[tuple[int, float]], chosen
 
 
 def _bodies(conn: dict[int, np.ndarray], n: int) -> np.ndarray:
-    """Connected part (elements sharing nodes) of every node; −1 for nodes of no element."""
+    """Connected part (elements sharing nodes) of every node (a node of no element is a part alone)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -293,16 +298,13 @@ def _face_blocks(faces: list[tuple[str, int, np.ndarray]], remap: np.ndarray) ->
     order = {k: i for i, k in enumerate(dict.fromkeys(k for _, k, _ in faces))}
     blocks, first = [], 0
     for ftype, k, f in faces:
-        label = (
-            f"contact faces of body {order[k] + 1} ({ftype.upper()}, {len(f)} faces with CONTACT output "
-            "at every node)"
-        )
+        label = f"contact faces of body {order[k] + 1} ({ftype.upper()}, {len(f)} faces with CONTACT output)"
         blocks.append(Block(label, ftype, remap[f], first, order[k]))
         first += len(f)
     return blocks
 
 
-def _element_blocks(frd: FrdFile, conn: dict[int, np.ndarray]) -> list[Block]:
+def _element_blocks(conn: dict[int, np.ndarray]) -> list[Block]:
     blocks, first = [], 0
     for t, c in conn.items():
         canon = CANONICAL[t]
