@@ -212,3 +212,36 @@ def test_displacement_missing_at_contact_nodes(cases, tmp_path):
     fld = read_contact(path, displacement=None)
     clean = read_contact(cases["ascii"][0], displacement=None)
     assert build_patch(fld).N_fe == build_patch(clean).N_fe  # the undeformed faces, as in the clean file
+
+
+def test_double_precision_results(cases, tmp_path):
+    """Format 3 (float64 records, as CalculiX writes with its double-precision binary option):
+    the float32 file rewritten in doubles reads to the same field."""
+    from fepost.reader.frdparse import open_frd, scan
+
+    src = cases["binary"][0]
+    data = src.read_bytes()
+    mapped = open_frd(src)
+    try:
+        blocks = scan(src, mapped).blocks
+    finally:
+        mapped.close()
+    out, pos = bytearray(), 0
+    for b in blocks:
+        head = data.rfind(b"  100C", 0, b.start)
+        eol = data.index(b"\n", head)
+        out += data[pos:head] + data[head : head + 74] + b"3" + data[head + 75 : b.start]
+        rec = np.frombuffer(
+            data, np.dtype([("id", "<i4"), ("v", "<f4", (len(b.components),))]), b.count, b.start
+        )
+        dbl = np.empty(b.count, np.dtype([("id", "<i4"), ("v", "<f8", (len(b.components),))]))
+        dbl["id"], dbl["v"] = rec["id"], rec["v"]
+        out += dbl.tobytes()
+        pos = b.end
+        assert eol < b.start
+    out += data[pos:]
+    path = tmp_path / "double.frd"
+    path.write_bytes(bytes(out))
+    a, b = read_contact(src), read_contact(path)
+    np.testing.assert_array_equal(a.values, b.values)
+    np.testing.assert_array_equal(a.points, b.points)
