@@ -98,20 +98,61 @@ def test_truncated(bases, tmp_path, capsys, name):
     assert errors >= len(cuts) - 3
 
 
+def _second_reading(path: Path, tmp_path: Path) -> float | None:
+    """N_fe of the mutated ASCII file as ccx2paraview parses it (its VTU read by fepost), or None."""
+    from ccx2paraview.common import Converter
+
+    work = tmp_path / f"c2p_{path.stem}"
+    work.mkdir()
+    copy = work / "job.frd"
+    copy.write_bytes(path.read_bytes())
+    try:
+        Converter(str(copy), ["vtu"]).run()
+    except Exception:  # ccx2paraview stops on what it cannot parse (SyntaxError, ValueError, ...)
+        return None
+    vtus = sorted(work.glob("*.vtu"))
+    if not vtus:
+        return None
+    from fepost.patch import build_patch
+    from fepost.reader import read_contact
+
+    try:
+        return build_patch(read_contact(vtus[-1])).N_fe
+    except Exception:  # the converted file is refused by fepost's VTU path: no second value
+        return None
+
+
 @pytest.mark.parametrize("name", ["ascii", "binary"])
 def test_mutated(bases, tmp_path, capsys, name):
+    """Mutated files: refused in one line, or the clean file's N_fe, or (ASCII, a changed value)
+    the N_fe of the same bytes parsed by ccx2paraview, to its float32 round-off. Besides random
+    bytes, ASCII files get single digits of numbers changed (the format intact), to be read."""
+    pytest.importorskip("ccx2paraview.common", reason="ccx2paraview is not installed")
     data = bytearray(bases[name].read_bytes())
     reference = _reference(bases[name], capsys)
     rng = random.Random(SEED + len(name))
-    seen = set()
-    for k in range(25):
+    seen: dict[str, int] = {}
+    digits = [m.start() for m in re.finditer(rb"\d(?=\.\d{5}E)", bytes(data))]  # leading digits (ASCII)
+    for k in range(25 + (8 if digits else 0)):
         mutated = bytearray(data)
-        for _ in range(rng.choice((1, 4, 32))):
+        if k >= 25:  # a number changed, the format intact: a value of the contact or a coordinate
+            mutated[rng.choice(digits)] = ord(str(rng.randrange(1, 10)))
+        for _ in range(rng.choice((1, 4, 32)) if k < 25 else 0):
             mutated[rng.randrange(len(mutated))] = rng.randrange(256)
         path = tmp_path / f"mut{k}.frd"
         path.write_bytes(bytes(mutated))
-        seen.add(_verdict(path, capsys, reference).split(":")[0])
-    assert "fepost" in seen  # some mutations are refused, none crash or hang
+        verdict = _verdict(path, capsys, reference).split(":")[0]
+        if verdict == "changed" and name == "ascii":
+            code, _, result = _run(path, capsys)
+            second = _second_reading(path, tmp_path)
+            if second is not None:
+                assert result["N_fe"] == pytest.approx(second, rel=1e-6), path
+                verdict = "changed, confirmed by ccx2paraview"
+        seen[verdict] = seen.get(verdict, 0) + 1
+    assert seen.get("fepost", 0) >= 10, seen  # most mutations are refused; none crash or hang
+    assert seen.get("changed", 0) <= 2, seen  # results that differ are confirmed by a second parser
+    if name == "ascii":
+        assert seen.get("changed, confirmed by ccx2paraview", 0) >= 1, seen
 
 
 def _replace_count(data: bytes, key: bytes, new: int) -> bytes:
