@@ -287,6 +287,13 @@ def _group(types: np.ndarray, flat: np.ndarray) -> dict[int, np.ndarray]:
     return out
 
 
+def _header_line(path: str, data, pos: int) -> tuple[bytes, int]:
+    eol = data.find(b"\n", pos, pos + MAX_LINE)
+    if eol < 0:
+        raise _bad(path, "a result block header is cut off")
+    return bytes(data[pos:eol]).rstrip(b"\r"), eol + 1
+
+
 def _result_header(path: str, data, pos: int, head: bytes, step: int) -> tuple[ResultBlock, int]:
     """Parse a ``100C`` block from its header line ``head``; ``pos`` is just after it."""
     count = _int(path, head[24:36], "result block node count")
@@ -298,24 +305,16 @@ def _result_header(path: str, data, pos: int, head: bytes, step: int) -> tuple[R
         time = float("nan")
     if not np.isfinite(time):
         raise _bad(path, f"result block time {_show(head[12:24].strip())} is not a finite number")
-    lines: list[bytes] = []
-    for _ in range(1 + 1000):
-        eol = data.find(b"\n", pos, pos + MAX_LINE)
-        if eol < 0:
-            raise _bad(path, "a result block header is cut off")
-        lines.append(bytes(data[pos:eol]).rstrip(b"\r"))
-        pos = eol + 1
-        if len(lines) == 1:
-            if lines[0][:3] != b" -4":
-                raise _bad(path, f"result block header: expected a -4 line, found {_show(lines[0][:40])}")
-            ncomp = _int(path, lines[0][13:18], "result block component count")
-            if not 0 <= ncomp <= 1000:
-                raise _bad(path, f"result block with {ncomp} components")
-        if len(lines) == ncomp + 1:
-            break
-    name = lines[0][5:13].decode("latin-1").strip()
+    minus4, pos = _header_line(path, data, pos)
+    if minus4[:3] != b" -4":
+        raise _bad(path, f"result block header: expected a -4 line, found {_show(minus4[:40])}")
+    name = minus4[5:13].decode("latin-1").strip()
+    ncomp = _int(path, minus4[13:18], "result block component count")
+    if not 0 <= ncomp <= 1000:
+        raise _bad(path, f"result block {name} with {ncomp} components")
     comps: list[str] = []
-    for ln in lines[1:]:
+    for _ in range(ncomp):
+        ln, pos = _header_line(path, data, pos)
         if ln[:3] != b" -5":
             raise _bad(path, f"result block {name}: expected a -5 line, found {_show(ln[:40])}")
         if ln[33:38].strip() != b"1":  # IEXIST = 1: derived (ALL), no values stored
