@@ -1,7 +1,7 @@
 """CalculiX ``.frd`` files read directly, checked against the solver's own reaction and ccx2paraview.
 
 Each case solves a small contact model with the ``ccx`` on PATH (a soft block
-pressed on a steel plate, tests/frd_decks.py; under 2 s each) and compares
+pressed on a steel plate, tests/test_reader_frd_decks.py; under 2 s each) and compares
 
 * fepost's load from the ``.frd`` (N_fe: the exact integral of the nodal CPRESS
   over the recovered contact faces) with the total reaction CalculiX prints for
@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from frd_decks import write_deck
+from test_reader_frd_decks import write_deck
 
 from fepost import analyse
 from fepost.cli import main

@@ -1,6 +1,6 @@
 """Malformed and hostile ``.frd`` files through ``fepost coefficients``: one-line error or the right load.
 
-Base files: the small contact model of tests/frd_decks.py solved by ``ccx``
+Base files: the small contact model of tests/test_reader_frd_decks.py solved by ``ccx``
 (skipped without it), ASCII and binary, one and four increments. Seeded and
 bounded: truncations at many points, byte mutations, huge declared counts,
 text in binary, missing blocks, and NaN in some increments. Every case ends in

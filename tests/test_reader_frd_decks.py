@@ -2,11 +2,13 @@
 
 The block (0.1 × 0.1 × 0.04 m, E = 10 MPa) sits on a plate (0.16 × 0.16 ×
 0.02 m, steel) at z = 0; the block's top is pushed down by ``push`` m and its
-bottom nodes are the slave surface of a penalty contact pair. The block is
+bottom element faces are the slave surface of a penalty contact pair. The block is
 meshed with the element type asked for (hexahedra split into wedges or
 tetrahedra, mid-side nodes added for the quadratic types); the plate is C3D8.
 The solver's own check of the load: ``*NODE PRINT, TOTALS=ONLY`` of the
 reaction forces of the plate's fixed bottom (set ``PBOT``) in the ``.dat`` file.
+This module holds no tests: it writes the decks of tests/test_reader_frd.py and
+tests/test_reader_frd_fuzz.py.
 """
 
 from __future__ import annotations
@@ -117,7 +119,6 @@ def write_deck(
     push: float = 2e-4,
     increments: int = 1,
     n: int = 4,
-    friction: float | None = None,
 ) -> Path:
     """Write the deck ``path`` (job = its stem) and return it."""
     base, edges = TYPES[etype]
@@ -160,8 +161,6 @@ def write_deck(
     w += ["*SOLID SECTION, ELSET=BLOCK, MATERIAL=SOFT", "*SOLID SECTION, ELSET=PLATE, MATERIAL=STEEL"]
     w += ["*SURFACE INTERACTION, NAME=SI", "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR"]
     w += ["1e11, 1.0" if contact == "NODE TO SURFACE" else "1e11"]
-    if friction is not None:
-        w += ["*FRICTION", f"{friction}, 1e9"]
     w += [f"*CONTACT PAIR, INTERACTION=SI, TYPE={contact}", "SLAVE, MASTER"]
     w += ["*BOUNDARY", "PBOT, 1, 3", "TOP, 1, 2"]
     dt = 1.0 / increments
