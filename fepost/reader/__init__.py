@@ -1,7 +1,7 @@
 """Read FE contact results into a `fepost.field.ContactField`.
 
-Formats are chosen by suffix; every format is read by a well-kept library,
-never by a hand-written parser:
+Formats are chosen by suffix; every format is read by a well-kept library, except
+CalculiX `.frd`, which has none that reads binary files (see `frd`):
 
 =============================== =============================================
 suffix                          reader
@@ -15,6 +15,8 @@ suffix                          reader
                                 joined by `pieces`
 ``.e .exo .ex2 .exii``          the netCDF container read with netCDF4 (`exodus`)
 ``.xdmf .xmf`` (+ ``.h5``)      meshio (`xdmf`), after the checks of `xdmfcheck`
+``.frd``                        CalculiX results, ASCII or binary (`frd`;
+                                fixed-width records parsed by `frdparse`)
 =============================== =============================================
 
 Every file is read in a forked child process (`isolate`): a file that
@@ -48,6 +50,7 @@ if TYPE_CHECKING:
 VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm", ".vts", ".vtr", ".pvtu", ".pvtp")
 EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
 XDMF_SUFFIXES = (".xdmf", ".xmf")
+FRD_SUFFIXES = (".frd",)
 #: Values that mean "no contact data" rather than a pressure (MOOSE writes −99999).
 SENTINELS = (-99999.0, -999999.0, -9999.0, -1.0e30, -1.0e20)
 
@@ -68,7 +71,7 @@ __all__ = [
 
 
 def supported_suffixes() -> tuple[str, ...]:
-    return VTK_SUFFIXES + EXODUS_SUFFIXES + XDMF_SUFFIXES
+    return VTK_SUFFIXES + EXODUS_SUFFIXES + XDMF_SUFFIXES + FRD_SUFFIXES
 
 
 def _missing(path: Path, exc: OSError) -> InputFileError:
@@ -157,13 +160,14 @@ def read_contact(
     ----------
     path : file path
         ``.vtu``, ``.vtp``, ``.vtk`` (legacy), ``.vtm``, ``.vts``, ``.vtr``, ``.pvtu``,
-        ``.pvtp``, Exodus II ``.e``/``.exo`` or XDMF ``.xdmf`` (with its ``.h5``).
+        ``.pvtp``, Exodus II ``.e``/``.exo``, XDMF ``.xdmf`` (with its ``.h5``) or
+        CalculiX ``.frd``.
     field : str, optional
         Name of the pressure array (``NAME:k`` for component k, or a component
         name such as ``CPRESS``). Default: found by name among `PRESSURE_NAMES`.
     step : int, optional
-        Time step of an Exodus file or an XDMF time series (0-based; negative counts
-        from the end). Default: last.
+        Time step of an Exodus file or an XDMF time series, or ``.frd`` increment
+        (0-based; negative counts from the end). Default: last.
     displacement : str or None
         ``"auto"`` (default): add the displacement array if one is found;
         a name: add that array; ``None``: use the coordinates as written.
@@ -243,16 +247,20 @@ def _steps_here(path: Path) -> tuple[float, ...] | None:
         from .xdmf import read_steps as xdmf_steps
 
         return xdmf_steps(path)
+    if path.suffix.lower() in FRD_SUFFIXES:
+        from .frd import read_steps as frd_steps
+
+        return frd_steps(path)
     return None
 
 
 def time_steps(path: str | Path, units: str | UnitSystem | None = None) -> tuple[TimeStep, ...]:
     """The states stored in an FE export, in order.
 
-    Exodus files and XDMF time series list every time step (``TimeStep(k, t_k)``;
-    an Exodus file without steps gives one ``TimeStep(None, None)``); VTK files and
-    single-grid XDMF files hold one state (``TimeStep(None, None)``). ``units`` scales
-    the times (``mm-kg-ms``: ms).
+    Exodus files, XDMF time series and ``.frd`` files list every time step or
+    increment (``TimeStep(k, t_k)``; an Exodus file without steps gives one
+    ``TimeStep(None, None)``); VTK files and single-grid XDMF files hold one state
+    (``TimeStep(None, None)``). ``units`` scales the times (``mm-kg-ms``: ms).
     Pass ``step=ts.index`` to `read_contact` / `fepost.analyse`.
     """
     path, size = _checked(path)

@@ -20,6 +20,7 @@ from ..errors import DimensionError, FieldError, InputFileError, PressureError, 
 from ..field import OTHER_FACE_TYPES, ContactField
 from .cells import SPECS
 from .exodus import read_exodus
+from .frd import FRD_SUFFIXES, read_frd
 from .names import ArrayInfo, FieldChoice, norm, pick_displacement, pick_field
 from .raw import RawMesh
 from .sidecar import at_step, read_sidecar
@@ -66,6 +67,8 @@ def read_raw(path: Path, step: int | None) -> RawMesh:
         return read_exodus(path, step)
     if path.suffix.lower() in XDMF_SUFFIXES:
         return read_xdmf(path, step)
+    if path.suffix.lower() in FRD_SUFFIXES:
+        return read_frd(path, step)
     if step is not None:
         raise InputFileError(f"{path}: --step applies to Exodus time series, not to {path.suffix} files")
     return read_vtk(path)
