@@ -231,8 +231,9 @@ def _pressures(
 
 def _deformed(
     raw: RawMesh, source: str, catalogue: list[ArrayInfo], displacement: str | None, units: UnitSystem | None
-) -> np.ndarray:
-    """The node coordinates with the displacement added, in SI (a new array when changed)."""
+) -> tuple[np.ndarray, str | None]:
+    """The node coordinates with the displacement added, in SI (a new array when changed),
+    and the name of the displacement array added (None: the coordinates as written)."""
     points = np.asarray(raw.points, float)
     _absurd(source, "node coordinates", points, MAX_COORDINATE)
     disp = pick_displacement(source, catalogue, displacement)
@@ -248,7 +249,7 @@ def _deformed(
         points[:, : min(3, u.shape[1])] += u[:, :3]
     if units is not None and not units.is_si:
         points *= units.length
-    return points
+    return points, disp
 
 
 def _surface(
@@ -301,7 +302,7 @@ def _contact(
     if not _range(checked)[1] > 0:  # NaN passed over; +inf counts (refused later as not finite)
         _no_contact(raw, path, choice, checked)
     _absurd(source, f"pressure values of {choice.label!r}", checked, MAX_PRESSURE)
-    points = _deformed(raw, source, catalogue, displacement, units)
+    points, disp = _deformed(raw, source, catalogue, displacement, units)
     if units is not None and not units.is_si:
         if point_values is not None:
             point_values = point_values * units.pressure
