@@ -51,7 +51,7 @@ def check_file(path: Path) -> Counts:
     try:
         with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
             if suffix == ".vtk":
-                return Legacy(path, data[:]).check()
+                return Legacy(path, data).check()
             return Xml(path, data, 0).check()
     except InputFileError:
         raise
