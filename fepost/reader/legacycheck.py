@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import mmap
 import re
 from pathlib import Path
 
@@ -37,15 +38,21 @@ _NUMBER = re.compile(rb"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|[+-]?(?:nan|in
 class Legacy:
     """A walk over the sections of a legacy file, counting what follows each keyword."""
 
-    def __init__(self, path: Path, data: bytes):
+    def __init__(self, path: Path, data: bytes | mmap.mmap):
         self.path, self.data = path, data
 
     def bad(self, what: str) -> InputFileError:
         return bad_file(self.path, what)
 
     def check(self) -> Counts:
-        lines = self.data.split(b"\n", 4)
-        if len(lines) < 5 or not lines[0].startswith(b"# vtk DataFile Version"):
+        lines, pos = [], 0
+        for _ in range(4):  # the four header lines, found without copying the body
+            eol = self.data.find(b"\n", pos)
+            if eol < 0:
+                break
+            lines.append(self.data[pos:eol])
+            pos = eol + 1
+        if len(lines) < 4 or not lines[0].startswith(b"# vtk DataFile Version"):
             raise self.bad("no '# vtk DataFile Version' line: not a legacy VTK file")
         try:
             self.version = float(lines[0].split()[-1])
@@ -58,7 +65,7 @@ class Legacy:
         kind = dataset[1].upper()
         if kind not in (b"UNSTRUCTURED_GRID", b"POLYDATA"):
             return Counts()  # other data sets are left to VTK (and the child process)
-        body_start = len(self.data) - len(lines[4])
+        body_start = pos
         if mode == b"ASCII":
             return self._ascii(body_start)
         return self._binary(body_start)

@@ -10,20 +10,22 @@ inconsistencies crash them. This module reads only the *structure* of a file
 arrays; no array is decoded) and refuses a file whose header disagrees with
 its data, before VTK sees it:
 
-XML (``.vtu .vtp .vtm``)
+XML (``.vtu .vtp .vtm .vts .vtr .pvtu .pvtp``)
     no DOCTYPE or ENTITY declarations (entity expansion), tags nested at most
     `MAX_DEPTH` deep and balanced, the root type matching the suffix,
     ``NumberOfPoints``/``NumberOfCells`` (``NumberOf{Verts,Lines,Strips,Polys}``)
     non-negative and within `MAX_COUNT`, every data array's length
     (from its binary header — plain or compressed blocks, inline base64 or
     appended raw/base64 — or its ASCII token count) equal to what the piece
-    declares, and the bytes it announces present in the file. A ``.vtm``'s
-    pieces are checked in turn (they must be VTK XML files that exist).
+    declares (structured grids: the counts of their ``Extent``), and the bytes it
+    announces present in the file. The pieces of a ``.vtm``, ``.pvtu`` or ``.pvtp``
+    are checked in turn: files of their kind that exist in the file's folder.
 Legacy (``.vtk``, ASCII or binary, ``UNSTRUCTURED_GRID`` and ``POLYDATA``)
     every section's declared count (``POINTS``, ``CELLS``/``OFFSETS``/
     ``CONNECTIVITY``, ``CELL_TYPES``, ``POINT_DATA``/``CELL_DATA`` arrays,
-    ``FIELD`` arrays) matches the values that follow: a section followed by
-    more numbers than declared, or by fewer, is refused.
+    ``FIELD`` arrays, binary ones followed by METADATA blocks or not) matches the
+    values that follow: a section followed by more numbers than declared, or by
+    fewer, is refused.
 
 The structure is VTK's documented file format ("VTK File Formats", VTK User's
 Guide); nothing here is used to *read* data, only to decide whether VTK may.
@@ -51,7 +53,7 @@ def check_file(path: Path) -> Counts:
     try:
         with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
             if suffix == ".vtk":
-                return Legacy(path, data[:]).check()
+                return Legacy(path, data).check()
             return Xml(path, data, 0).check()
     except InputFileError:
         raise
