@@ -19,7 +19,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from .coefficients import Coefficients, coefficients_from_moments
-from .errors import PatchWarning, ScaleWarning
+from .errors import ArgumentError, PatchWarning, ScaleWarning
 from .field import ContactField
 from .moments import Moments, moments
 from .patch import DEFAULT_THRESHOLD, Patch, build_patch
@@ -42,6 +42,7 @@ class Analysis:
     rolling_patch: Patch | None = None
     rolling_map: PolarMap | None = None
     rolling_moments: Moments | None = None
+    load_mismatch_allowed: bool = False
 
     @property
     def grid(self) -> PolarGrid:
@@ -88,6 +89,9 @@ class Analysis:
                 "reaction_z": rf.reaction_z,
                 "centre_of_pressure": list(self.rolling_patch.centre_of_pressure),
                 "grid_radius": self.rolling_map.radius,
+                "load_ratio": self.rolling_patch.N_fe / self.static_patch.N_fe,
+                "load_tolerance": LOAD_TOL,
+                "load_mismatch_allowed": self.load_mismatch_allowed,
             }
         if model:  # generalised friction model (fepost.friction.summary)
             d["model"] = self.model_summary.to_dict()
@@ -98,6 +102,12 @@ class Analysis:
 RESAMPLE_TOL = 0.01
 #: Largest accepted distance between N_fe and the solver's reaction before a warning.
 REACTION_TOL = 0.10
+#: Largest accepted |N_fe(rolling)/N_fe(static) − 1| of a static/rolling pair, unless the
+#: caller allows a mismatch. The pair must be one tire at one load: the shipped pairs agree to
+#: 0.4 % (aircraft, 100 %) and 1.5 % (small tire), a displacement-controlled rolling step moves
+#: the load by a few tenths of a percent, while the nearest other load point of a sweep is
+#: 25 % away; k_x = R x_c/<x^2> then mixes two patches (0.39 for 0.24 at 50 %/100 %).
+LOAD_TOL = 0.03
 _AXIS = re.compile(r"(?:^|[_\s.-])([xyz])$|([xyzXYZ])$")
 
 
@@ -145,6 +155,26 @@ def _check_reaction(fld: ContactField, patch: Patch) -> None:
     )
 
 
+def check_load_pair(static: Patch, rolling: Patch, *, allow: bool = False) -> float:
+    """The ratio N_fe(rolling) / N_fe(static); refuse a pair further apart than :data:`LOAD_TOL`.
+
+    Raises
+    ------
+    ArgumentError
+        The loads differ by more than :data:`LOAD_TOL` and ``allow`` is false
+        (one line naming both maps and both loads).
+    """
+    ratio = rolling.N_fe / static.N_fe
+    if abs(ratio - 1.0) > LOAD_TOL and not allow:
+        raise ArgumentError(
+            f"{rolling.source}: the rolling map's load N_fe = {rolling.N_fe:.6g} N differs from the "
+            f"static map's ({static.source}) N_fe = {static.N_fe:.6g} N by {ratio - 1.0:+.1%}, more "
+            f"than the {LOAD_TOL:.0%} tolerance: k_x needs both maps at one load (pair maps of the "
+            "same load, or allow the mismatch: --allow-load-mismatch)"
+        )
+    return ratio
+
+
 def _check_resampling(patch: Patch, mom: Moments) -> None:
     err = mom.N / patch.N_fe - 1.0
     if abs(err) > RESAMPLE_TOL:
@@ -186,6 +216,7 @@ def analyse(
     rolling_axis=None,
     units=None,
     surface: str | None = None,
+    allow_load_mismatch: bool = False,
 ) -> Analysis:
     """Run the pipeline on a static map (path or :class:`ContactField`) and an optional rolling map.
 
@@ -197,7 +228,9 @@ def analyse(
     :data:`fepost.reader.units.SYSTEMS`) and ``surface`` (an Exodus side set
     or block) are passed to :func:`fepost.reader.read_contact`. N_fe is checked
     against the solver's reaction where the export carries one (warning above
-    :data:`REACTION_TOL`).
+    :data:`REACTION_TOL`). A rolling map whose load differs from the static
+    map's by more than :data:`LOAD_TOL` is refused (`ArgumentError`) unless
+    ``allow_load_mismatch``, which the result then records.
     """
     grid = grid or PolarGrid.make()
     units = unit_system(units)
@@ -211,13 +244,23 @@ def analyse(
         # one BLAS thread: the patch step's products are thin (n × 3, chunk-long dots), where
         # BLAS threads only spin, and on a busy machine they stall it (2-5x slower)
         with threadpool_limits(limits=1, user_api="blas"):
-            return _pipeline(pending, rolling is not None, friction, grid, threshold, rolling_axis)
+            return _pipeline(
+                pending,
+                with_rolling=rolling is not None,
+                friction=friction,
+                grid=grid,
+                threshold=threshold,
+                rolling_axis=rolling_axis,
+                allow_load_mismatch=allow_load_mismatch,
+            )
     finally:
         for p in pending:
             p.cancel()
 
 
-def _pipeline(pending, with_rolling, friction, grid, threshold, rolling_axis) -> Analysis:
+def _pipeline(
+    pending, *, with_rolling, friction, grid, threshold, rolling_axis, allow_load_mismatch
+) -> Analysis:
     sf = pending[0].result()
     sp = build_patch(sf, threshold=threshold, rolling_axis=rolling_axis)
     _check_reaction(sf, sp)
@@ -228,9 +271,10 @@ def _pipeline(pending, with_rolling, friction, grid, threshold, rolling_axis) ->
     if with_rolling:
         rf = pending[1].result()
         rp = build_patch(rf, threshold=threshold, frame=sp.frame)
+        check_load_pair(sp, rp, allow=allow_load_mismatch)
         r_roll = float(np.max(np.hypot(rp.xy[:, 0], rp.xy[:, 1])))
         rm = resample(rp, grid, radius=max(sp.r_max, r_roll))
         rmo = moments(rm)
         _check_resampling(rp, rmo)
     coef = coefficients_from_moments(smo, rmo, friction=friction)
-    return Analysis(sf, sp, sm, smo, coef, rf, rp, rm, rmo)
+    return Analysis(sf, sp, sm, smo, coef, rf, rp, rm, rmo, load_mismatch_allowed=allow_load_mismatch)

@@ -52,6 +52,12 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
         help="take the contact faces from this Exodus side set or element block (name or id)",
     )
     g.add_argument("--rolling-axis", metavar="X,Y,Z", help="global rolling direction (default 1,0,0)")
+    g.add_argument(
+        "--allow-load-mismatch",
+        action="store_true",
+        help="accept a rolling map whose load differs from the static map's by more than 3 %% "
+        "(recorded in the outputs; k_x then mixes two loads)",
+    )
     g.add_argument("--threshold", type=v.fraction, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
     g.add_argument(
         "--nr",
@@ -92,4 +98,5 @@ def analysis_kwargs(args: argparse.Namespace) -> dict:
         "rolling_axis": axis,
         "units": unit_system(args.units),  # an unknown name fails here, before any file is read
         "surface": args.surface,
+        "allow_load_mismatch": bool(args.allow_load_mismatch),
     }

@@ -33,6 +33,20 @@ def _pct(x: float) -> str:
     return f"{(x if abs(x) >= 5e-5 else 0.0):+.2%}"
 
 
+def _rolling_load(a: Analysis) -> str:
+    """The rolling map's load beside the static one, and whether a mismatch was allowed."""
+    from ..analysis import LOAD_TOL
+
+    rp, c = a.rolling_patch, a.coefficients
+    assert rp is not None and c.N_rolling is not None
+    ratio = rp.N_fe / a.static_patch.N_fe
+    text = f"{c.N_rolling:.6g} N  (N_fe {rp.N_fe:.6g} N, {_pct(ratio - 1)} vs the static N_fe"
+    if abs(ratio - 1) > LOAD_TOL:
+        return text + f"; beyond {LOAD_TOL:.0%}, ALLOWED by --allow-load-mismatch)"
+    allowed = ", --allow-load-mismatch given" if a.load_mismatch_allowed else ""
+    return text + f"; within {LOAD_TOL:.0%}{allowed})"
+
+
 def format_analysis(a: Analysis) -> str:
     """A readable table of the patch and the coefficients."""
     c, p = a.coefficients, a.static_patch
@@ -74,6 +88,7 @@ def format_analysis(a: Analysis) -> str:
     if c.k_x is not None and a.rolling_field is not None:
         rows += [
             ("rolling map", f"{a.rolling_field.source}"),
+            ("rolling normal load N", _rolling_load(a)),
             ("x_c (rolling CoP shift)", f"{c.x_c:.6g} m"),
             ("k_x", f"{c.k_x:.6g}"),
         ]

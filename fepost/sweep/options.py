@@ -117,7 +117,7 @@ class RowOptions:
         default) gives the same row as one not given, so a sweep started from Python and
         resumed from the command line reuses its rows."""
         d = self.to_dict()
-        d["extra"] = {k: v for k, v in d["extra"].items() if v is not None}
+        d["extra"] = {k: v for k, v in d["extra"].items() if v is not None and v is not False}
         return d
 
 
