@@ -162,7 +162,7 @@ def test_rolling_pairs_rule_and_csv(cluster, load_sweep, tmp_path):
     assert_row_equals(dict(res2.rows[0]), doc)
 
 
-def test_bad_inputs_are_error_rows_and_exit_1(cluster, load_sweep, tmp_path, capsys):
+def test_bad_files_are_error_rows_and_exit_1(cluster, load_sweep, tmp_path, capsys):
     d, files, _ = load_sweep
     bad = tmp_path / "bad"
     bad.mkdir()
@@ -178,8 +178,6 @@ def test_bad_inputs_are_error_rows_and_exit_1(cluster, load_sweep, tmp_path, cap
         str(good),
         str(trunc),
         str(bad / "garbage.e"),
-        str(bad / "missing.vtu"),
-        str(bad / "nothing*.vtu"),
         str(side),
         str(files[2]),
         "--out",
@@ -194,13 +192,11 @@ def test_bad_inputs_are_error_rows_and_exit_1(cluster, load_sweep, tmp_path, cap
     assert main(argv) == 1  # finished, some inputs failed: the table marks them
     err = capsys.readouterr().err.strip().splitlines()
     rows = read_table(out / "coefficients.parquet")
-    assert [r["status"] for r in rows] == ["ok", "error", "error", "error", "error", "error", "ok"]
+    assert [r["status"] for r in rows] == ["ok", "error", "error", "error", "ok"]
     failed = [r for r in rows if r["status"] == "error"]
     expect = [
         f"{trunc}: corrupt or truncated",
         f"{bad / 'garbage.e'}: cannot",
-        f"{bad / 'missing.vtu'}: no such file",
-        f"{bad / 'nothing*.vtu'}: no FE export matches this pattern",
         f"{side.with_suffix('.json')}: sidecar key 'load' must be a finite number, got 'heavy'",
     ]
     for r, start in zip(failed, expect, strict=True):

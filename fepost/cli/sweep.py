@@ -98,6 +98,14 @@ def run(args: argparse.Namespace) -> int:
         f"{len(result.rows)} rows ({result.reused} from an earlier run, {result.computed} computed), "
         f"{result.errors} failed"
     )
+    for r in result.rows:
+        if r["also_as"]:
+            print(f"note: {r['source']} read; the same case also as {r['also_as']} (not read)")
+        if r["role"] == "rolling" and r["step"] in (None, 0):
+            print(
+                f"note: {r['source']} is a rolling map without its static map among the inputs: "
+                "listed apart (role rolling), not a load point of the trends"
+            )
     print(f"table: {result.csv}  {result.parquet}")
     if result.trends is not None:
         print(f"trends: {result.trends}")

@@ -53,6 +53,11 @@ class Job:
     error : str or None
         Set when the row fails before any analysis (input names no file, its
         time steps cannot be listed): the row is this error.
+    role : str
+        ``"static"`` (a load point) or ``"rolling"`` (an unpaired rolling map,
+        listed apart and left out of the load trends).
+    also : tuple of str
+        Other files of the same case (other formats), not read.
     """
 
     source: str
@@ -63,6 +68,8 @@ class Job:
     rolling_given: str | None = None
     time: float | None = None
     error: str | None = None
+    role: str = "static"
+    also: tuple[str, ...] = ()
 
     def key(self) -> str:
         """Identity of the row: inputs, their size and modification time, step and options."""
@@ -75,6 +82,8 @@ class Job:
             _stamp(self.rolling),
             _stamp(None if self.path is None else str(sidecar_path(self.path))),
             self.error,
+            self.role,
+            list(self.also),
         ]
         return hashlib.sha1(json.dumps(ident, sort_keys=True).encode()).hexdigest()
 
@@ -84,6 +93,8 @@ class Job:
             "rolling": self.rolling_given or "",
             "step": self.step,
             "time": self.time,
+            "role": self.role,
+            "also_as": " ".join(self.also),
         }
 
 

@@ -145,7 +145,16 @@ def _jobs(pairings: Sequence[Pairing], steps, listed: dict, options: RowOptions)
     jobs: list[Job] = []
     for pr in pairings:
         src = pr.static
-        base = Job(src.given, src.path, None, options, rolling=pr.rolling, rolling_given=pr.rolling_given)
+        base = Job(
+            src.given,
+            src.path,
+            None,
+            options,
+            rolling=pr.rolling,
+            rolling_given=pr.rolling_given,
+            role=pr.role,
+            also=src.also + pr.rolling_also,
+        )
         if src.error is not None or src.path is None:
             jobs.append(replace(base, error=src.error or f"{src.given}: no file"))
         elif steps != "all":
