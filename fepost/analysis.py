@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import re
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -19,14 +21,31 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from .coefficients import Coefficients, coefficients_from_moments
-from .errors import ArgumentError, PatchWarning, ScaleWarning
+from .errors import ArgumentError, PatchWarning, ScaleError, ScaleWarning
 from .field import ContactField
 from .moments import Moments, moments
-from .patch import DEFAULT_THRESHOLD, Patch, build_patch
+from .options import DEFAULT_FRICTION, AnalysisOptions, check_friction
+from .patch import Patch, build_patch
 from .polar import PolarGrid, PolarMap
 from .reader import isolate, start_reading
-from .reader.units import describe, unit_system
+from .reader.units import describe
 from .resample import resample
+
+
+@contextmanager
+def float_range(source: object) -> Iterator[None]:
+    """Turn an arithmetic overflow or a division by an underflowed zero inside the block into
+    a `ScaleError` naming ``source``: a map whose loads or lengths reach the ends of the
+    floating-point range (a load near 1.8e308 N, a radius near 1e-154 m) has no
+    meaningful coefficients, and Python's own message names no file. numpy's
+    RuntimeWarning is caught too where warnings are errors (``python -W error``)."""
+    try:
+        yield
+    except (OverflowError, ZeroDivisionError, FloatingPointError, RuntimeWarning) as exc:
+        raise ScaleError(
+            f"{source}: values beyond the floating-point range in the analysis ({type(exc).__name__}: "
+            f"{exc}); loads or lengths this large or small are no tire contact: check the file and --units"
+        ) from None
 
 
 @dataclass(frozen=True)
@@ -42,7 +61,23 @@ class Analysis:
     rolling_patch: Patch | None = None
     rolling_map: PolarMap | None = None
     rolling_moments: Moments | None = None
-    load_mismatch_allowed: bool = False
+    options: AnalysisOptions | None = None
+
+    @property
+    def load_mismatch_allowed(self) -> bool:
+        """Whether the analysis was told to accept a rolling map of another load."""
+        return self.options is not None and self.options.allow_load_mismatch
+
+    def __repr__(self) -> str:
+        c, p = self.coefficients, self.static_patch
+        roll = (
+            "" if self.rolling_field is None else f", rolling={self.rolling_field.source!r}, k_x={c.k_x:.6g}"
+        )
+        return (
+            f"Analysis(static={self.static_field.source!r}, N={c.N:.6g} N, R={c.R:.6g} m, "
+            f"M0={c.M0:.6g} N m, a={c.a:.6g}, m={c.m:.6g}, f={c.f:g}{roll}, "
+            f"grid={self.grid.shape[0]}x{self.grid.shape[1]}, faces={len(p.triangles)})"
+        )
 
     @property
     def grid(self) -> PolarGrid:
@@ -53,7 +88,8 @@ class Analysis:
         """The generalised friction model of these maps (:mod:`fepost.friction.summary`)."""
         from .friction.summary import summarise
 
-        return summarise(self)
+        with float_range(self.static_field.source):
+            return summarise(self)
 
     def to_dict(self, model: bool = True) -> dict:
         """The coefficients JSON (SI units, keys in docs/formats.md), with provenance.
@@ -192,77 +228,81 @@ def _warm_up() -> None:
     from .friction import summary  # noqa: F401
 
 
-def _start(src, field, step, displacement, units, surface) -> isolate.Pending:
-    """The reading of ``src`` under way (a :class:`ContactField` or a started read is taken as it is)."""
+def _start(src, options: AnalysisOptions) -> isolate.Pending:
+    """The reading of ``src`` under way (a `ContactField` or a started read is taken as it is)."""
     if isinstance(src, isolate.Pending):
         return src
     if isinstance(src, ContactField):
         return isolate.Pending(str(src.source), value=src)
-    return start_reading(
-        Path(src), field=field, step=step, displacement=displacement, units=units, surface=surface
-    )
+    return start_reading(Path(src), **options.reading())
+
+
+def friction_coefficient(friction) -> float:
+    """f from a number or a `fepost.friction.law.FrictionLaw` (its ``f``), checked by
+    `fepost.options.check_friction`."""
+    return check_friction(getattr(friction, "f", friction))
 
 
 def analyse(
     static,
     rolling=None,
     *,
-    friction: float = 0.3,
-    field: str | None = None,
-    step: int | None = None,
-    displacement: str | None = "auto",
-    grid: PolarGrid | None = None,
-    threshold: float = DEFAULT_THRESHOLD,
-    rolling_axis=None,
-    units=None,
-    surface: str | None = None,
-    allow_load_mismatch: bool = False,
+    friction=DEFAULT_FRICTION,
+    options: AnalysisOptions | None = None,
+    **changes,
 ) -> Analysis:
-    """Run the pipeline on a static map (path or :class:`ContactField`) and an optional rolling map.
+    """Run the pipeline on a static map (path or `ContactField`) and an optional rolling map.
 
-    A map may also be a read already under way (:func:`fepost.reader.start_reading`,
-    with its own reading options): a caller can start it before importing this module.
+    Parameters
+    ----------
+    static, rolling : path, ContactField or a started read
+        The maps. A map may be a read already under way (`fepost.reader.start_reading`,
+        with its own reading options): a caller can start it before importing this module.
+    friction : float or FrictionLaw
+        The friction coefficient f (default `fepost.options.DEFAULT_FRICTION`), or a
+        friction law whose ``f`` is taken.
+    options : AnalysisOptions, optional
+        How to read, resample and pair the maps (default: the defaults).
+    **changes
+        Single options changed on ``options`` by name (``field=``, ``step=``, ``grid=``,
+        ``threshold=``, ``units=``, ... as in `AnalysisOptions.make`), for short calls.
+
     The rolling map is placed in the static patch's frame; its polar grid is
     centred on the static centre of pressure with a radius large enough to
-    hold its own loaded region. ``units`` (a name of
-    :data:`fepost.reader.units.SYSTEMS`) and ``surface`` (an Exodus side set
-    or block) are passed to :func:`fepost.reader.read_contact`. N_fe is checked
-    against the solver's reaction where the export carries one (warning above
-    :data:`REACTION_TOL`). A rolling map whose load differs from the static
-    map's by more than :data:`LOAD_TOL` is refused (`ArgumentError`) unless
-    ``allow_load_mismatch``, which the result then records.
+    hold its own loaded region. N_fe is checked against the solver's reaction
+    where the export carries one (warning above `REACTION_TOL`). A rolling map
+    whose load differs from the static map's by more than `LOAD_TOL` is refused
+    (`ArgumentError`) unless ``allow_load_mismatch``, which the result records.
+
+    Examples
+    --------
+    >>> from fepost import analyse
+    >>> a = analyse("meshes/static.vtu", "meshes/rolling.vtu", friction=0.3)  # doctest: +SKIP
+    >>> round(a.coefficients.k_x, 3)  # doctest: +SKIP
+    0.265
     """
-    grid = grid or PolarGrid.make()
-    units = unit_system(units)
+    opts = AnalysisOptions.make(options, **changes)
+    f = friction_coefficient(friction)
     # both files are read at once in their own children; the patch step's imports run meanwhile
-    pending = [_start(static, field, step, displacement, units, surface)]
+    pending = [_start(static, opts)]
     try:
         if rolling is not None:
-            pending.append(_start(rolling, field, step, displacement, units, surface))
+            pending.append(_start(rolling, opts))
         if any(p.running for p in pending):
             _warm_up()
         # one BLAS thread: the patch step's products are thin (n × 3, chunk-long dots), where
         # BLAS threads only spin, and on a busy machine they stall it (2-5x slower)
-        with threadpool_limits(limits=1, user_api="blas"):
-            return _pipeline(
-                pending,
-                with_rolling=rolling is not None,
-                friction=friction,
-                grid=grid,
-                threshold=threshold,
-                rolling_axis=rolling_axis,
-                allow_load_mismatch=allow_load_mismatch,
-            )
+        with threadpool_limits(limits=1, user_api="blas"), float_range(pending[0].what):
+            return _pipeline(pending, with_rolling=rolling is not None, friction=f, options=opts)
     finally:
         for p in pending:
             p.cancel()
 
 
-def _pipeline(
-    pending, *, with_rolling, friction, grid, threshold, rolling_axis, allow_load_mismatch
-) -> Analysis:
+def _pipeline(pending, *, with_rolling: bool, friction: float, options: AnalysisOptions) -> Analysis:
+    grid = options.grid
     sf = pending[0].result()
-    sp = build_patch(sf, threshold=threshold, rolling_axis=rolling_axis)
+    sp = build_patch(sf, threshold=options.threshold, rolling_axis=options.rolling_axis)
     _check_reaction(sf, sp)
     sm = resample(sp, grid, radius=sp.r_max)
     smo = moments(sm)
@@ -270,11 +310,11 @@ def _pipeline(
     rf = rp = rm = rmo = None
     if with_rolling:
         rf = pending[1].result()
-        rp = build_patch(rf, threshold=threshold, frame=sp.frame)
-        check_load_pair(sp, rp, allow=allow_load_mismatch)
+        rp = build_patch(rf, threshold=options.threshold, frame=sp.frame)
+        check_load_pair(sp, rp, allow=options.allow_load_mismatch)
         r_roll = float(np.max(np.hypot(rp.xy[:, 0], rp.xy[:, 1])))
         rm = resample(rp, grid, radius=max(sp.r_max, r_roll))
         rmo = moments(rm)
         _check_resampling(rp, rmo)
     coef = coefficients_from_moments(smo, rmo, friction=friction)
-    return Analysis(sf, sp, sm, smo, coef, rf, rp, rm, rmo, load_mismatch_allowed=allow_load_mismatch)
+    return Analysis(sf, sp, sm, smo, coef, rf, rp, rm, rmo, options=options)

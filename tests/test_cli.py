@@ -17,6 +17,7 @@ import pytest
 
 import fepost
 import fepost.cli as cli
+import fepost.errors
 from fepost.cli import COMMANDS, EXIT_STATUSES, build_parser, main
 from fepost.cli import _validate as v
 from fepost.synthetic import write_map
@@ -230,7 +231,12 @@ def test_bad_options_are_one_line_exit_2(capsys, small_map, tmp_path, extra, mes
         (["table1", "--friction", "1e-300"], r"argument --friction: must be a friction coefficient in \["),
         (["report", "--out", "x", "--friction", "11"], r"argument --friction: must be a friction coeff"),
         (["report", "--out", "x", "--seed", "-7"], r"argument --seed: must be an integer >= 0, got '-7'"),
-        (["report", "--out", "x", "--inflation-pressure", "abc"], r"argument --inflation-pressure: invalid"),
+        (["report", "--out", "x", "--inflation-pressure",
+         "abc"], r"--inflation-pressure: unknown pressure unit 'abc'"),
+        (["report", "--out", "x", "--inflation-pressure",
+         "0kPa"], r"--inflation-pressure: must be a positive pressure"),
+        (["report", "--out", "x", "--inflation-pressure",
+         "1e3GPa"], r"--inflation-pressure: must be a positive pressure up to 1 GPa"),
         (["report"], r"the following arguments are required: --out"),
         (["diagnose", "--simulation", "s.vtu", "--measured", "m.csv", "--out", "o", "--folds", "1"],
          r"argument --folds: must be an integer >= 2, got '1'"),
@@ -467,3 +473,23 @@ def test_usage_error_in_a_real_process():
     assert err.decode() == (
         "fepost: error: argument --seed: must be an integer >= 0, got '-1' (see 'fepost table1 --help')\n"
     )
+
+
+@pytest.mark.parametrize(
+    ("text", "pa"),
+    [
+        ("1.38e6", 1.38e6),
+        ("1380kPa", 1.38e6),
+        ("1.38 MPa", 1.38e6),
+        ("13.8bar", 1.38e6),
+        # psi from its definition: a pound-force (0.45359237 kg x 9.80665 m/s^2) per square inch
+        ("200psi", 200 * 0.45359237 * 9.80665 / 0.0254**2),
+    ],
+)
+def test_inflation_pressure_takes_units(text, pa):
+    assert v.pressure(text) == pytest.approx(pa, rel=1e-12)
+
+
+def test_an_implausible_inflation_pressure_warns():
+    with pytest.warns(fepost.errors.OptionWarning, match="a bare number is Pa"):
+        assert v.pressure("1.38") == 1.38  # MPa meant, Pa given

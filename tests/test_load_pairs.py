@@ -89,7 +89,9 @@ def test_an_allowed_mismatch_goes_on_and_is_recorded(capsys, tmp_path):
     assert code == 0, err
     doc = json.loads(out_json.read_text())
     assert doc["rolling"]["load_mismatch_allowed"] is True
-    assert doc["rolling"]["load_ratio"] == pytest.approx(sidecar_load(rolling) / sidecar_load(static), rel=2e-3)
+    assert doc["rolling"]["load_ratio"] == pytest.approx(
+        sidecar_load(rolling) / sidecar_load(static), rel=2e-3
+    )
     assert "ALLOWED by --allow-load-mismatch" in out
 
 

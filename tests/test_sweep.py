@@ -25,7 +25,8 @@ import numpy as np
 import pytest
 
 from fepost.cli import main
-from fepost.sweep import RowOptions, read_table, run_sweep
+from fepost.options import AnalysisOptions
+from fepost.sweep import read_table, run_sweep
 from fepost.sweep.store import WORK
 from fepost.sweep.table import NAMES
 from fepost.synthetic import disc_mesh, write_exodus, write_map
@@ -359,8 +360,8 @@ def test_cli_option_errors(cluster, tmp_path, capsys, monkeypatch):
 
 def test_options_reach_every_row(cluster, tmp_path):
     f = hertz(tmp_path / "a.vtu", 1e4)
-    opts = RowOptions(friction=0.45, nr=24, nphi=48, rule="trapezoid")
-    res = run_sweep([str(f)], tmp_path / "o", options=opts, client=cluster, trends=False)
+    opts = AnalysisOptions(nr=24, nphi=48, rule="trapezoid")
+    res = run_sweep([str(f)], tmp_path / "o", options=opts, friction=0.45, client=cluster, trends=False)
     doc = single_file(tmp_path, f, "--friction", "0.45", "--nr", "24", "--nphi", "48", "--rule", "trapezoid")
     assert_row_equals(dict(res.rows[0]), doc)
     # other options are other rows: nothing reused

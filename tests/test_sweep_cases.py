@@ -5,6 +5,7 @@ nothing is a usage error with nothing written."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -43,7 +44,9 @@ def test_the_rolling_map_pairs_with_its_static_map_of_the_same_load():
     assert len(pairings) == 6
     assert all(p.role == STATIC for p in pairings)
     paired = [p for p in pairings if p.rolling is not None]
-    assert [(Path(p.static.path).stem, Path(p.rolling).stem) for p in paired] == [("static_100", "rolling_100")]
+    assert [(Path(p.static.path).stem, Path(p.rolling).stem) for p in paired] == [
+        ("static_100", "rolling_100")
+    ]
     assert [Path(a).name for a in paired[0].rolling_also] == ["rolling_100.vtu"]
     # an explicit rule pairs the same way
     ruled = pair_sources(expand_inputs([str(AIR)]), parse_rolling_pairs("static=rolling"))
@@ -71,7 +74,9 @@ def test_a_rolling_map_without_its_static_map_is_listed_apart(tmp_path):
 )
 def test_an_input_naming_nothing_is_a_usage_error_with_nothing_written(capsys, tmp_path, given):
     out = tmp_path / "out"
-    code = main(["sweep", str(ROOT / given) if given == "docs" else given, "--out", str(out), "--no-progress"])
+    code = main(
+        ["sweep", str(ROOT / given) if given == "docs" else given, "--out", str(out), "--no-progress"]
+    )
     _, err = capsys.readouterr()
     assert code == 2
     lines = err.strip().splitlines()
@@ -83,8 +88,16 @@ def test_an_input_naming_nothing_is_a_usage_error_with_nothing_written(capsys, t
 
 
 def test_the_aircraft_folder_gives_six_load_points_and_the_pair(tmp_path):
-    res = run_sweep([str(AIR)], tmp_path / "out", workers=1, processes=False, progress=False)
+    old = os.umask(0o027)  # the outputs must follow the umask, as docs/cli-exit-codes.md says
+    try:
+        res = run_sweep([str(AIR)], tmp_path / "out", workers=1, processes=False, progress=False)
+    finally:
+        os.umask(old)
     assert res.ok
+    out = tmp_path / "out"
+    for p in [out / "coefficients.parquet", out / "coefficients.csv", out / "trends.html", out / "trends"]:
+        assert p.stat().st_mode & 0o777 == (0o750 if p.is_dir() else 0o640), p
+    assert all(p.stat().st_mode & 0o777 == 0o640 for p in (out / "trends").iterdir())
     rows = read_table(res.csv)
     assert [Path(r["source"]).stem for r in rows] == [f"static_{k}" for k in LOADS]
     assert all(r["role"] == STATIC and r["also_as"] for r in rows)

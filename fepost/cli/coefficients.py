@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from ._common import add_friction_option, add_input_options, analysis_kwargs
+from ._common import add_friction_option, add_input_options, analysis_options
 
 if TYPE_CHECKING:
     from ..analysis import Analysis
@@ -101,23 +101,18 @@ def format_analysis(a: Analysis) -> str:
     return "\n".join(lines)
 
 
-#: The options of :func:`fepost.reader.start_reading` among :func:`analysis_kwargs`.
-READING = ("field", "step", "displacement", "units", "surface")
-
-
 def run(args: argparse.Namespace) -> int:
     from ..reader import start_reading
 
-    kwargs = analysis_kwargs(args)
-    reading = {k: kwargs[k] for k in READING}
+    options = analysis_options(args)
     # the files are read in their children while the pipeline's modules are imported
-    pending = [start_reading(args.static, **reading)]
+    pending = [start_reading(args.static, **options.reading())]
     try:
         if args.rolling:
-            pending.append(start_reading(args.rolling, **reading))
+            pending.append(start_reading(args.rolling, **options.reading()))
         from ..analysis import analyse
 
-        result = analyse(*pending, friction=args.friction, **kwargs)
+        result = analyse(*pending, friction=args.friction, options=options)
     finally:
         for p in pending:
             p.cancel()

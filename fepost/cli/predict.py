@@ -45,10 +45,10 @@ def run(args: argparse.Namespace) -> int:
     from ..analysis import analyse
     from ..friction.predict import predict, read_kinematics
     from ..output import write_text_atomic
-    from ._common import analysis_kwargs
+    from ._common import analysis_options
 
     kin = read_kinematics(args.kinematics)  # bad CSV: fail before the FE work
-    result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
+    result = analyse(args.static, args.rolling, friction=args.friction, options=analysis_options(args))
     pred = predict(result, kin.vx, kin.vy, kin.wz)
     write_text_atomic(args.out, pred.to_csv())
     if args.model_json:

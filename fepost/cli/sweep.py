@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 
 #: Error rows listed on stderr at the end of a sweep (all are in the table).
 SHOWN_ERRORS = 10
@@ -66,11 +67,11 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import ArgumentError
-    from ..sweep import RowOptions, run_sweep
+    from ..sweep import run_sweep
     from . import FAILED_INPUTS, OK, Terminated
-    from ._common import analysis_kwargs
+    from ._common import analysis_options
 
-    kwargs = analysis_kwargs(args)
+    options = analysis_options(args)
     if args.step is not None and args.steps == "all":
         raise ArgumentError("--step N picks one time step of every file; it cannot go with --steps all")
     steps = args.step if args.step is not None else (args.steps or "last")
@@ -80,7 +81,8 @@ def run(args: argparse.Namespace) -> int:
             args.out,
             steps=steps,
             rolling_pairs=args.rolling_pairs,
-            options=RowOptions.from_analysis_kwargs(kwargs, friction=args.friction),
+            options=replace(options, step=None),  # the sweep's steps are its own business
+            friction=args.friction,
             workers=args.workers,
             scheduler=args.scheduler,
             progress=False if args.no_progress else None,

@@ -69,7 +69,7 @@ def is_rolling_map(path: str) -> bool:
         side = read_sidecar(Path(path))
     except InputFileError:
         return False  # the row's own analysis reports the sidecar
-    return bool(side) and "rolling_standin" in side
+    return side is not None and "rolling_standin" in side
 
 
 def _static_name(name: str) -> str:
@@ -198,7 +198,7 @@ def pair_sources(sources: Sequence[Source], pairs: RollingPairs | None) -> list[
             f"--rolling-pairs {pairs.spec}: no input has a rolling partner (no file named like an "
             f"input with {old!r} replaced by {new!r})"
         )
-    paired = {s.path for s, p in found if p is not None}
+    paired = {s.path for s, p in found if p is not None and s.path is not None}
     default = _default_partners(sources, partners | paired)
     partners |= {rolling for rolling, _ in default.values()}
     also = {s.path: s.also for s in sources if s.path is not None}

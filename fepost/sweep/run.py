@@ -28,10 +28,11 @@ from pathlib import Path
 from types import MappingProxyType
 
 from ..errors import ArgumentError
+from ..options import DEFAULT_FRICTION, AnalysisOptions, check_friction
+from ..output import umask_mode
 from .engine import Cluster, WorkerDied
 from .inputs import expand_inputs
 from .jobs import Job, run_job
-from .options import RowOptions
 from .pairs import Pairing, RollingPairs, pair_sources, parse_rolling_pairs
 from .progress import ProgressBar
 from .steps import SERIES_SUFFIXES, time_steps
@@ -141,7 +142,9 @@ def _listed_steps(pairings: Sequence[Pairing], work: WorkFolder, cluster: Cluste
     return listed
 
 
-def _jobs(pairings: Sequence[Pairing], steps, listed: dict, options: RowOptions) -> list[Job]:
+def _jobs(
+    pairings: Sequence[Pairing], steps, listed: dict, options: AnalysisOptions, friction: float
+) -> list[Job]:
     jobs: list[Job] = []
     for pr in pairings:
         src = pr.static
@@ -154,6 +157,7 @@ def _jobs(pairings: Sequence[Pairing], steps, listed: dict, options: RowOptions)
             rolling_given=pr.rolling_given,
             role=pr.role,
             also=src.also + pr.rolling_also,
+            friction=friction,
         )
         if src.error is not None or src.path is None:
             jobs.append(replace(base, error=src.error or f"{src.given}: no file"))
@@ -176,7 +180,8 @@ def run_sweep(
     *,
     steps: str | int = "last",
     rolling_pairs: str | RollingPairs | None = None,
-    options: RowOptions | None = None,
+    options: AnalysisOptions | None = None,
+    friction: float = DEFAULT_FRICTION,
     workers: int | None = None,
     scheduler: str | None = None,
     client=None,
@@ -202,8 +207,11 @@ def run_sweep(
         per time step of every Exodus file; an int: that step of every file.
     rolling_pairs : str or RollingPairs, optional
         ``STATIC=ROLLING`` naming rule or a CSV of pairs (:mod:`.pairs`).
-    options : RowOptions, optional
-        Analysis options of every row (default: those of ``fepost coefficients``).
+    options : AnalysisOptions, optional
+        Analysis options of every row (default: those of ``fepost coefficients``); its
+        ``step`` is replaced by each row's (see ``steps``).
+    friction : float
+        Friction coefficient f of every row.
     workers : int, optional
         Processes of the embedded local cluster (default: the usable CPU cores).
     scheduler : str, optional
@@ -232,15 +240,16 @@ def run_sweep(
     if not inputs:
         raise ArgumentError("no inputs given (files, folders or glob patterns)")
     steps = _check_steps(steps)
-    options = options or RowOptions()
+    options = options or AnalysisOptions()
+    friction = check_friction(friction)
     pairs = parse_rolling_pairs(rolling_pairs) if isinstance(rolling_pairs, str) else rolling_pairs
     cluster = Cluster(workers, scheduler, client, processes=processes)
     pairings = pair_sources(expand_inputs(inputs), pairs)
     out = Path(out)
     with WorkFolder(out, force=force, fresh=fresh) as work, cluster:
-        units = options.units
+        units = options.unit_system
         listed = _listed_steps(pairings, work, cluster, units) if steps == "all" else {}
-        jobs = _jobs(pairings, steps, listed, options)
+        jobs = _jobs(pairings, steps, listed, options, friction)
         keys = [j.key() for j in jobs]
         rows: list[dict | None] = [None] * len(jobs)
         todo = []
@@ -264,6 +273,7 @@ def run_sweep(
             from .page import write_trends
 
             page = write_trends(table, out)
+            umask_mode(out / "trends")  # drawn in a tempfile.mkdtemp folder (0700)
     frozen = tuple(MappingProxyType(r) for r in table)
     return SweepResult(out, frozen, reused, len(todo), parquet, csv, page)
 

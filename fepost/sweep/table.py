@@ -15,7 +15,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..output import write_text_atomic
+from ..output import atomic_path, write_text_atomic
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,9 @@ class Column:
 COLUMNS: tuple[Column, ...] = (
     Column("source", "str", "", "FE export, path as given (or as the folder/glob produced it)"),
     Column("rolling", "str", "", "rolling map paired with it, empty when none"),
-    Column("role", "str", "", "static (a load point) or rolling (an unpaired rolling map, not in the trends)"),
+    Column(
+        "role", "str", "", "static (a load point) or rolling (an unpaired rolling map, not in the trends)"
+    ),
     Column("also_as", "str", "", "other files of the same case (same stem, other formats), not read"),
     Column("step", "int", "", "Exodus time step read (0-based); empty for files without time steps"),
     Column("time", "float", "s", "time value of that step (the solver's time unit)"),
@@ -147,22 +149,14 @@ def arrow_schema():
 
 def write_table(rows: Sequence[Mapping], folder: Path) -> tuple[Path, Path]:
     """Write ``coefficients.parquet`` and ``coefficients.csv`` into ``folder``, each atomically."""
-    import os
-    import tempfile
-
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     rows = [normalise(r) for r in rows]
     table = pa.Table.from_pylist(rows, schema=arrow_schema())
     parquet = folder / "coefficients.parquet"
-    fd, tmp = tempfile.mkstemp(prefix=".coefficients.", suffix=".parquet.tmp", dir=folder)
-    os.close(fd)
-    try:
+    with atomic_path(parquet) as tmp:  # created by pyarrow with the umask's mode, as documented
         pq.write_table(table, tmp)
-        os.replace(tmp, parquet)
-    finally:
-        Path(tmp).unlink(missing_ok=True)
     return parquet, write_text_atomic(folder / "coefficients.csv", csv_text(rows))
 
 
