@@ -432,7 +432,8 @@ def test_report_bad_inflation_pressure(tmp_path, small_map, capsys):
     assert code == 2
     assert (
         capsys.readouterr().err
-        == "fepost: error: argument --inflation-pressure: must be a positive pressure up to 1 GPa, got '0'\n"
+        == "fepost: error: argument --inflation-pressure: must be a positive pressure up to 1 GPa, got '0' "
+        "(see 'fepost report --help')\n"
     )
     assert not out.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["small.vtu"]
@@ -497,7 +498,7 @@ def test_report_optional_sections(tmp_path, small_map):
         return None
 
     out = tmp_path / "rep"
-    res = build_report(small_map, out=out, seed=1, sections=(nothing, extra))
+    res = build_report(small_map, out=out, seed=1, sections=(nothing, extra), inflation_pressure=200e3)
     html = (out / "report.html").read_text(encoding="utf-8")
     assert html.count("<h2") == 9  # the 8 core sections and the extra one
     assert '<h2 id="extra-section">Extra section &lt;demo&gt;</h2>' in html

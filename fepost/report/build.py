@@ -120,6 +120,13 @@ class ReportResult:
     inflation_pressure: float
     inflation_pressure_source: str
 
+    def __repr__(self) -> str:
+        total = sum(t for _, t in self.timings)
+        return (
+            f"ReportResult(out={str(self.out)!r}, files={len(self.files)}, seconds={total:.1f}, "
+            f"inflation_pressure={self.inflation_pressure:g} Pa)"
+        )
+
     def to_dict(self) -> dict:
         return {
             "out": str(self.out),

@@ -67,6 +67,12 @@ class SweepResult:
     csv: Path
     trends: Path | None = None
 
+    def __repr__(self) -> str:
+        return (
+            f"SweepResult(out={str(self.out)!r}, rows={len(self.rows)}, errors={self.errors}, "
+            f"reused={self.reused}, computed={self.computed})"
+        )
+
     @property
     def errors(self) -> int:
         return sum(r["status"] != "ok" for r in self.rows)
@@ -251,17 +257,8 @@ def run_sweep(
         listed = _listed_steps(pairings, work, cluster, units) if steps == "all" else {}
         jobs = _jobs(pairings, steps, listed, options, friction)
         keys = [j.key() for j in jobs]
-        rows: list[dict | None] = [None] * len(jobs)
-        todo = []
-        reused = 0
-        for i, (job, key) in enumerate(zip(jobs, keys, strict=True)):
-            if job.error is not None:
-                rows[i] = run_job(job)
-            elif (saved := work.load_row(key)) is not None and saved["status"] == "ok":
-                rows[i] = saved
-                reused += 1
-            else:
-                todo.append(i)
+        rows, todo = _saved_rows(jobs, keys, work)
+        reused = len(jobs) - len(todo) - sum(j.error is not None for j in jobs)
         bar = ProgressBar(len(todo), done=len(jobs) - len(todo), enabled=progress)
         if todo:
             _compute(cluster, jobs, keys, todo, rows, work, bar)
@@ -276,6 +273,21 @@ def run_sweep(
             umask_mode(out / "trends")  # drawn in a tempfile.mkdtemp folder (0700)
     frozen = tuple(MappingProxyType(r) for r in table)
     return SweepResult(out, frozen, reused, len(todo), parquet, csv, page)
+
+
+def _saved_rows(jobs: Sequence[Job], keys: Sequence[str], work: WorkFolder) -> tuple[list, list[int]]:
+    """The rows known without computing (failed jobs, rows finished by an earlier run), and
+    the indices of the jobs left to compute."""
+    rows: list[dict | None] = [None] * len(jobs)
+    todo = []
+    for i, (job, key) in enumerate(zip(jobs, keys, strict=True)):
+        if job.error is not None:
+            rows[i] = run_job(job)
+        elif (saved := work.load_row(key)) is not None and saved["status"] == "ok":
+            rows[i] = saved
+        else:
+            todo.append(i)
+    return rows, todo
 
 
 def _compute(cluster: Cluster, jobs, keys, todo, rows, work: WorkFolder, bar: ProgressBar) -> None:
