@@ -253,6 +253,13 @@ def analyse(
 ) -> Analysis:
     """Run the pipeline on a static map (path or `ContactField`) and an optional rolling map.
 
+    The rolling map is placed in the static patch's frame; its polar grid is
+    centred on the static centre of pressure with a radius large enough to
+    hold its own loaded region. N_fe is checked against the solver's reaction
+    where the export carries one (warning above `REACTION_TOL`). A rolling map
+    whose load differs from the static map's by more than `LOAD_TOL` is refused
+    (`ArgumentError`) unless ``allow_load_mismatch``, which the result records.
+
     Parameters
     ----------
     static, rolling : path, ContactField or a started read
@@ -267,19 +274,17 @@ def analyse(
         Single options changed on ``options`` by name (``field=``, ``step=``, ``grid=``,
         ``threshold=``, ``units=``, ... as in `AnalysisOptions.make`), for short calls.
 
-    The rolling map is placed in the static patch's frame; its polar grid is
-    centred on the static centre of pressure with a radius large enough to
-    hold its own loaded region. N_fe is checked against the solver's reaction
-    where the export carries one (warning above `REACTION_TOL`). A rolling map
-    whose load differs from the static map's by more than `LOAD_TOL` is refused
-    (`ArgumentError`) unless ``allow_load_mismatch``, which the result records.
+    Returns
+    -------
+    Analysis
+        The patches, polar maps, moments and coefficients.
 
     Examples
     --------
     >>> from fepost import analyse
     >>> a = analyse("meshes/static.vtu", "meshes/rolling.vtu", friction=0.3)  # doctest: +SKIP
     >>> round(a.coefficients.k_x, 3)  # doctest: +SKIP
-    0.265
+    0.254
     """
     opts = AnalysisOptions.make(options, **changes)
     f = friction_coefficient(friction)
