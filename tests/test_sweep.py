@@ -339,7 +339,7 @@ def test_cli_option_errors(cluster, tmp_path, capsys, monkeypatch):
             ["--workers", "2", "--scheduler", cluster.scheduler.address],
             "--workers sizes the embedded cluster",
         ),
-        (["--friction", "-1"], "argument --friction: must be a positive number"),
+        (["--friction", "-1"], "argument --friction: must be a friction coefficient in [0.001, 10]"),
     ]
     for extra, message in cases:
         code = main(["sweep", str(f), "--out", str(tmp_path / "o"), *extra])
