@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import re
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -19,14 +21,31 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from .coefficients import Coefficients, coefficients_from_moments
-from .errors import PatchWarning, ScaleWarning
+from .errors import ArgumentError, PatchWarning, ScaleError, ScaleWarning
 from .field import ContactField
 from .moments import Moments, moments
-from .patch import DEFAULT_THRESHOLD, Patch, build_patch
+from .options import DEFAULT_FRICTION, AnalysisOptions, check_friction
+from .patch import Patch, build_patch
 from .polar import PolarGrid, PolarMap
 from .reader import isolate, start_reading
-from .reader.units import describe, unit_system
+from .reader.units import describe
 from .resample import resample
+
+
+@contextmanager
+def float_range(source: object) -> Iterator[None]:
+    """Turn an arithmetic overflow or a division by an underflowed zero inside the block into
+    a `ScaleError` naming ``source``: a map whose loads or lengths reach the ends of the
+    floating-point range (a load near 1.8e308 N, a radius near 1e-154 m) has no
+    meaningful coefficients, and Python's own message names no file. numpy's
+    RuntimeWarning is caught too where warnings are errors (``python -W error``)."""
+    try:
+        yield
+    except (OverflowError, ZeroDivisionError, FloatingPointError, RuntimeWarning) as exc:
+        raise ScaleError(
+            f"{source}: values beyond the floating-point range in the analysis ({type(exc).__name__}: "
+            f"{exc}); loads or lengths this large or small are no tire contact: check the file and --units"
+        ) from None
 
 
 @dataclass(frozen=True)
@@ -42,6 +61,23 @@ class Analysis:
     rolling_patch: Patch | None = None
     rolling_map: PolarMap | None = None
     rolling_moments: Moments | None = None
+    options: AnalysisOptions | None = None
+
+    @property
+    def load_mismatch_allowed(self) -> bool:
+        """Whether the analysis was told to accept a rolling map of another load."""
+        return self.options is not None and self.options.allow_load_mismatch
+
+    def __repr__(self) -> str:
+        c, p = self.coefficients, self.static_patch
+        roll = (
+            "" if self.rolling_field is None else f", rolling={self.rolling_field.source!r}, k_x={c.k_x:.6g}"
+        )
+        return (
+            f"Analysis(static={self.static_field.source!r}, N={c.N:.6g} N, R={c.R:.6g} m, "
+            f"M0={c.M0:.6g} N m, a={c.a:.6g}, m={c.m:.6g}, f={c.f:g}{roll}, "
+            f"grid={self.grid.shape[0]}x{self.grid.shape[1]}, faces={len(p.triangles)})"
+        )
 
     @property
     def grid(self) -> PolarGrid:
@@ -55,9 +91,10 @@ class Analysis:
 
         c, p = self.coefficients, self.static_patch
         law = FrictionLaw(f=c.f)
-        return summarise(
-            self.static_map, c, law, rolling_map=self.rolling_map, circular=p.circular, aspect=p.aspect
-        )
+        with float_range(self.static_field.source):
+            return summarise(
+                self.static_map, c, law, rolling_map=self.rolling_map, circular=p.circular, aspect=p.aspect
+            )
 
     def to_dict(self, model: bool = True) -> dict:
         """The coefficients JSON (SI units, keys in docs/formats.md), with provenance.
@@ -93,6 +130,9 @@ class Analysis:
                 "reaction_z": rf.reaction_z,
                 "centre_of_pressure": list(self.rolling_patch.centre_of_pressure),
                 "grid_radius": self.rolling_map.radius,
+                "load_ratio": self.rolling_patch.N_fe / self.static_patch.N_fe,
+                "load_tolerance": LOAD_TOL,
+                "load_mismatch_allowed": self.load_mismatch_allowed,
             }
         if model:  # generalised friction model (fepost.friction.summary)
             d["model"] = self.model_summary.to_dict()
@@ -103,6 +143,12 @@ class Analysis:
 RESAMPLE_TOL = 0.01
 #: Largest accepted distance between N_fe and the solver's reaction before a warning.
 REACTION_TOL = 0.10
+#: Largest accepted |N_fe(rolling)/N_fe(static) − 1| of a static/rolling pair, unless the
+#: caller allows a mismatch. The pair must be one tire at one load: the shipped pairs agree to
+#: 0.4 % (aircraft, 100 %) and 1.5 % (small tire), a displacement-controlled rolling step moves
+#: the load by a few tenths of a percent, while the nearest other load point of a sweep is
+#: 25 % away; k_x = R x_c/<x^2> then mixes two patches (0.39 for 0.24 at 50 %/100 %).
+LOAD_TOL = 0.03
 _AXIS = re.compile(r"(?:^|[_\s.-])([xyz])$|([xyzXYZ])$")
 
 
@@ -150,6 +196,26 @@ def _check_reaction(fld: ContactField, patch: Patch) -> None:
     )
 
 
+def check_load_pair(static: Patch, rolling: Patch, *, allow: bool = False) -> float:
+    """The ratio N_fe(rolling) / N_fe(static); refuse a pair further apart than :data:`LOAD_TOL`.
+
+    Raises
+    ------
+    ArgumentError
+        The loads differ by more than :data:`LOAD_TOL` and ``allow`` is false
+        (one line naming both maps and both loads).
+    """
+    ratio = rolling.N_fe / static.N_fe
+    if abs(ratio - 1.0) > LOAD_TOL and not allow:
+        raise ArgumentError(
+            f"{rolling.source}: the rolling map's load N_fe = {rolling.N_fe:.6g} N differs from the "
+            f"static map's ({static.source}) N_fe = {static.N_fe:.6g} N by {ratio - 1.0:+.1%}, more "
+            f"than the {LOAD_TOL:.0%} tolerance: k_x needs both maps at one load (pair maps of the "
+            "same load, or allow the mismatch: --allow-load-mismatch)"
+        )
+    return ratio
+
+
 def _check_resampling(patch: Patch, mom: Moments) -> None:
     err = mom.N / patch.N_fe - 1.0
     if abs(err) > RESAMPLE_TOL:
@@ -167,42 +233,56 @@ def _warm_up() -> None:
     from .friction import summary  # noqa: F401
 
 
-def _start(src, field, step, displacement, units, surface) -> isolate.Pending:
-    """The reading of ``src`` under way (a :class:`ContactField` or a started read is taken as it is)."""
+def _start(src, options: AnalysisOptions) -> isolate.Pending:
+    """The reading of ``src`` under way (a `ContactField` or a started read is taken as it is)."""
     if isinstance(src, isolate.Pending):
         return src
     if isinstance(src, ContactField):
         return isolate.Pending(str(src.source), value=src)
-    return start_reading(
-        Path(src), field=field, step=step, displacement=displacement, units=units, surface=surface
-    )
+    return start_reading(Path(src), **options.reading())
+
+
+def friction_coefficient(friction) -> float:
+    """f from a number or a `fepost.friction.law.FrictionLaw` (its ``f``), checked by
+    `fepost.options.check_friction`."""
+    return check_friction(getattr(friction, "f", friction))
 
 
 def analyse(
     static,
     rolling=None,
     *,
-    friction: float = 0.3,
-    field: str | None = None,
-    step: int | None = None,
-    displacement: str | None = "auto",
-    grid: PolarGrid | None = None,
-    threshold: float = DEFAULT_THRESHOLD,
-    rolling_axis=None,
-    units=None,
-    surface: str | None = None,
+    friction=DEFAULT_FRICTION,
+    options: AnalysisOptions | None = None,
+    **changes,
 ) -> Analysis:
-    """Run the pipeline on a static map (path or :class:`ContactField`) and an optional rolling map.
+    """Run the pipeline on a static map (path or `ContactField`) and an optional rolling map.
 
-    A map may also be a read already under way (:func:`fepost.reader.start_reading`,
-    with its own reading options): a caller can start it before importing this module.
     The rolling map is placed in the static patch's frame; its polar grid is
     centred on the static centre of pressure with a radius large enough to
-    hold its own loaded region. ``units`` (a name of
-    :data:`fepost.reader.units.SYSTEMS`) and ``surface`` (an Exodus side set
-    or block) are passed to :func:`fepost.reader.read_contact`. N_fe is checked
-    against the solver's reaction where the export carries one (warning above
-    :data:`REACTION_TOL`).
+    hold its own loaded region. N_fe is checked against the solver's reaction
+    where the export carries one (warning above `REACTION_TOL`). A rolling map
+    whose load differs from the static map's by more than `LOAD_TOL` is refused
+    (`ArgumentError`) unless ``allow_load_mismatch``, which the result records.
+
+    Parameters
+    ----------
+    static, rolling : path, ContactField or a started read
+        The maps. A map may be a read already under way (`fepost.reader.start_reading`,
+        with its own reading options): a caller can start it before importing this module.
+    friction : float or FrictionLaw
+        The friction coefficient f (default `fepost.options.DEFAULT_FRICTION`), or a
+        friction law whose ``f`` is taken.
+    options : AnalysisOptions, optional
+        How to read, resample and pair the maps (default: the defaults).
+    **changes
+        Single options changed on ``options`` by name (``field=``, ``step=``, ``grid=``,
+        ``threshold=``, ``units=``, ... as in `AnalysisOptions.make`), for short calls.
+
+    Returns
+    -------
+    Analysis
+        The patches, polar maps, moments and coefficients.
 
     Examples
     --------
@@ -218,27 +298,28 @@ def analyse(
     >>> bool(res.static_patch.circular), round(res.static_patch.aspect, 2)
     (False, 1.16)
     """
-    grid = grid or PolarGrid.make()
-    units = unit_system(units)
+    opts = AnalysisOptions.make(options, **changes)
+    f = friction_coefficient(friction)
     # both files are read at once in their own children; the patch step's imports run meanwhile
-    pending = [_start(static, field, step, displacement, units, surface)]
+    pending = [_start(static, opts)]
     try:
         if rolling is not None:
-            pending.append(_start(rolling, field, step, displacement, units, surface))
+            pending.append(_start(rolling, opts))
         if any(p.running for p in pending):
             _warm_up()
         # one BLAS thread: the patch step's products are thin (n × 3, chunk-long dots), where
         # BLAS threads only spin, and on a busy machine they stall it (2-5x slower)
-        with threadpool_limits(limits=1, user_api="blas"):
-            return _pipeline(pending, rolling is not None, friction, grid, threshold, rolling_axis)
+        with threadpool_limits(limits=1, user_api="blas"), float_range(pending[0].what):
+            return _pipeline(pending, with_rolling=rolling is not None, friction=f, options=opts)
     finally:
         for p in pending:
             p.cancel()
 
 
-def _pipeline(pending, with_rolling, friction, grid, threshold, rolling_axis) -> Analysis:
+def _pipeline(pending, *, with_rolling: bool, friction: float, options: AnalysisOptions) -> Analysis:
+    grid = options.grid
     sf = pending[0].result()
-    sp = build_patch(sf, threshold=threshold, rolling_axis=rolling_axis)
+    sp = build_patch(sf, threshold=options.threshold, rolling_axis=options.rolling_axis)
     _check_reaction(sf, sp)
     sm = resample(sp, grid, radius=sp.r_max)
     smo = moments(sm)
@@ -246,10 +327,11 @@ def _pipeline(pending, with_rolling, friction, grid, threshold, rolling_axis) ->
     rf = rp = rm = rmo = None
     if with_rolling:
         rf = pending[1].result()
-        rp = build_patch(rf, threshold=threshold, frame=sp.frame)
+        rp = build_patch(rf, threshold=options.threshold, frame=sp.frame)
+        check_load_pair(sp, rp, allow=options.allow_load_mismatch)
         r_roll = float(np.max(np.hypot(rp.xy[:, 0], rp.xy[:, 1])))
         rm = resample(rp, grid, radius=max(sp.r_max, r_roll))
         rmo = moments(rm)
         _check_resampling(rp, rmo)
     coef = coefficients_from_moments(smo, rmo, friction=friction)
-    return Analysis(sf, sp, sm, smo, coef, rf, rp, rm, rmo)
+    return Analysis(sf, sp, sm, smo, coef, rf, rp, rm, rmo, options=options)

@@ -178,6 +178,53 @@ def _write_through(path: Path, text: str) -> Path:
     return path
 
 
+@contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path beside ``path`` (not created) for a writer that makes its own
+    file (pyarrow, matplotlib); renamed over ``path`` when the block ends, removed on error.
+
+    The writer creates the file with the usual mode masked by the umask, unlike
+    `tempfile.mkstemp`'s private 0600.
+    """
+    path = Path(path)
+    folder = _folder_of(path)
+    remove_stale_temporaries(folder)
+    tmp = folder / _temporary_name(path.name)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _umask() -> int:
+    """The process's umask, read without changing it where Linux shows it (threads run)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def umask_mode(path: str | Path) -> None:
+    """Give ``path`` the mode a plain ``open``/``mkdir`` would (0o666 or 0o777 masked by
+    the umask): for a folder another library made private (`tempfile.mkdtemp`'s 0700)."""
+    mask = _umask()
+    base = 0o777 if os.path.isdir(path) else 0o666
+    try:
+        os.chmod(path, base & ~mask)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot set its permissions ({exc.strerror or exc})") from None
+
+
 def write_json_atomic(path: str | Path, data) -> Path:
     """:func:`to_json` of ``data`` written with :func:`write_text_atomic`."""
     return write_text_atomic(path, to_json(data) + "\n")
@@ -187,6 +234,17 @@ def _contains(folder: Path, other: Path) -> bool:
     return folder == other or folder in other.parents
 
 
+def _resolve(path: str | Path) -> Path:
+    """``Path(path).resolve()``, with a symbolic-link loop or a name too long as `OutputError`
+    (Python 3.11 raises RuntimeError for a loop)."""
+    try:
+        return Path(path).resolve()
+    except RuntimeError:
+        raise OutputError(f"{path}: cannot write here (a symbolic-link loop)") from None
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write here ({exc.strerror or exc})") from None
+
+
 def check_replaceable(out: str | Path, inputs: Iterable[str | Path | None] = ()) -> None:
     """Refuse writing ``out`` when that would delete an input or a folder one works in.
 
@@ -194,11 +252,8 @@ def check_replaceable(out: str | Path, inputs: Iterable[str | Path | None] = ())
     current folder, the home folder or the file-system root. Raises
     :class:`~fepost.errors.OutputError` with one line naming what it holds.
     """
-    try:
-        target = Path(out).resolve()
-    except OSError as exc:  # a name too long, a symlink loop
-        raise OutputError(f"{out}: cannot write here ({exc.strerror or exc})") from None
-    guarded = [(Path(p).resolve(), f"the input {p}") for p in inputs if p is not None]
+    target = _resolve(out)
+    guarded = [(_resolve(p), f"the input {p}") for p in inputs if p is not None]
     guarded.append((Path.cwd().resolve(), "the current folder"))
     try:
         guarded.append((Path.home().resolve(), "the home folder"))

@@ -158,7 +158,7 @@ def test_two_patches(capsys, tmp_path):
 
 def test_bad_friction_argument(capsys, tmp_path):
     p = disc(tmp_path / "m.vtu")
-    message = r"argument --friction: must be a positive number, got '-1'"
+    message = r"argument --friction: must be a friction coefficient in \[0.001, 10\], got '-1'"
     run_bad(capsys, tmp_path, [p, "--friction", "-1"], message)
 
 

@@ -17,6 +17,7 @@ import pytest
 
 import fepost
 import fepost.cli as cli
+import fepost.errors
 from fepost.cli import COMMANDS, EXIT_STATUSES, build_parser, main
 from fepost.cli import _validate as v
 from fepost.synthetic import write_map
@@ -189,10 +190,16 @@ def test_commands_are_registered_from_the_list(monkeypatch):
 # --- option ranges -----------------------------------------------------------------------
 
 BAD_OPTIONS = [
-    (["--friction", "0"], r"argument --friction: must be a positive number, got '0'"),
-    (["--friction", "-0.3"], r"argument --friction: must be a positive number, got '-0.3'"),
-    (["--friction", "nan"], r"argument --friction: must be a positive number, got 'nan'"),
-    (["--friction", "inf"], r"argument --friction: must be a positive number, got 'inf'"),
+    (["--friction", "0"], r"argument --friction: must be a friction coefficient in \[0.001, 10\], got '0'"),
+    (["--friction", "-0.3"], r"argument --friction: must be a friction coefficient in .*, got '-0.3'"),
+    (
+        ["--friction", "nan"],
+        r"argument --friction: must be a friction coefficient in \[0.001, 10\], got 'nan'",
+    ),
+    (
+        ["--friction", "inf"],
+        r"argument --friction: must be a friction coefficient in \[0.001, 10\], got 'inf'",
+    ),
     (["--friction", "high"], r"argument --friction: not a number: 'high'"),
     (["--threshold", "0"], r"argument --threshold: must be a number between 0 and 1 \(exclusive\), got '0'"),
     (["--threshold", "1"], r"argument --threshold: must be a number between 0 and 1"),
@@ -204,7 +211,12 @@ BAD_OPTIONS = [
     (["--json", ""], r"argument --json: must not be empty"),
     (["--field", " "], r"argument --field: must not be empty"),
     (["--rule", "simpson"], r"argument --rule: invalid choice: 'simpson'"),
-    (["--bogus"], r"unrecognized arguments: --bogus"),
+    (["--bogus"], r"unrecognized argument '--bogus' \(see 'fepost coefficients --help'\)"),
+    (
+        ["--frcition", "0.4"],
+        r"'--frcition' \(did you mean --friction\?\) \(see 'fepost coefficients --help'\)",
+    ),
+    (["--nphi=64", "--thresold=0.1"], r"'--thresold=0.1' \(did you mean --threshold\?\)"),
 ]
 
 
@@ -230,15 +242,21 @@ def test_bad_options_are_one_line_exit_2(capsys, small_map, tmp_path, extra, mes
         (["table1", "--friction", "1e-300"], r"argument --friction: must be a friction coefficient in \["),
         (["report", "--out", "x", "--friction", "11"], r"argument --friction: must be a friction coeff"),
         (["report", "--out", "x", "--seed", "-7"], r"argument --seed: must be an integer >= 0, got '-7'"),
-        (["report", "--out", "x", "--inflation-pressure", "abc"], r"argument --inflation-pressure: invalid"),
+        (["report", "--out", "x", "--inflation-pressure",
+         "abc"], r"--inflation-pressure: unknown pressure unit 'abc'"),
+        (["report", "--out", "x", "--inflation-pressure",
+         "0kPa"], r"--inflation-pressure: must be a positive pressure"),
+        (["report", "--out", "x", "--inflation-pressure",
+         "1e3GPa"], r"--inflation-pressure: must be a positive pressure up to 1 GPa"),
         (["report"], r"the following arguments are required: --out"),
         (["diagnose", "--simulation", "s.vtu", "--measured", "m.csv", "--out", "o", "--folds", "1"],
          r"argument --folds: must be an integer >= 2, got '1'"),
         (["diagnose", "--simulation", "s.vtu", "--measured", "m.csv", "--out", "o", "--seed", "-2"],
          r"argument --seed: must be an integer >= 0, got '-2'"),
         (["diagnose", "--measured", "m.csv", "--out", "o"], r"arguments are required: --simulation"),
-        (["frobnicate"], r"argument COMMAND: invalid choice: 'frobnicate'"),
-        ([], r"the following arguments are required: COMMAND"),
+        (["frobnicate"], r"unknown command 'frobnicate' \(see 'fepost --help'\)"),
+        (["coefficent", "x.vtu"], r"unknown command 'coefficent' \(did you mean coefficients\?\)"),
+        (["sweep", "x", "--out", "o", "--wrokers", "2"], r"--workers\?\) \(see 'fepost sweep --help'\)"),
     ],
 )  # fmt: skip
 def test_bad_options_of_each_command(capsys, argv, message):
@@ -467,3 +485,43 @@ def test_usage_error_in_a_real_process():
     assert err.decode() == (
         "fepost: error: argument --seed: must be an integer >= 0, got '-1' (see 'fepost table1 --help')\n"
     )
+
+
+@pytest.mark.parametrize(
+    ("text", "pa"),
+    [
+        ("1.38e6", 1.38e6),
+        ("1380kPa", 1.38e6),
+        ("1.38 MPa", 1.38e6),
+        ("13.8bar", 1.38e6),
+        # psi from its definition: a pound-force (0.45359237 kg x 9.80665 m/s^2) per square inch
+        ("200psi", 200 * 0.45359237 * 9.80665 / 0.0254**2),
+    ],
+)
+def test_inflation_pressure_takes_units(text, pa):
+    assert v.pressure(text) == pytest.approx(pa, rel=1e-12)
+
+
+def test_an_implausible_inflation_pressure_warns():
+    with pytest.warns(fepost.errors.OptionWarning, match="a bare number is Pa"):
+        assert v.pressure("1.38") == 1.38  # MPa meant, Pa given
+
+
+@pytest.mark.parametrize("argv", [[], ["--debug"]])
+def test_fepost_alone_prints_the_help_as_a_usage_error(capsys, argv):
+    """A bare ``fepost`` shows the whole help (on stderr, as argparse's usage errors go) and
+    exits 2 as argparse does when the required COMMAND is missing (docs/cli-exit-codes.md)."""
+    code, out, err = run(capsys, argv)
+    assert code == 2 and out == ""
+    assert err.startswith("usage: fepost ") and all(name in err for name in COMMANDS)
+    assert "exit status:" in err and "Traceback" not in err
+
+
+def test_result_objects_have_a_short_repr(small_map, tmp_path):
+    from fepost.analysis import analyse
+
+    a = analyse(small_map, small_map)
+    text = repr(a)
+    assert len(text.splitlines()) == 1 and len(text) < 400
+    assert f"N={a.coefficients.N:.6g} N" in text and f"R={a.coefficients.R:.6g} m" in text
+    assert "k_x=" in text and "array" not in text

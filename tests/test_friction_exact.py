@@ -356,7 +356,7 @@ def test_bad_law_and_quad_rejected():
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"f": -0.1}, "f must be >= 0, got -0.1"),
+        ({"f": -0.1}, "f must be a friction coefficient in [0.001, 10], got -0.1"),
         ({"anisotropy": 0.0}, "anisotropy must be > 0 (f_y/f_x), got 0.0"),
         ({"speed_coef": float("nan")}, "speed_coef must be finite, got nan"),
         ({"pressure_ref": -1.0}, "pressure_ref must be a positive finite pressure in Pa, got -1.0"),

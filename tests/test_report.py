@@ -9,6 +9,7 @@ import re
 import shutil
 import subprocess
 import sys
+import warnings
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -431,7 +432,8 @@ def test_report_bad_inflation_pressure(tmp_path, small_map, capsys):
     assert code == 2
     assert (
         capsys.readouterr().err
-        == "fepost: error: --inflation-pressure must be a positive pressure in Pa, got 0.0\n"
+        == "fepost: error: argument --inflation-pressure: must be a positive pressure up to 1 GPa, got '0' "
+        "(see 'fepost report --help')\n"
     )
     assert not out.exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["small.vtu"]
@@ -496,7 +498,7 @@ def test_report_optional_sections(tmp_path, small_map):
         return None
 
     out = tmp_path / "rep"
-    res = build_report(small_map, out=out, seed=1, sections=(nothing, extra))
+    res = build_report(small_map, out=out, seed=1, sections=(nothing, extra), inflation_pressure=200e3)
     html = (out / "report.html").read_text(encoding="utf-8")
     assert html.count("<h2") == 9  # the 8 core sections and the extra one
     assert '<h2 id="extra-section">Extra section &lt;demo&gt;</h2>' in html
@@ -619,8 +621,8 @@ def test_report_sample_sweep_section(report):
     taken from its analysis, equal to a fresh computation of that row."""
     from scipy import stats
 
+    from fepost.options import AnalysisOptions
     from fepost.sweep.jobs import Job, run_job
-    from fepost.sweep.options import RowOptions
     from fepost.sweep.table import read_table
 
     _, out, _, inputs = report
@@ -651,10 +653,57 @@ def test_report_sample_sweep_section(report):
         assert own[key] == coef[key], key
     # ... and equals the row a sweep computes for that file
     static, rolling = sample_paths()
-    job = Job(own["source"], str(static.resolve()), None, RowOptions(friction=0.3),
+    job = Job(own["source"], str(static.resolve()), None, AnalysisOptions(), friction=0.3,
               rolling=str(rolling.resolve()), rolling_given=own["rolling"])  # fmt: skip
     fresh = run_job(job)
     assert fresh["status"] == "ok", fresh["error"]
     for key in ("N", "R", "M0", "a", "m", "k_x", "aspect", "circular", "load", "case", "deflection"):
         assert own[key] == fresh[key], key
     assert "The report above is the case static_100 of this sweep." in section
+
+
+@pytest.mark.slow
+def test_report_sweep_folder_follows_the_umask(report):
+    """The report's sweep folder is as readable as the documented outputs (no 0600/0700)."""
+    from fepost.output import _umask  # noqa: PLC2701 - the test reads the process's umask
+
+    _, out, _, inputs = report
+    if inputs:
+        pytest.skip("the sample meshes are absent: no sample sweep")
+    mask = _umask()
+    entries = [out / "sweep", *sorted((out / "sweep").rglob("*"))]
+    assert any(p.name == "coefficients.parquet" for p in entries)
+    for p in entries:
+        want = (0o777 if p.is_dir() else 0o666) & ~mask
+        assert p.stat().st_mode & 0o777 == want, (p, oct(p.stat().st_mode))
+
+
+@pytest.mark.slow
+def test_report_quotes_one_model_accuracy_the_error_maps_largest(report):
+    """The recommendation's "within X %" and the coefficient table's model errors are the error
+    maps' largest errors (the densest grid the report evaluates), not the coarser check grid's."""
+    _, out, _, _ = report
+    html = (out / "report.html").read_text(encoding="utf-8")
+    worst = []
+    for stem in ("error_map", "error_map_rolling"):
+        if (out / f"{stem}.json").is_file():
+            doc = json.loads((out / f"{stem}.json").read_text())
+            worst += [doc["worst"]["model"]["force"], doc["worst"]["model"]["torque"]]
+    quoted = re.findall(r"within ([\d.]+)%", html.split('class="verdict">Which model to use', 1)[1][:600])
+    assert quoted and float(quoted[0]) == pytest.approx(100 * max(worst), abs=0.05)
+    check = json.loads((out / "coefficients.json").read_text())["model"]["static"]["accuracy"]
+    assert max(check["model_force"], check["model_torque"]) < max(worst)  # the check grid is coarser
+
+
+def test_a_map_without_inflation_pressure_warns_and_says_so(small_map):
+    from fepost.analysis import analyse
+    from fepost.errors import ReaderWarning
+    from fepost.report.build import inflation_pressure_of
+
+    a = analyse(small_map)
+    with pytest.warns(ReaderWarning, match=r"the paper's P\* = 200 kPa is assumed"):
+        p, source = inflation_pressure_of(None, a)
+    assert p == 200e3 and source.startswith("NOT GIVEN")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert inflation_pressure_of(1.38e6, a) == (1.38e6, "option")

@@ -10,7 +10,7 @@ import os
 import pytest
 
 from fepost.errors import ArgumentError, InputFileError, OutputError
-from fepost.sweep import RowOptions
+from fepost.options import AnalysisOptions, check_friction
 from fepost.sweep.inputs import expand_inputs
 from fepost.sweep.jobs import Job, run_job
 from fepost.sweep.metadata import case_metadata
@@ -31,23 +31,18 @@ def test_expand_files_folders_globs(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for name in ("runs/b.vtu", "runs/a.e", "runs/notes.txt", "runs/.hidden.vtu", "runs/sub/c.vtu", "x.vtk"):
         touch(tmp_path / name)
-    src = expand_inputs(["x.vtk", "runs", "runs/**/*.vtu", "missing.vtu", "none*.e", "empty"])
+    src = expand_inputs(["x.vtk", "runs", "runs/**/*.vtu"])
     # the folder: its FE exports by name, not the sub-folder, not hidden or other files
-    assert [s.given for s in src] == [
-        "x.vtk",
-        "runs/a.e",
-        "runs/b.vtu",
-        "runs/sub/c.vtu",
-        "missing.vtu",
-        "none*.e",
-        "empty",
-    ]
+    assert [s.given for s in src] == ["x.vtk", "runs/a.e", "runs/b.vtu", "runs/sub/c.vtu"]
     assert src[0].path == str(tmp_path / "x.vtk") and src[0].error is None
-    assert src[4].path == str(tmp_path / "missing.vtu") and src[4].error is None  # the reader names it
-    assert src[5].path is None and src[5].error == "none*.e: no FE export matches this pattern"
-    assert src[6].path == str(tmp_path / "empty") and src[6].error is None  # no magic: a missing file
+    # an input naming nothing is a usage error, not a row
+    with pytest.raises(ArgumentError, match="^missing.vtu: no such file or folder$"):
+        expand_inputs(["x.vtk", "missing.vtu"])
+    with pytest.raises(ArgumentError, match=r"^none\*.e: no FE export matches this pattern$"):
+        expand_inputs(["none*.e"])
     (tmp_path / "empty").mkdir()
-    assert expand_inputs(["empty"])[0].error.startswith("empty: folder holds no FE exports")
+    with pytest.raises(ArgumentError, match="^empty: folder holds no FE exports"):
+        expand_inputs(["empty"])
     # one file reached twice is one source, at its first place
     assert [s.given for s in expand_inputs(["runs/b.vtu", "runs", "./runs/b.vtu"])] == [
         "runs/b.vtu",
@@ -223,17 +218,21 @@ def test_table_csv_round_trip_and_types(tmp_path):
 
 
 def test_error_job_and_one_line_messages():
-    job = Job("x*.vtu", None, None, RowOptions(), error="x*.vtu: no FE export\nmatches  this")
+    job = Job("x*.vtu", None, None, AnalysisOptions(), error="x*.vtu: no FE export\nmatches  this")
     row = run_job(job)
     assert row["status"] == "error" and row["error"] == "x*.vtu: no FE export matches this"
 
 
 def test_row_identity_follows_inputs_and_options(tmp_path):
     f = touch(tmp_path / "a.vtu")
-    base = Job("a.vtu", str(f), None, RowOptions())
-    assert base.key() == Job("a.vtu", str(f), None, RowOptions()).key()
-    assert base.key() != Job("a.vtu", str(f), 2, RowOptions()).key()
-    assert base.key() != Job("a.vtu", str(f), None, RowOptions(friction=0.5)).key()
+    base = Job("a.vtu", str(f), None, AnalysisOptions())
+    assert base.key() == Job("a.vtu", str(f), None, AnalysisOptions()).key()
+    assert base.key() != Job("a.vtu", str(f), 2, AnalysisOptions()).key()
+    assert base.key() != Job("a.vtu", str(f), None, AnalysisOptions(), friction=0.5).key()
+    assert base.key() != Job("a.vtu", str(f), None, AnalysisOptions(units="mm-N-MPa")).key()
+    assert base.key() != Job("a.vtu", str(f), None, AnalysisOptions(allow_load_mismatch=True)).key()
+    # the options' step is the job's business: it does not make another row
+    assert base.key() == Job("a.vtu", str(f), None, AnalysisOptions(step=3)).key()
     before = base.key()
     os.utime(f, ns=(1, 1))
     assert base.key() != before  # the file changed
@@ -245,10 +244,19 @@ def test_row_identity_follows_inputs_and_options(tmp_path):
     assert base.key() != with_side  # the sidecar changed
 
 
-def test_row_options_validated():
-    for kw in ({"friction": 0}, {"friction": math.nan}, {"friction": True}, {"rule": "simpson"}, {"nr": 0}):
+def test_analysis_options_validated():
+    bad = (
+        {"rule": "simpson"}, {"nr": 1}, {"threshold": 1.5}, {"units": "furlongs"}, {"field": ""},
+        {"rolling_axis": (0, 0, 0)}, {"rolling_axis": (1, 2)}, {"allow_load_mismatch": "yes"},
+        {"inflation_pressure": -1.0}, {"inflation_pressure": math.inf}, {"step": 1.5},
+    )  # fmt: skip
+    for kw in bad:
         with pytest.raises(ArgumentError):
-            RowOptions(**kw)
+            AnalysisOptions(**kw)
+    for f in (0, math.nan, True, 11.0, "0.3"):
+        with pytest.raises(ArgumentError, match=r"friction coefficient in \[0.001, 10\]"):
+            check_friction(f)
+    assert check_friction(0.001) == 0.001 and check_friction(10) == 10.0
 
 
 def test_work_folder_lock_and_refusals(tmp_path):
@@ -289,41 +297,35 @@ def test_progress_bar_draws_only_when_asked():
     assert quiet.getvalue() == ""
 
 
-def test_row_options_follow_the_single_file_kwargs():
-    """Every keyword the single-file commands pass to ``analyse`` reaches the rows, new ones included."""
+def test_the_single_file_options_reach_the_rows():
+    """``AnalysisOptions.make`` takes the keyword arguments ``analyse`` takes; every one reaches
+    the rows and their identity."""
     from fepost.polar import PolarGrid
 
     kwargs = {
         "field": "CPRESS:0",
-        "step": 4,  # the sweep's own business
         "displacement": None,
         "grid": PolarGrid.make(16, 32, "trapezoid"),
         "threshold": 1e-4,
         "rolling_axis": (0.0, 1.0, 0.0),
-        "units": "mm-N-MPa",  # a reading option the sweep does not know by name
-    }
-    o = RowOptions.from_analysis_kwargs(kwargs, friction=0.4)
-    got = o.analyse_kwargs()
-    assert got.pop("grid").shape == (16, 32)
-    assert got == {
-        "friction": 0.4,
-        "field": "CPRESS:0",
-        "displacement": None,
-        "threshold": 1e-4,
-        "rolling_axis": (0.0, 1.0, 0.0),
         "units": "mm-N-MPa",
     }
-    assert o.to_dict()["extra"] == {"units": "mm-N-MPa"}
-    assert (
-        Job("a", "/a", None, o).key()
-        != Job(
-            "a", "/a", None, RowOptions.from_analysis_kwargs({**kwargs, "units": "SI"}, friction=0.4)
-        ).key()
-    )
-    # an option left at None (its default) keys the same row as an option not given
-    assert RowOptions(extra=(("surface", None),)).key_dict() == RowOptions().key_dict()
-    with pytest.raises(ArgumentError, match="set through its own field"):
-        RowOptions(extra=(("friction", 1.0),))
+    o = AnalysisOptions.make(**kwargs)
+    assert o.grid.shape == (16, 32) and o.grid.rule == "trapezoid"
+    assert o.reading()["units"].name == "mm-N-MPa" and o.displacement is None
+    assert o.to_dict() == {
+        "field": "CPRESS:0", "step": None, "displacement": None, "units": "mm-N-MPa", "surface": None,
+        "nr": 16, "nphi": 32, "rule": "trapezoid", "threshold": 1e-4, "rolling_axis": [0.0, 1.0, 0.0],
+        "allow_load_mismatch": False, "inflation_pressure": None,
+    }  # fmt: skip
+    assert Job("a", "/a", None, o).key() != Job("a", "/a", None, AnalysisOptions.make(o, units="SI")).key()
+    # a change to None keeps the value (a caller passing its own defaults), except displacement
+    assert AnalysisOptions.make(o, field=None) == o
+    assert AnalysisOptions.make(displacement=None).displacement is None
+    with pytest.raises(ArgumentError, match="unknown analysis option 'friction'"):
+        AnalysisOptions.make(friction=1.0)
+    assert repr(AnalysisOptions()) == "AnalysisOptions()"
+    assert repr(AnalysisOptions(units="mm-N-MPa")) == "AnalysisOptions(units='mm-N-MPa')"
 
 
 def test_workers_must_run_this_fepost():

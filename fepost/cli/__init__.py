@@ -18,6 +18,7 @@ turns them into errors, so each one is a defect to fix where it arises).
 from __future__ import annotations
 
 import argparse
+import difflib
 import os
 import signal
 import sys
@@ -237,13 +238,46 @@ def _internal(exc: BaseException) -> int:
     return INTERNAL
 
 
+def _subparser(parser: argparse.ArgumentParser, name: str | None) -> argparse.ArgumentParser | None:
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction) and name in action.choices:
+            return action.choices[name]
+    return None
+
+
+def _suggest(word: str, choices: Sequence[str]) -> str:
+    """`` (did you mean X?)`` for the closest of ``choices`` (difflib), or nothing."""
+    close = difflib.get_close_matches(word, choices, n=1, cutoff=0.6)
+    return f" (did you mean {close[0]}?)" if close else ""
+
+
+def _parse(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Namespace:
+    """Parse ``argv``; an unknown option or command is a `UsageError` naming the nearest
+    known one and the subcommand's help."""
+    command = next((a for a in argv if not a.startswith("-")), None)
+    if command is not None and command not in COMMANDS:
+        raise UsageError(f"unknown command {command!r}{_suggest(command, COMMANDS)} (see 'fepost --help')")
+    args, extra = parser.parse_known_args(argv)
+    if extra:
+        sub = _subparser(parser, getattr(args, "command", None)) or parser
+        options = [o for a in sub._actions for o in a.option_strings]
+        unknown = next((a for a in extra if a.startswith("-")), extra[0])
+        name = unknown.split("=", 1)[0]
+        hint = _suggest(name, options) if name.startswith("-") else ""
+        raise UsageError(f"unrecognized argument {unknown!r}{hint} (see '{sub.prog} --help')")
+    return args
+
+
 def _run(argv: list[str], run: _Run) -> int:
     from ._validate import check_grid, check_outputs, check_strings, resolve_defaults
 
     run.debug = "--debug" in argv[: next((i for i, a in enumerate(argv) if a in COMMANDS), len(argv))]
     try:
         parser = build_parser()
-        args = parser.parse_args(argv)
+        if not [a for a in argv if a != "--debug"]:  # a bare `fepost`: the help, as a usage error
+            parser.print_help(sys.stderr)
+            return BAD_INPUT
+        args = _parse(parser, argv)
         resolve_defaults(args)
         check_strings(parser, args)
         check_grid(args)

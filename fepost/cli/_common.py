@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..errors import ArgumentError
+from ..options import DEFAULT_FRICTION, FRICTION_RANGE, AnalysisOptions
 from ..reader.units import SYSTEMS  # a light module: no numpy
 from . import _validate as v
 
@@ -24,8 +25,14 @@ def sample_mesh(name: str) -> Path:
 
 
 def add_friction_option(p: argparse.ArgumentParser, what: str = "friction coefficient f") -> None:
-    """``--friction F`` (default 0.3), shared by every command that needs f."""
-    p.add_argument("--friction", type=v.friction, default=0.3, metavar="F", help=f"{what} (default 0.3)")
+    """``--friction F`` (default `fepost.options.DEFAULT_FRICTION`), for every command that needs f."""
+    p.add_argument(
+        "--friction",
+        type=v.friction,
+        default=DEFAULT_FRICTION,
+        metavar="F",
+        help=f"{what} in [{FRICTION_RANGE[0]:g}, {FRICTION_RANGE[1]:g}] (default {DEFAULT_FRICTION:g})",
+    )
 
 
 def add_input_options(p: argparse.ArgumentParser) -> None:
@@ -52,7 +59,18 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
         help="take the contact faces from this Exodus side set or element block (name or id)",
     )
     g.add_argument("--rolling-axis", metavar="X,Y,Z", help="global rolling direction (default 1,0,0)")
-    g.add_argument("--threshold", type=v.fraction, default=1e-6, help="loaded if pressure > THRESHOLD x peak")
+    g.add_argument(
+        "--allow-load-mismatch",
+        action="store_true",
+        help="accept a rolling map whose load differs from the static map's by more than 3 %% "
+        "(recorded in the outputs; k_x then mixes two loads)",
+    )
+    g.add_argument(
+        "--threshold",
+        type=v.fraction,
+        default=v.LibraryDefault("fepost.patch", "DEFAULT_THRESHOLD"),
+        help="loaded if pressure > THRESHOLD x peak (default %(default)s)",
+    )
     g.add_argument(
         "--nr",
         type=v.radial_nodes,
@@ -68,10 +86,9 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--rule", choices=("gauss", "trapezoid"), default="gauss", help="radial quadrature rule")
 
 
-def analysis_kwargs(args: argparse.Namespace) -> dict:
-    from ..polar import PolarGrid
-    from ..reader.units import unit_system
-
+def analysis_options(args: argparse.Namespace) -> AnalysisOptions:
+    """The `AnalysisOptions` of a command's reading, grid and pairing options (validated:
+    an unknown unit system or a bad rolling axis fails here, before any file is read)."""
     axis = None
     if args.rolling_axis:
         try:
@@ -83,13 +100,17 @@ def analysis_kwargs(args: argparse.Namespace) -> dict:
         if len(axis) != 3:
             raise ArgumentError(f"--rolling-axis must be three numbers X,Y,Z, got {args.rolling_axis!r}")
     disp = None if str(args.displacement).lower() == "none" else args.displacement
-    return {
-        "field": args.field,
-        "step": args.step,
-        "displacement": disp,
-        "grid": PolarGrid.make(args.nr, args.nphi, args.rule),
-        "threshold": args.threshold,
-        "rolling_axis": axis,
-        "units": unit_system(args.units),  # an unknown name fails here, before any file is read
-        "surface": args.surface,
-    }
+    return AnalysisOptions(
+        field=args.field,
+        step=args.step,
+        displacement=disp,
+        units=args.units,
+        surface=args.surface,
+        nr=args.nr,
+        nphi=args.nphi,
+        rule=args.rule,
+        threshold=args.threshold,
+        rolling_axis=axis,  # type: ignore[arg-type]
+        allow_load_mismatch=bool(args.allow_load_mismatch),
+        inflation_pressure=getattr(args, "inflation_pressure", None),
+    )

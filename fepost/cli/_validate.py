@@ -9,11 +9,15 @@ implausible are accepted with an :class:`~fepost.errors.OptionWarning`.
 The ranges (documented in ``docs/cli-exit-codes.md`` and each option's help):
 
 ================  ======================================================
-``--friction``    a number in [0.001, 10] (:data:`FRICTION_RANGE`); above
+``--friction``    a number in [0.001, 10] (`fepost.options.FRICTION_RANGE`); above
                   :data:`FRICTION_PLAUSIBLE` (1.5) accepted with a warning:
                   tire rubber on a road reaches about 1.2 (dry asphalt)
 ``--threshold``   a number strictly between 0 and 1 (fraction of the peak)
 ``--seed``        an integer >= 0 (numpy's generators take no negative seed)
+``--inflation-pressure``  a pressure with an optional unit (``1.38e6``,
+                  ``1380kPa``, ``1.38 MPa``, ``13.8bar``, ``200psi``; no
+                  unit: Pa) in (0, 1 GPa]; outside [10 kPa, 10 MPa]
+                  accepted with a warning (:func:`pressure`)
 ``--nr``          an integer in [2, 4096]; ``--nphi`` in [4, 16384]; and
                   the grid must fit in memory (:func:`check_grid`)
 table1            ``--span`` in (0, 100], ``--k-x`` in [-10, 10],
@@ -44,9 +48,6 @@ from ..errors import OptionWarning
 #: Above this friction coefficient ``--friction`` warns (accepted: rubber on
 #: glass or on a clean dry surface can reach 2-3, so it is not refused).
 FRICTION_PLAUSIBLE = 1.5
-#: ``--friction`` outside this range is refused: not a friction coefficient of a
-#: tire (ice is about 0.05), and the friction curves over- or underflow beyond it.
-FRICTION_RANGE = (0.001, 10.0)
 #: Largest grid sizes accepted per option (a million-node FE patch is resolved
 #: by 256 x 512; the default is 64 x 128).
 NR_MAX = 4096
@@ -77,15 +78,19 @@ def _integer(text: str) -> int:
 
 
 def friction(text: str) -> float:
-    """Friction coefficient f in :data:`FRICTION_RANGE`; a warning above :data:`FRICTION_PLAUSIBLE`."""
+    """Friction coefficient f by the one rule, `fepost.options.check_friction`; a warning
+    above :data:`FRICTION_PLAUSIBLE`."""
+    from ..errors import ArgumentError
+    from ..options import FRICTION_RANGE, check_friction
+
     f = _number(text)
-    lo, hi = FRICTION_RANGE
-    if not (math.isfinite(f) and f > 0):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {_text(text)}")
-    if not lo <= f <= hi:
+    try:
+        check_friction(f)
+    except ArgumentError:
+        lo, hi = FRICTION_RANGE
         raise argparse.ArgumentTypeError(
             f"must be a friction coefficient in [{lo:g}, {hi:g}], got {_text(text)}"
-        )
+        ) from None
     if f > FRICTION_PLAUSIBLE:
         warnings.warn(
             f"--friction {f:g} is above {FRICTION_PLAUSIBLE:g}, implausible for a tire on a road "
@@ -94,6 +99,41 @@ def friction(text: str) -> float:
             stacklevel=2,
         )
     return f
+
+
+#: Units ``--inflation-pressure`` accepts, in Pa.
+PRESSURE_UNITS = {"pa": 1.0, "kpa": 1e3, "mpa": 1e6, "gpa": 1e9, "bar": 1e5, "psi": 6894.757293168361}
+#: Inflation pressures of real tires: a bicycle's 0.1 MPa ... an aircraft's 1.4-2 MPa.
+PRESSURE_PLAUSIBLE = (1e4, 1e7)
+
+
+def pressure(text: str) -> float:
+    """An inflation pressure in Pa, from a number and an optional unit of :data:`PRESSURE_UNITS`."""
+    raw = str(text).strip()
+    number = raw.rstrip("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ").strip()
+    unit = raw[len(raw.rstrip("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ")) :].lower()
+    if unit and unit not in PRESSURE_UNITS:
+        names = ", ".join(k if k != "pa" else "Pa" for k in PRESSURE_UNITS)
+        raise argparse.ArgumentTypeError(f"unknown pressure unit {unit!r} in {_text(text)} (use {names})")
+    try:
+        p = float(number) * PRESSURE_UNITS[unit or "pa"]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"not a pressure: {_text(text)} (e.g. 1.38e6, 1380kPa, 13.8bar)"
+        ) from None
+    from ..options import PRESSURE_MAX
+
+    if not (math.isfinite(p) and 0.0 < p <= PRESSURE_MAX):
+        raise argparse.ArgumentTypeError(f"must be a positive pressure up to 1 GPa, got {_text(text)}")
+    lo, hi = PRESSURE_PLAUSIBLE
+    if not lo <= p <= hi:
+        warnings.warn(
+            f"--inflation-pressure {p:g} Pa is outside {lo:g}-{hi:g} Pa, implausible for a tire "
+            "(a unit missing? a bare number is Pa); going on with it",
+            OptionWarning,
+            stacklevel=2,
+        )
+    return p
 
 
 def fraction(text: str) -> float:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from ._common import add_friction_option, add_input_options, analysis_kwargs
+from ._common import add_friction_option, add_input_options, analysis_options
 
 if TYPE_CHECKING:
     from ..analysis import Analysis
@@ -31,6 +31,20 @@ def add_parser(sub) -> None:
 def _pct(x: float) -> str:
     """A signed percentage without a negative zero."""
     return f"{(x if abs(x) >= 5e-5 else 0.0):+.2%}"
+
+
+def _rolling_load(a: Analysis) -> str:
+    """The rolling map's load beside the static one, and whether a mismatch was allowed."""
+    from ..analysis import LOAD_TOL
+
+    rp, c = a.rolling_patch, a.coefficients
+    assert rp is not None and c.N_rolling is not None
+    ratio = rp.N_fe / a.static_patch.N_fe
+    text = f"{c.N_rolling:.6g} N  (N_fe {rp.N_fe:.6g} N, {_pct(ratio - 1)} vs the static N_fe"
+    if abs(ratio - 1) > LOAD_TOL:
+        return text + f"; beyond {LOAD_TOL:.0%}, ALLOWED by --allow-load-mismatch)"
+    allowed = ", --allow-load-mismatch given" if a.load_mismatch_allowed else ""
+    return text + f"; within {LOAD_TOL:.0%}{allowed})"
 
 
 def format_analysis(a: Analysis) -> str:
@@ -74,6 +88,7 @@ def format_analysis(a: Analysis) -> str:
     if c.k_x is not None and a.rolling_field is not None:
         rows += [
             ("rolling map", f"{a.rolling_field.source}"),
+            ("rolling normal load N", _rolling_load(a)),
             ("x_c (rolling CoP shift)", f"{c.x_c:.6g} m"),
             ("k_x", f"{c.k_x:.6g}"),
         ]
@@ -86,23 +101,18 @@ def format_analysis(a: Analysis) -> str:
     return "\n".join(lines)
 
 
-#: The options of :func:`fepost.reader.start_reading` among :func:`analysis_kwargs`.
-READING = ("field", "step", "displacement", "units", "surface")
-
-
 def run(args: argparse.Namespace) -> int:
     from ..reader import start_reading
 
-    kwargs = analysis_kwargs(args)
-    reading = {k: kwargs[k] for k in READING}
+    options = analysis_options(args)
     # the files are read in their children while the pipeline's modules are imported
-    pending = [start_reading(args.static, **reading)]
+    pending = [start_reading(args.static, **options.reading())]
     try:
         if args.rolling:
-            pending.append(start_reading(args.rolling, **reading))
+            pending.append(start_reading(args.rolling, **options.reading()))
         from ..analysis import analyse
 
-        result = analyse(*pending, friction=args.friction, **kwargs)
+        result = analyse(*pending, friction=args.friction, options=options)
     finally:
         for p in pending:
             p.cancel()

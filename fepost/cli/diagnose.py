@@ -18,7 +18,7 @@ from pathlib import Path
 from ..diagnose.causenames import CAUSES  # a light module: no numpy
 from ..errors import ArgumentError, OutputError
 from . import _validate as v
-from ._common import add_friction_option, add_input_options, analysis_kwargs
+from ._common import add_friction_option, add_input_options, analysis_options
 
 
 def add_parser(sub) -> None:
@@ -111,7 +111,7 @@ def _make_example(args: argparse.Namespace) -> int:
         seed=seed,
         friction=args.friction,
         rolling=args.rolling,
-        analyse_kwargs=analysis_kwargs(args),
+        analyse_kwargs={"options": analysis_options(args)},
     )
     print(
         f"written: {target} ({len(syn.data)} test points, hidden cause {args.cause}, seed {seed}; "
@@ -121,8 +121,6 @@ def _make_example(args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    if not args.friction > 0:
-        raise ArgumentError(f"--friction must be positive, got {args.friction!r}")
     if args.seed is not None and args.seed < 0:
         raise ArgumentError(f"--seed must be a non-negative integer, got {args.seed!r}")
     if args.make_example:
@@ -147,7 +145,7 @@ def run(args: argparse.Namespace) -> int:
         friction=args.friction,
         seed=0 if args.seed is None else args.seed,
         n_folds=args.folds,
-        analyse_kwargs=analysis_kwargs(args),
+        analyse_kwargs={"options": analysis_options(args)},
     )
     out = write_diagnosis(result, args.out, force=args.force)
     print(result.summary(), end="")

@@ -46,10 +46,10 @@ def run(args: argparse.Namespace) -> int:
     from ..friction.law import FrictionLaw
     from ..friction.predict import predict, read_kinematics
     from ..output import write_text_atomic
-    from ._common import analysis_kwargs
+    from ._common import analysis_options
 
     kin = read_kinematics(args.kinematics)  # bad CSV: fail before the FE work
-    result = analyse(args.static, args.rolling, friction=args.friction, **analysis_kwargs(args))
+    result = analyse(args.static, args.rolling, friction=args.friction, options=analysis_options(args))
     rolling = result.rolling_map is not None
     pmap = result.rolling_map if result.rolling_map is not None else result.static_map
     law = FrictionLaw(f=result.coefficients.f)

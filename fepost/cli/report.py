@@ -11,7 +11,7 @@ import argparse
 import sys
 
 from . import _validate as v
-from ._common import add_friction_option, add_input_options, analysis_kwargs
+from ._common import add_friction_option, add_input_options, analysis_options
 
 
 def add_parser(sub) -> None:
@@ -39,9 +39,11 @@ def add_parser(sub) -> None:
     add_friction_option(p)
     p.add_argument(
         "--inflation-pressure",
-        type=float,
+        type=v.pressure,
         metavar="P",
-        help="inflation pressure P* in Pa for sigma/P* (default: sidecar 'inflation_pressure', else 200e3)",
+        help="inflation pressure P* for sigma/P* of Figures 1-3, a number in Pa or with a unit "
+        "(1380kPa, 1.38MPa, 13.8bar, 200psi); default: the sidecar's inflation_pressure, else the "
+        "paper's 200 kPa, with a warning",
     )
     p.add_argument(
         "--seed",
@@ -71,9 +73,8 @@ def run(args: argparse.Namespace) -> int:
         args.out,
         force=args.force,
         friction=args.friction,
-        inflation_pressure=args.inflation_pressure,
         seed=args.seed,
-        analysis_kwargs=analysis_kwargs(args),
+        options=analysis_options(args),
         progress=_progress,
     )
     total = sum(t for _, t in result.timings)

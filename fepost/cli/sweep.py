@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 
 #: Error rows listed on stderr at the end of a sweep (all are in the table).
 SHOWN_ERRORS = 10
@@ -67,11 +68,11 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..errors import ArgumentError
     from ..report.sweeppage import write_trends
-    from ..sweep import RowOptions, run_sweep
+    from ..sweep import run_sweep
     from . import FAILED_INPUTS, OK, Terminated
-    from ._common import analysis_kwargs
+    from ._common import analysis_options
 
-    kwargs = analysis_kwargs(args)
+    options = analysis_options(args)
     if args.step is not None and args.steps == "all":
         raise ArgumentError("--step N picks one time step of every file; it cannot go with --steps all")
     steps = args.step if args.step is not None else (args.steps or "last")
@@ -81,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
             args.out,
             steps=steps,
             rolling_pairs=args.rolling_pairs,
-            options=RowOptions.from_analysis_kwargs(kwargs, friction=args.friction),
+            options=replace(options, step=None),  # the sweep's steps are its own business
+            friction=args.friction,
             workers=args.workers,
             scheduler=args.scheduler,
             progress=False if args.no_progress else None,
@@ -99,6 +101,14 @@ def run(args: argparse.Namespace) -> int:
         f"{len(result.rows)} rows ({result.reused} from an earlier run, {result.computed} computed), "
         f"{result.errors} failed"
     )
+    for r in result.rows:
+        if r["also_as"]:
+            print(f"note: {r['source']} read; the same case also as {r['also_as']} (not read)")
+        if r["role"] == "rolling" and r["step"] in (None, 0):
+            print(
+                f"note: {r['source']} is a rolling map without its static map among the inputs: "
+                "listed apart (role rolling), not a load point of the trends"
+            )
     print(f"table: {result.csv}  {result.parquet}")
     if result.trends is not None:
         print(f"trends: {result.trends}")

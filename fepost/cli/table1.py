@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 
 from . import _validate as v
-from ._common import add_friction_option, add_input_options, analysis_kwargs
+from ._common import add_friction_option, add_input_options, analysis_options
 
 #: The committed seed of ``fepost table1`` (:data:`fepost.table1.DEFAULT_SEED`).
 SEED = v.LibraryDefault("fepost.table1", "DEFAULT_SEED")
@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
         rolling = args.rolling if args.rolling is not None else sample_rolling
     else:
         static, rolling = args.static, args.rolling
-    result = analyse(static, rolling, friction=args.friction, **analysis_kwargs(args))
+    result = analyse(static, rolling, friction=args.friction, options=analysis_options(args))
     t = table1(
         result,
         seed=args.seed,

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ArgumentError
+from ..options import DEFAULT_FRICTION, check_friction
 
 
 def store_reals(obj, names: tuple[str, ...]) -> None:
@@ -43,7 +44,7 @@ def store_reals(obj, names: tuple[str, ...]) -> None:
 class FrictionLaw:
     """Parameters of the local friction law (see the module docstring)."""
 
-    f: float = 0.3
+    f: float = DEFAULT_FRICTION
     pressure_coef: float = 0.0
     speed_coef: float = 0.0
     anisotropy: float = 1.0
@@ -51,8 +52,7 @@ class FrictionLaw:
 
     def __post_init__(self) -> None:
         store_reals(self, ("f", "pressure_coef", "speed_coef", "anisotropy"))
-        if self.f < 0:
-            raise ArgumentError(f"f must be >= 0, got {self.f!r}")
+        check_friction(self.f, name="f")  # the one rule of fepost.options
         if self.anisotropy <= 0:
             raise ArgumentError(f"anisotropy must be > 0 (f_y/f_x), got {self.anisotropy!r}")
         ref = self.pressure_ref

@@ -17,6 +17,7 @@ whole kinematic sphere (the data of the report's error maps).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -116,9 +117,10 @@ class ModelSummary:
     aspect: float
     paper: dict
 
-    def recommendation(self) -> str:
-        """Which model to use, in one sentence, from the patch shape and the measured errors."""
-        acc = self.static.accuracy
+    def recommendation(self, accuracy: Mapping[str, Any] | None = None) -> str:
+        """Which model to use, in one sentence, from the patch shape and the measured errors
+        (``accuracy``: errors measured on a denser grid, keys as the model's ``accuracy``)."""
+        acc = self.static.accuracy if accuracy is None else accuracy
         paper = max(acc["compare_force"], acc["compare_torque"])
         model = max(acc["model_force"], acc["model_torque"])
         if not self.circular:

@@ -216,6 +216,7 @@ _FIGURES = {
 COEFFICIENT_ROWS = (
     ("N", "N", "force", "∬ σ dA on the polar grid"),
     ("N_fe", "N_fe", "force", "exact integral of the FE pressure over the FE faces"),
+    ("N_rolling", "N (rolling)", "force", "∬ σ dA of the rolling map: its load, within 3 % of N"),
     (
         "R",
         "R",
@@ -418,10 +419,16 @@ def page_context(
             "field": a.static_field.field,
             "location": p.location,
             "faces": len(p.triangles),
+            "load": coef["N"],
         },
         "rolling": None
         if a.rolling_field is None
-        else {"source": a.rolling_field.source, "field": a.rolling_field.field},
+        else {
+            "source": a.rolling_field.source,
+            "field": a.rolling_field.field,
+            "load": coef.get("N_rolling"),
+            "mismatch_allowed": coef["rolling"]["load_mismatch_allowed"],
+        },
         "friction": a.coefficients.f,
         "p_star": p_star,
         "p_star_source": p_star_source,

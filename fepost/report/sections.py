@@ -23,6 +23,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
+from ..options import AnalysisOptions
+
 if TYPE_CHECKING:
     from ..analysis import Analysis
     from ..table1 import Table1
@@ -34,9 +36,9 @@ if TYPE_CHECKING:
 class ReportData:
     """What a section provider may look at: the report's results, never recomputed.
 
-    ``analysis_kwargs``: the reading and grid options the report passed to
-    :func:`fepost.analysis.analyse` (read-only), so a provider that analyses
-    further files can use the same ones.
+    ``options``: the `fepost.options.AnalysisOptions` the report passed to
+    `fepost.analysis.analyse`, so a provider that analyses further files can use
+    the same ones.
     """
 
     analysis: Analysis
@@ -45,10 +47,7 @@ class ReportData:
     inflation_pressure: float
     seed: int | None
     friction: float
-    analysis_kwargs: Mapping[str, Any] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "analysis_kwargs", MappingProxyType(dict(self.analysis_kwargs)))
+    options: AnalysisOptions = field(default_factory=AnalysisOptions)
 
 
 @dataclass(frozen=True)

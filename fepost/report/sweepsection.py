@@ -91,8 +91,10 @@ def _same_file(a, b) -> bool:
         return False
 
 
-def _analysis_kwargs(data) -> dict:
-    return dict(getattr(data, "analysis_kwargs", None) or {})
+def _options(data):
+    from ..options import AnalysisOptions
+
+    return getattr(data, "options", None) or AnalysisOptions()
 
 
 def _report_case(data: ReportData, pairings) -> tuple[int | None, bool]:
@@ -104,7 +106,7 @@ def _report_case(data: ReportData, pairings) -> tuple[int | None, bool]:
     for i, pr in enumerate(pairings):
         if pr.static.path is not None and _same_file(a.static_field.source, pr.static.path):
             rolling = None if a.rolling_field is None else a.rolling_field.source
-            same = _same_file(rolling, pr.rolling) and _analysis_kwargs(data).get("step") is None
+            same = _same_file(rolling, pr.rolling) and _options(data).step is None
             return i, same
     return None, False
 
@@ -124,7 +126,7 @@ def sweep_provider(
     ``only_with_report_case`` also when the report's static map is not one of the
     inputs (a report of other files). The report's own case, when it is a row, is
     taken from the report's analysis (module docstring). ``data`` needs
-    ``friction``; ``analysis`` and ``analysis_kwargs`` are used when present.
+    ``friction``; ``analysis`` and ``options`` are used when present.
     """
 
     def provider(data: ReportData, folder: Path) -> Section | None:
@@ -146,7 +148,6 @@ def sweep_provider(
         if only_with_report_case and own is None:
             return None  # decided before the sweep's heavier imports (Dask, pyarrow)
         from ..sweep.jobs import Job, analysis_row
-        from ..sweep.options import RowOptions
         from ..sweep.run import run_sweep
         from ..sweep.store import WORK, WorkFolder
         from ..sweep.trends import load_trends
@@ -154,12 +155,13 @@ def sweep_provider(
         from .sections import Section
         from .sweeppage import draw_figures
 
-        options = RowOptions.from_analysis_kwargs(_analysis_kwargs(data), friction=float(data.friction))
+        options, friction = _options(data), float(data.friction)
         out = Path(folder) / FOLDER
         if own is not None and same:
             pr = pairings[own]
             job = Job(pr.static.given, pr.static.path, None, options, rolling=pr.rolling,
-                      rolling_given=pr.rolling_given)  # fmt: skip
+                      rolling_given=pr.rolling_given, role=pr.role, also=pr.static.also + pr.rolling_also,
+                      friction=friction)  # fmt: skip
             with WorkFolder(out, force=True) as work:
                 work.save_row(job.key(), analysis_row(job, data.analysis))
         result = run_sweep(
@@ -167,6 +169,7 @@ def sweep_provider(
             out,
             rolling_pairs=pairs,
             options=options,
+            friction=friction,
             workers=1,
             processes=False,
             progress=False,

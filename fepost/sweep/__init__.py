@@ -14,7 +14,6 @@ Modules, one job each:
 * :mod:`.pairs` – ``--rolling-pairs``: naming rule or CSV of static/rolling pairs
 * :mod:`.steps` – which time steps an export holds
 * :mod:`.metadata` – case metadata from a sidecar ``<case>.json``
-* :mod:`.options` – the analysis options of every row
 * :mod:`.jobs` – one row: its identity and the function a worker runs
 * :mod:`.store` – the work folder that makes a sweep resumable
 * :mod:`.engine` – the Dask client (embedded local cluster or an existing one)
@@ -31,7 +30,6 @@ its HTML section) and ``fepost.report.sweepsection`` (the sweep as an optional
 section of ``fepost report``).
 """
 
-from .options import RowOptions
 from .run import SweepResult, run_sweep
 from .table import COLUMNS, read_table
 from .trends import PowerLaw, fit_power_law, load_trends
@@ -39,7 +37,6 @@ from .trends import PowerLaw, fit_power_law, load_trends
 __all__ = [
     "COLUMNS",
     "PowerLaw",
-    "RowOptions",
     "SweepResult",
     "fit_power_law",
     "load_trends",

@@ -1,9 +1,9 @@
 """The sweep's inputs: files, folders and globs expanded into FE exports.
 
 Every INPUT yields at least one :class:`Source`. An input that names nothing
-(a missing file, a glob without matches, a folder without FE exports) is a
-:class:`Source` with an ``error``: it becomes one error row of the table, so a
-typo is reported beside the results rather than silently dropped.
+(a missing file or folder, a glob without matches, a folder without FE exports)
+is a usage error (`ArgumentError`, exit status 2), raised before anything is
+written: a typo never leaves an output folder behind.
 
 * a file: itself, whatever its suffix (the reader names an unknown format);
 * a folder: the FE exports directly inside it (by suffix, sorted by name;
@@ -12,6 +12,13 @@ typo is reported beside the results rather than silently dropped.
   matches, sorted.
 
 A file reached twice (the same resolved path) is kept once, at its first place.
+
+One case written in several formats (files of one folder with the same stem,
+``static_100.vtu`` and ``static_100.e``) is one source: the file whose suffix
+comes first in :data:`PREFERENCE` is read, the others are noted in its
+``also`` (the table's ``also_as`` column). Exodus comes first because it holds
+every time step (``--steps all``) and the side sets; then VTK XML, then legacy
+VTK, then any other format in the reader's order.
 """
 
 from __future__ import annotations
@@ -19,10 +26,14 @@ from __future__ import annotations
 import glob
 import os
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
+from ..errors import ArgumentError
+
 _MAGIC = ("*", "?", "[")
+#: Suffixes in the order a case written in several formats is read (the first present wins).
+PREFERENCE = (".e", ".exo", ".ex2", ".exii", ".vtu", ".vtp", ".vtk")
 
 
 @dataclass(frozen=True)
@@ -38,11 +49,15 @@ class Source:
         Absolute path read by the workers; None when ``error`` is set.
     error : str or None
         One-line reason why the input gives no file.
+    also : tuple of str
+        Other files of the same case (same folder and stem, other formats),
+        as given; they are not read.
     """
 
     given: str
     path: str | None
     error: str | None = None
+    also: tuple[str, ...] = ()
 
 
 def fe_suffixes() -> tuple[str, ...]:
@@ -61,21 +76,63 @@ def _expand_one(given: str, suffixes: tuple[str, ...]) -> list[Source]:
     if p.is_dir():
         found = sorted(c for c in p.iterdir() if _is_export(c, suffixes))
         if not found:
-            return [Source(given, None, f"{given}: folder holds no FE exports ({' '.join(suffixes)})")]
+            raise ArgumentError(f"{given}: folder holds no FE exports ({' '.join(suffixes)})")
         return [Source(os.path.join(given, c.name), str(c.resolve())) for c in found]
-    if p.exists() or not any(ch in given for ch in _MAGIC):
+    if p.exists():
         return [Source(given, str(p.resolve()))]
+    if not any(ch in given for ch in _MAGIC):
+        raise ArgumentError(f"{given}: no such file or folder")
     hits = sorted(h for h in glob.glob(given, recursive=True) if _is_export(Path(h), suffixes))
     if not hits:
-        return [Source(given, None, f"{given}: no FE export matches this pattern")]
+        raise ArgumentError(f"{given}: no FE export matches this pattern")
     return [Source(h, str(Path(h).resolve())) for h in hits]
 
 
-def expand_inputs(inputs: Iterable[str | os.PathLike]) -> list[Source]:
-    """Expand files, folders and globs into :class:`Source` items, in the order given.
+def _rank(path: str) -> tuple[int, int]:
+    """Sort key of a format: :data:`PREFERENCE` first, then the reader's order."""
+    suffix = Path(path).suffix.lower()
+    if suffix in PREFERENCE:
+        return (0, PREFERENCE.index(suffix))
+    known = fe_suffixes()
+    return (1, known.index(suffix) if suffix in known else len(known))
 
-    A missing plain file is kept as a source (its row reports "no such file"
-    from the reader, like ``fepost coefficients`` would).
+
+def one_per_case(sources: Iterable[Source]) -> list[Source]:
+    """One source per case: files of one folder with the same stem are one case.
+
+    The preferred format (:data:`PREFERENCE`) is kept, at the place of the
+    case's first file; the others are listed in its ``also``.
+    """
+    sources = list(sources)
+    cases: dict[tuple[str, str], list[Source]] = {}
+    for src in sources:
+        if src.path is not None:
+            p = Path(src.path)
+            cases.setdefault((str(p.parent), p.stem), []).append(src)
+    out: list[Source] = []
+    placed: set[tuple[str, str]] = set()
+    for src in sources:
+        if src.path is None:
+            out.append(src)
+            continue
+        case = (str(Path(src.path).parent), Path(src.path).stem)
+        if case in placed:
+            continue
+        placed.add(case)
+        members = sorted(cases[case], key=lambda s: _rank(s.path or ""))
+        best = members[0]
+        out.append(replace(best, also=tuple(m.given for m in members[1:])))
+    return out
+
+
+def expand_inputs(inputs: Iterable[str | os.PathLike]) -> list[Source]:
+    """Expand files, folders and globs into :class:`Source` items, in the order given,
+    one per case (:func:`one_per_case`).
+
+    Raises
+    ------
+    ArgumentError
+        An input names no file: missing, a glob without matches, a folder without exports.
     """
     suffixes = fe_suffixes()
     seen: set[str] = set()
@@ -87,4 +144,4 @@ def expand_inputs(inputs: Iterable[str | os.PathLike]) -> list[Source]:
                     continue
                 seen.add(src.path)
             out.append(src)
-    return out
+    return one_per_case(out)

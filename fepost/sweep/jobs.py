@@ -15,11 +15,11 @@ import json
 import os
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..errors import ArgumentError, FepostError, FepostWarning
+from ..options import DEFAULT_FRICTION, AnalysisOptions
 from .metadata import case_metadata, sidecar_path
-from .options import RowOptions
 from .table import coefficient_columns, one_line
 
 
@@ -48,21 +48,31 @@ class Job:
         Time step to read; None: the file's last step (or a file without steps).
     time : float or None
         Time value of ``step`` when listed.
-    options : RowOptions
-        Keyword arguments of the analysis.
+    options : AnalysisOptions
+        How the row is analysed (its ``step`` is replaced by the job's).
+    friction : float
+        Friction coefficient f.
     error : str or None
         Set when the row fails before any analysis (input names no file, its
         time steps cannot be listed): the row is this error.
+    role : str
+        ``"static"`` (a load point) or ``"rolling"`` (an unpaired rolling map,
+        listed apart and left out of the load trends).
+    also : tuple of str
+        Other files of the same case (other formats), not read.
     """
 
     source: str
     path: str | None
     step: int | None
-    options: RowOptions
+    options: AnalysisOptions
     rolling: str | None = None
     rolling_given: str | None = None
     time: float | None = None
     error: str | None = None
+    role: str = "static"
+    also: tuple[str, ...] = ()
+    friction: float = DEFAULT_FRICTION
 
     def key(self) -> str:
         """Identity of the row: inputs, their size and modification time, step and options."""
@@ -70,11 +80,13 @@ class Job:
             self.path or self.source,
             self.step,
             self.rolling,
-            self.options.key_dict(),
+            {**self.options.to_dict(), "step": None, "friction": self.friction},
             _stamp(self.path),
             _stamp(self.rolling),
             _stamp(None if self.path is None else str(sidecar_path(self.path))),
             self.error,
+            self.role,
+            list(self.also),
         ]
         return hashlib.sha1(json.dumps(ident, sort_keys=True).encode()).hexdigest()
 
@@ -84,6 +96,8 @@ class Job:
             "rolling": self.rolling_given or "",
             "step": self.step,
             "time": self.time,
+            "role": self.role,
+            "also_as": " ".join(self.also),
         }
 
 
@@ -131,7 +145,9 @@ def run_job(job: Job) -> dict:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FepostWarning)
         try:
-            res = analyse(path, job.rolling, step=job.step, **job.options.analyse_kwargs())
+            res = analyse(
+                path, job.rolling, friction=job.friction, options=replace(job.options, step=job.step)
+            )
             row = analysis_row(job, res)
         except FepostError as exc:
             row["status"], row["error"] = "error", one_line(str(exc))

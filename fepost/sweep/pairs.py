@@ -16,27 +16,70 @@ Two ways to say it:
 
 A rolling map that is paired with an input is not a row of its own, even when
 a folder or glob also matched it.
+
+A rolling map is never a static load point. Without ``--rolling-pairs`` (and for
+the inputs a given rule or CSV leaves unpaired), an input recognised as a
+rolling map (:func:`is_rolling_map`: ``rolling`` in its file name, or a sidecar
+with a ``rolling_standin`` block) is paired with the input named like it with
+``rolling`` replaced by ``static`` (``rolling_100.vtu`` → ``static_100.vtu``);
+without such an input it stays a row of its own with the role ``rolling``,
+listed apart and left out of the load trends.
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import ArgumentError
+from ..errors import ArgumentError, InputFileError
+from ..reader.sidecar import read_sidecar
 from .inputs import Source
+
+#: Roles of a row: a static load point, or a rolling map left unpaired.
+STATIC, ROLLING = "static", "rolling"
+_ROLLING_WORD = re.compile("rolling", re.IGNORECASE)
 
 
 @dataclass(frozen=True)
 class Pairing:
-    """A static source and its rolling map (absolute path and as written), if any."""
+    """A source and its rolling map (absolute path and as written), if any.
+
+    ``role`` is :data:`STATIC` (a load point) or :data:`ROLLING` (an unpaired
+    rolling map: a row of its own, not a load point); ``rolling_also`` the
+    rolling map's other formats, not read.
+    """
 
     static: Source
     rolling: str | None = None
     rolling_given: str | None = None
+    role: str = STATIC
+    rolling_also: tuple[str, ...] = ()
+
+
+def is_rolling_map(path: str) -> bool:
+    """Whether the export ``path`` is a rolling map: ``rolling`` in its file name, or a
+    sidecar ``<stem>.json`` with a ``rolling_standin`` block (as the shipped samples have)."""
+    if _ROLLING_WORD.search(Path(path).name):
+        return True
+    try:
+        side = read_sidecar(Path(path))
+    except InputFileError:
+        return False  # the row's own analysis reports the sidecar
+    return side is not None and "rolling_standin" in side
+
+
+def _static_name(name: str) -> str:
+    """``name`` with every ``rolling`` replaced by ``static`` in the same case."""
+
+    def swap(m: re.Match) -> str:
+        word = m.group(0)
+        return "STATIC" if word.isupper() else "Static" if word[0].isupper() else "static"
+
+    return _ROLLING_WORD.sub(swap, name)
 
 
 @dataclass(frozen=True)
@@ -122,21 +165,52 @@ def _read_pairs_csv(path: Path) -> dict[str, str]:
     return table
 
 
+def _default_partners(sources: Sequence[Source], taken: set[str]) -> dict[str, tuple[str, str]]:
+    """{static path: (rolling path, as given)} for the rolling maps among ``sources`` whose
+    static partner (``rolling`` → ``static`` in the name) is an input too."""
+    by_path = {s.path: s for s in sources if s.path is not None}
+    by_case = {(str(Path(p).parent), Path(p).stem): p for p in by_path}
+    out: dict[str, tuple[str, str]] = {}
+    for src in sources:
+        path = src.path
+        if path is None or path in taken or not is_rolling_map(path):
+            continue
+        p = Path(path)
+        static = by_case.get((str(p.parent), _static_name(p.stem)))
+        if static is not None and static != path and static not in out and static not in taken:
+            out[static] = (path, src.given)
+    return out
+
+
 def pair_sources(sources: Sequence[Source], pairs: RollingPairs | None) -> list[Pairing]:
-    """Attach rolling maps to the static sources; drop the rolling maps that were paired."""
-    if pairs is None:
-        return [Pairing(s) for s in sources]
-    found = [(s, pairs.partner(s)) for s in sources]
+    """Attach rolling maps to the static sources; drop the rolling maps that were paired;
+    mark the rolling maps left unpaired with the role :data:`ROLLING`."""
+    found = [(s, pairs.partner(s) if pairs is not None else None) for s in sources]
     partners = {p[0] for _, p in found if p is not None}
-    if pairs.rule is not None and not partners and any(s.path is not None for s in sources):
+    if (
+        pairs is not None
+        and pairs.rule is not None
+        and not partners
+        and any(s.path is not None for s in sources)
+    ):
         old, new = pairs.rule
         raise ArgumentError(
             f"--rolling-pairs {pairs.spec}: no input has a rolling partner (no file named like an "
             f"input with {old!r} replaced by {new!r})"
         )
+    paired = {s.path for s, p in found if p is not None and s.path is not None}
+    default = _default_partners(sources, partners | paired)
+    partners |= {rolling for rolling, _ in default.values()}
+    also = {s.path: s.also for s in sources if s.path is not None}
     out = []
     for src, p in found:
         if src.path is not None and src.path in partners and p is None:
             continue  # this file is another input's rolling map
-        out.append(Pairing(src, *p) if p is not None else Pairing(src))
+        p = p if p is not None else default.get(src.path or "")
+        if p is not None:
+            out.append(Pairing(src, *p, rolling_also=also.get(p[0], ())))
+        elif src.path is not None and is_rolling_map(src.path):
+            out.append(Pairing(src, role=ROLLING))
+        else:
+            out.append(Pairing(src))
     return out

@@ -30,10 +30,11 @@ from pathlib import Path
 from types import MappingProxyType
 
 from ..errors import ArgumentError
+from ..options import DEFAULT_FRICTION, AnalysisOptions, check_friction
+from ..output import umask_mode
 from .engine import Cluster, WorkerDied
 from .inputs import expand_inputs
 from .jobs import Job, run_job
-from .options import RowOptions
 from .pairs import Pairing, RollingPairs, pair_sources, parse_rolling_pairs
 from .progress import ProgressBar
 from .steps import SERIES_SUFFIXES, time_steps
@@ -70,6 +71,12 @@ class SweepResult:
     parquet: Path
     csv: Path
     trends: Path | None = None
+
+    def __repr__(self) -> str:
+        return (
+            f"SweepResult(out={str(self.out)!r}, rows={len(self.rows)}, errors={self.errors}, "
+            f"reused={self.reused}, computed={self.computed})"
+        )
 
     @property
     def errors(self) -> int:
@@ -146,11 +153,23 @@ def _listed_steps(pairings: Sequence[Pairing], work: WorkFolder, cluster: Cluste
     return listed
 
 
-def _jobs(pairings: Sequence[Pairing], steps, listed: dict, options: RowOptions) -> list[Job]:
+def _jobs(
+    pairings: Sequence[Pairing], steps, listed: dict, options: AnalysisOptions, friction: float
+) -> list[Job]:
     jobs: list[Job] = []
     for pr in pairings:
         src = pr.static
-        base = Job(src.given, src.path, None, options, rolling=pr.rolling, rolling_given=pr.rolling_given)
+        base = Job(
+            src.given,
+            src.path,
+            None,
+            options,
+            rolling=pr.rolling,
+            rolling_given=pr.rolling_given,
+            role=pr.role,
+            also=src.also + pr.rolling_also,
+            friction=friction,
+        )
         if src.error is not None or src.path is None:
             jobs.append(replace(base, error=src.error or f"{src.given}: no file"))
         elif steps != "all":
@@ -172,7 +191,8 @@ def run_sweep(
     *,
     steps: str | int = "last",
     rolling_pairs: str | RollingPairs | None = None,
-    options: RowOptions | None = None,
+    options: AnalysisOptions | None = None,
+    friction: float = DEFAULT_FRICTION,
     workers: int | None = None,
     scheduler: str | None = None,
     client=None,
@@ -198,8 +218,11 @@ def run_sweep(
         per time step of every Exodus file; an int: that step of every file.
     rolling_pairs : str or RollingPairs, optional
         ``STATIC=ROLLING`` naming rule or a CSV of pairs (:mod:`.pairs`).
-    options : RowOptions, optional
-        Analysis options of every row (default: those of ``fepost coefficients``).
+    options : AnalysisOptions, optional
+        Analysis options of every row (default: those of ``fepost coefficients``); its
+        ``step`` is replaced by each row's (see ``steps``).
+    friction : float
+        Friction coefficient f of every row.
     workers : int, optional
         Processes of the embedded local cluster (default: the usable CPU cores).
     scheduler : str, optional
@@ -230,27 +253,19 @@ def run_sweep(
     if not inputs:
         raise ArgumentError("no inputs given (files, folders or glob patterns)")
     steps = _check_steps(steps)
-    options = options or RowOptions()
+    options = options or AnalysisOptions()
+    friction = check_friction(friction)
     pairs = parse_rolling_pairs(rolling_pairs) if isinstance(rolling_pairs, str) else rolling_pairs
     cluster = Cluster(workers, scheduler, client, processes=processes)
     pairings = pair_sources(expand_inputs(inputs), pairs)
     out = Path(out)
     with WorkFolder(out, force=force, fresh=fresh) as work, cluster:
-        units = options.units
+        units = options.unit_system
         listed = _listed_steps(pairings, work, cluster, units) if steps == "all" else {}
-        jobs = _jobs(pairings, steps, listed, options)
+        jobs = _jobs(pairings, steps, listed, options, friction)
         keys = [j.key() for j in jobs]
-        rows: list[dict | None] = [None] * len(jobs)
-        todo = []
-        reused = 0
-        for i, (job, key) in enumerate(zip(jobs, keys, strict=True)):
-            if job.error is not None:
-                rows[i] = run_job(job)
-            elif (saved := work.load_row(key)) is not None and saved["status"] == "ok":
-                rows[i] = saved
-                reused += 1
-            else:
-                todo.append(i)
+        rows, todo = _saved_rows(jobs, keys, work)
+        reused = len(jobs) - len(todo) - sum(j.error is not None for j in jobs)
         bar = ProgressBar(len(todo), done=len(jobs) - len(todo), enabled=progress)
         if todo:
             _compute(cluster, jobs, keys, todo, rows, work, bar)
@@ -260,8 +275,24 @@ def run_sweep(
         page = None
         if trends is not None:
             page = trends(table, out)
+            umask_mode(out / "trends")  # drawn in a tempfile.mkdtemp folder (0700)
     frozen = tuple(MappingProxyType(r) for r in table)
     return SweepResult(out, frozen, reused, len(todo), parquet, csv, page)
+
+
+def _saved_rows(jobs: Sequence[Job], keys: Sequence[str], work: WorkFolder) -> tuple[list, list[int]]:
+    """The rows known without computing (failed jobs, rows finished by an earlier run), and
+    the indices of the jobs left to compute."""
+    rows: list[dict | None] = [None] * len(jobs)
+    todo = []
+    for i, (job, key) in enumerate(zip(jobs, keys, strict=True)):
+        if job.error is not None:
+            rows[i] = run_job(job)
+        elif (saved := work.load_row(key)) is not None and saved["status"] == "ok":
+            rows[i] = saved
+        else:
+            todo.append(i)
+    return rows, todo
 
 
 def _compute(cluster: Cluster, jobs, keys, todo, rows, work: WorkFolder, bar: ProgressBar) -> None:

@@ -15,7 +15,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..output import write_text_atomic
+from ..output import atomic_path, write_text_atomic
 
 
 @dataclass(frozen=True)
@@ -32,6 +32,10 @@ class Column:
 COLUMNS: tuple[Column, ...] = (
     Column("source", "str", "", "FE export, path as given (or as the folder/glob produced it)"),
     Column("rolling", "str", "", "rolling map paired with it, empty when none"),
+    Column(
+        "role", "str", "", "static (a load point) or rolling (an unpaired rolling map, not in the trends)"
+    ),
+    Column("also_as", "str", "", "other files of the same case (same stem, other formats), not read"),
     Column("step", "int", "", "Exodus time step read (0-based); empty for files without time steps"),
     Column("time", "float", "s", "time value of that step (the solver's time unit)"),
     Column("status", "str", "", "ok or error"),
@@ -50,6 +54,13 @@ COLUMNS: tuple[Column, ...] = (
     Column("k_x", "float", "1", "rolling pressure-shift coefficient; empty without a rolling map"),
     Column("x_c", "float", "m", "rolling centre-of-pressure shift; empty without a rolling map"),
     Column("N_fe", "float", "N", "normal load, exact integral over the FE faces"),
+    Column("N_rolling", "float", "N", "normal load of the rolling map (polar grid); empty without one"),
+    Column(
+        "load_mismatch_allowed",
+        "bool",
+        "",
+        "the rolling map's load differs from the static one's by more than 3 % and this was allowed",
+    ),
     Column("r_equiv", "float", "m", "sqrt(area/pi) of the loaded region"),
     Column("aR2", "float", "m^2", "a R^2 (independent of the choice of R)"),
     Column("m_over_R2", "float", "1/m^2", "m / R^2 (independent of the choice of R)"),
@@ -62,7 +73,9 @@ COLUMNS: tuple[Column, ...] = (
 )
 NAMES: tuple[str, ...] = tuple(c.name for c in COLUMNS)
 #: Keys copied from the top level of the coefficients JSON document.
-FROM_JSON = ("N", "R", "F0", "M0", "a", "m", "b", "b1", "f", "k_x", "x_c", "N_fe", "aR2", "m_over_R2")
+FROM_JSON = (
+    "N", "R", "F0", "M0", "a", "m", "b", "b1", "f", "k_x", "x_c", "N_fe", "N_rolling", "aR2", "m_over_R2",
+)  # fmt: skip
 #: Keys copied from its ``patch`` object.
 FROM_PATCH = ("aspect", "circular", "r_equiv")
 
@@ -72,6 +85,10 @@ def coefficient_columns(doc: Mapping) -> dict:
     row = {k: doc.get(k) for k in FROM_JSON}
     patch = doc.get("patch") or {}
     row.update({k: patch.get(k) for k in FROM_PATCH})
+    rolling = doc.get("rolling") or {}
+    ratio = rolling.get("load_ratio")
+    beyond = ratio is not None and abs(ratio - 1.0) > rolling.get("load_tolerance", 0.0)
+    row["load_mismatch_allowed"] = bool(beyond and rolling.get("load_mismatch_allowed")) if rolling else None
     return row
 
 
@@ -87,7 +104,7 @@ def normalise(row: Mapping) -> dict:
     for c in COLUMNS:
         v = row.get(c.name)
         if v is None or (isinstance(v, float) and math.isnan(v)):
-            v = "" if c.name in ("error", "warnings", "rolling") else None
+            v = "" if c.name in ("error", "warnings", "rolling", "also_as") else None
         elif c.kind == "float":
             v = float(v)
         elif c.kind == "int":
@@ -132,22 +149,14 @@ def arrow_schema():
 
 def write_table(rows: Sequence[Mapping], folder: Path) -> tuple[Path, Path]:
     """Write ``coefficients.parquet`` and ``coefficients.csv`` into ``folder``, each atomically."""
-    import os
-    import tempfile
-
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     rows = [normalise(r) for r in rows]
     table = pa.Table.from_pylist(rows, schema=arrow_schema())
     parquet = folder / "coefficients.parquet"
-    fd, tmp = tempfile.mkstemp(prefix=".coefficients.", suffix=".parquet.tmp", dir=folder)
-    os.close(fd)
-    try:
+    with atomic_path(parquet) as tmp:  # created by pyarrow with the umask's mode, as documented
         pq.write_table(table, tmp)
-        os.replace(tmp, parquet)
-    finally:
-        Path(tmp).unlink(missing_ok=True)
     return parquet, write_text_atomic(folder / "coefficients.csv", csv_text(rows))
 
 

@@ -12,7 +12,8 @@ so aR² ∝ N^(2/3) and m/R² ∝ N^(−2/3). A tire is not a Hertz contact (its
 inflation pressure carries most of the load, so R grows faster); the Hertz
 column says how far it departs.
 
-Rows are grouped by inflation pressure when the sidecars give it, so an
+Rows of unpaired rolling maps (role ``rolling``) are left out: a rolling map is
+not a static load point. Rows are grouped by inflation pressure when the sidecars give it, so an
 inflation sweep gives one load trend per pressure.
 """
 
@@ -164,8 +165,9 @@ def fit_power_law(
 
 
 def groups(rows: Sequence[Mapping]) -> dict[str, list[Mapping]]:
-    """Ok rows by inflation pressure (one group ``"all"`` when no sidecar gives it)."""
-    ok = [r for r in rows if r.get("status") == "ok"]
+    """Ok rows of load points by inflation pressure (one group ``"all"`` when no sidecar
+    gives it); rows of unpaired rolling maps (role ``rolling``) are no load points."""
+    ok = [r for r in rows if r.get("status") == "ok" and r.get("role") != "rolling"]
     pressures = sorted({r["inflation_pressure"] for r in ok if r.get("inflation_pressure") is not None})
     if len(pressures) <= 1:
         return {"all": ok} if ok else {}
