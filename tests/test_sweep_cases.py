@@ -13,6 +13,7 @@ import pytest
 
 from fepost.cli import main
 from fepost.errors import ArgumentError
+from fepost.report.sweeppage import write_trends
 from fepost.sweep import run_sweep
 from fepost.sweep.inputs import PREFERENCE, expand_inputs
 from fepost.sweep.pairs import ROLLING, STATIC, pair_sources, parse_rolling_pairs
@@ -90,7 +91,9 @@ def test_an_input_naming_nothing_is_a_usage_error_with_nothing_written(capsys, t
 def test_the_aircraft_folder_gives_six_load_points_and_the_pair(tmp_path):
     old = os.umask(0o027)  # the outputs must follow the umask, as docs/cli-exit-codes.md says
     try:
-        res = run_sweep([str(AIR)], tmp_path / "out", workers=1, processes=False, progress=False)
+        res = run_sweep(
+            [str(AIR)], tmp_path / "out", workers=1, processes=False, progress=False, trends=write_trends
+        )
     finally:
         os.umask(old)
     assert res.ok
