@@ -74,7 +74,10 @@ class Resultants:
         return {"Fx": self.Fx.tolist(), "Fy": self.Fy.tolist(), "Mz": self.Mz.tolist()}
 
 
-def _kinematics(vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
+def checked_kinematics(vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
+    """``vx``, ``vy`` (m/s), ``wz`` (rad/s) as flat float arrays of their broadcast shape,
+    and that shape; `fepost.errors.ArgumentError` naming the argument for a value that
+    is not a finite number or shapes that do not broadcast."""
     arrays = {}
     for name, value, unit in (("vx", vx, "m/s"), ("vy", vy, "m/s"), ("wz", wz, "rad/s")):
         try:
@@ -253,7 +256,7 @@ def friction_resultants(
         raise ArgumentError(f"subtract must be True, False, 0, 1 or 2, got {subtract!r}")
     if threads is not None and (isinstance(threads, bool) or int(threads) != threads or threads < 1):
         raise ArgumentError(f"threads must be a positive integer, got {threads!r}")
-    vx, vy, wz, shape = _kinematics(vx, vy, wz)
+    vx, vy, wz, shape = checked_kinematics(vx, vy, wz)
     sigma_ref = law.reference_pressure(quad.mean_pressure) if law.pressure_coef else 1.0
     nodes = _nodes(quad, law, sigma_ref)
     k = vx.size

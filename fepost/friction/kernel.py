@@ -1,0 +1,413 @@
+"""Compiled evaluation of the generalised friction model (numba, optional).
+
+The numpy evaluation (`GeneralisedModel._evaluate`) makes about a hundred
+passes over its arrays, each reading and writing memory; here one compiled loop
+takes one kinematic point at a time through the same formulas (the module
+docstring of `fepost.friction.model`) in registers. That is what takes the
+model from a few million evaluations per second to the tens of millions a
+Monte-Carlo shimmy study needs; numpy alone cannot fuse the passes, and the
+correction's sums (Fourier × Chebyshev by recurrences) are short loops that
+numpy can only do as whole-array steps.
+
+numba is an optional dependency (``pip install fepost[fast]``): without it
+`AVAILABLE` is False and the model keeps its numpy path. Both give the same
+numbers to round-off (tests/test_model_kernel.py). The generated C evaluator
+(`fepost.friction.cexport`) follows this kernel line by line.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import chebyshev
+
+from .._arrays import frozen
+
+try:  # optional: the numpy path serves without it
+    import numba
+except ImportError:  # pragma: no cover - exercised where numba is absent
+    numba = None
+
+#: True when numba is importable and the compiled kernel is used.
+AVAILABLE = numba is not None
+
+#: Order of the scalars in `KernelCoefficients.scalars`.
+SCALARS = (
+    "R",
+    "F0",
+    "U0",
+    "U0^5",
+    "U0^6",
+    "Q00",
+    "Q01",
+    "Q11",
+    "S00",
+    "S01",
+    "S11",
+    "gx",
+    "gy",
+    "xcx",
+    "xcy",
+    "alpha",
+    "g0",
+    "g1x",
+    "g1y",
+)
+
+
+@dataclass(frozen=True)
+class KernelCoefficients:
+    """The model's numbers as the kernel takes them: ``scalars`` (in the order of
+    `SCALARS`), the potential correction ``C`` (2K + 1, L), the coefficients ``Cd`` of
+    its derivative in t in the same basis, and the anisotropic-torque correction
+    ``Cg`` (zeros when the model has none); columns zero-padded to a multiple of four."""
+
+    scalars: np.ndarray
+    C: np.ndarray
+    Cd: np.ndarray
+    Cg: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("scalars", "C", "Cd", "Cg"):
+            object.__setattr__(self, name, frozen(np.ascontiguousarray(getattr(self, name), float)))
+
+
+def coefficients(model) -> KernelCoefficients:
+    """Pack a `GeneralisedModel` for `evaluate` (off-diagonals from the upper triangle,
+    as the numpy path reads them)."""
+    U0 = model.U0
+    Q, S = model.Q, model.S
+    scalars = [
+        model.R,
+        model.F0,
+        U0,
+        U0**5,
+        U0**6,
+        Q[0, 0],
+        Q[0, 1],
+        Q[1, 1],
+        S[0, 0],
+        S[0, 1],
+        S[1, 1],
+        model.g[0],
+        model.g[1],
+        model.xc[0],
+        model.xc[1],
+        model.anisotropy,
+        model.g0,
+        model.g1[0],
+        model.g1[1],
+    ]
+    cg = np.zeros((1, 1)) if model.correction_g is None else model.correction_g
+    C = model.correction
+    # d/dt T_l(2t − 1) = 2 T_l'(x): chebder's scale 2
+    Cd = chebyshev.chebder(C, scl=2.0, axis=1) if C.shape[1] > 1 else np.zeros_like(C)
+    return KernelCoefficients(np.array(scalars, float), _padded(C), _padded(Cd), _padded(cg))
+
+
+def _padded(C: np.ndarray) -> np.ndarray:
+    """C with zero columns up to a multiple of four (at least four: T_0, T_1 always exist)."""
+    L = max(4, -(-C.shape[1] // 4) * 4)
+    out = np.zeros((C.shape[0], L))
+    out[:, : C.shape[1]] = C
+    return out
+
+
+#: Kinematic points per block: the working rows stay in L1 cache.
+BLOCK = 256
+#: First guess of P^(−1/6) from the bits of P: 7/6 of the bits of 1.0 less a tuned
+#: constant (the exponent field read as a logarithm), within 6.1 % for every normal P.
+_MAGIC = 0x4A97C00000000000
+#: Newton steps for P^(−1/6) from that guess (6 % → round-off in four; one more for margin).
+_NEWTON = 5
+#: P below this (only with degenerate tensors, the kinematics are normalised) takes `pow`.
+_TINY = 1e-280
+# Cephes' atan (S. L. Moshier): rational approximation on |x| ≤ 0.66 after reduction.
+_AP = (-8.750608600031904122785e-1, -1.615753718733365076637e1, -7.500855792314704667340e1,
+       -1.228866684490136173410e2, -6.485021904942025371773e1)
+_AQ = (2.485846490142306297962e1, 1.650270098316988542046e2, 4.328810604912902668951e2,
+       4.853903996359136964868e2, 1.945506571482613964425e2)
+_MOREBITS = 6.123233995736765886130e-17
+_T3P8 = 2.41421356237309504880
+
+
+def _atan_ratio(y, x):
+    """atan2(y, x) for y, x ≥ 0 without a library call (Cephes' reduction and rational
+    form, to ~1 ulp), so that the loop around it vectorises; 0 for y = x = 0."""
+    big = y > _T3P8 * x
+    small = y <= 0.66 * x
+    num = -x if big else (y if small else y - x)
+    den = y if big else (x if small else y + x)
+    den = den if den > 0.0 else 1.0
+    r = num / den
+    z = r * r
+    pz = (((_AP[0] * z + _AP[1]) * z + _AP[2]) * z + _AP[3]) * z + _AP[4]
+    qz = ((((z + _AQ[0]) * z + _AQ[1]) * z + _AQ[2]) * z + _AQ[3]) * z + _AQ[4]
+    a = r * (z * pz / qz) + r
+    off = np.pi / 2 + _MOREBITS if big else (0.0 if small else np.pi / 4 + 0.5 * _MOREBITS)
+    return off + a
+
+
+def _base_block(p, vx, vy, wz, b, n, work, P, bits, guess):
+    """Normalise the block's kinematics (rows 0–2 of ``work``: v_x, v_y, u over
+    max(|v_x|, |v_y|, |u|); every resultant is of degree 0) and its P."""
+    R = p[0]
+    k5, k6 = p[3], p[4]
+    q00, q01, q11 = p[5], p[6], p[7]
+    s00, s01, s11 = p[8], p[9], p[10]
+    for j in range(n):
+        x = vx[b + j]
+        y = vy[b + j]
+        u = wz[b + j] * R
+        s = max(abs(x), abs(y), abs(u))
+        k = 1.0 / s if s > 0.0 else 0.0
+        x *= k
+        y *= k
+        u *= k
+        work[0, j] = x
+        work[1, j] = y
+        work[2, j] = u
+        u2 = u * u
+        v2 = x * x + y * y
+        qv = x * (q00 * x + q01 * y) + y * (q01 * x + q11 * y)
+        sv = x * (s00 * x + s01 * y) + y * (s01 * x + s11 * y)
+        P[j] = v2 * v2 * v2 + 3.0 * u2 * v2 * qv + 3.0 * k5 * u2 * u2 * sv + k6 * u2 * u2 * u2
+    for j in range(n):  # first guess of P^(-1/6) from the bits (P > 0 normal; others fixed below)
+        guess[j] = _MAGIC - bits[j] // 6
+
+
+def _inverse(P, y, n):
+    """y ← P^(−5/6) (0 where P ≤ 0), from the guess of P^(−1/6) in y, by Newton."""
+    for j in range(n):
+        g = y[j]
+        q = P[j]
+        for _ in range(_NEWTON):
+            g2 = g * g
+            g = g * (7.0 - q * g2 * g2 * g2) * (1.0 / 6.0)
+        g2 = g * g
+        y[j] = g2 * g2 * g if q >= _TINY else 0.0
+    for j in range(n):
+        if 0.0 < P[j] < _TINY:
+            y[j] = 1.0 / P[j] ** (5.0 / 6.0)
+
+
+def _forces_block(p, work, inv, n, fx, fy, mz, b):
+    """The base resultants, and the sphere coordinates into rows 3–8 of ``work``:
+    t, cos θ, sin θ, sgn ω_z, c = cos(πt/2), sn = sin(πt/2)."""
+    R, F0 = p[0], p[1]
+    k5, k6 = p[3], p[4]
+    q00, q01, q11 = p[5], p[6], p[7]
+    s00, s01, s11 = p[8], p[9], p[10]
+    gx, gy, xx, xy = p[11], p[12], p[13], p[14]
+    for j in range(n):
+        vx = work[0, j]
+        vy = work[1, j]
+        u = work[2, j]
+        iv = inv[j]
+        u2 = u * u
+        v2 = vx * vx + vy * vy
+        Qvx = q00 * vx + q01 * vy
+        Qvy = q01 * vx + q11 * vy
+        Svx = s00 * vx + s01 * vy
+        Svy = s01 * vx + s11 * vy
+        qv = vx * Qvx + vy * Qvy
+        sv = vx * Svx + vy * Svy
+        cv = v2 * v2 + u2 * qv
+        cq = u2 * v2
+        cs = k5 * u2 * u2
+        dvx = (cv * vx + cq * Qvx + cs * Svx) * iv
+        dvy = (cv * vy + cq * Qvy + cs * Svy) * iv
+        du = (u * v2 * qv + 2.0 * k5 * u * u2 * sv + k6 * u * u2 * u2) * iv
+        jx = -vy
+        jy = vx
+        a = u2 + v2
+        ia = 1.0 / a if a > 0.0 else 0.0
+        au = abs(u)
+        au3 = au * au * au
+        gj = gx * jx + gy * jy
+        w1 = u * au3 * ia * ia
+        dw1_du = (4.0 * au3 - 4.0 * u * au3 * u * ia) * ia * ia
+        dw1_dv2 = -2.0 * u * au3 * ia * ia * ia
+        dvx += gy * w1 + gj * dw1_dv2 * 2.0 * vx
+        dvy += -gx * w1 + gj * dw1_dv2 * 2.0 * vy
+        du += gj * dw1_du
+        xj = xx * jx + xy * jy
+        ia15 = ia * np.sqrt(ia)
+        w2 = u * v2 * ia15
+        dw2_du = v2 * ia15 - 3.0 * u2 * v2 * ia15 * ia
+        dw2_dv2 = u * ia15 - 1.5 * u * v2 * ia15 * ia
+        dvx -= xy * w2 + xj * dw2_dv2 * 2.0 * vx
+        dvy -= -xx * w2 + xj * dw2_dv2 * 2.0 * vy
+        du -= xj * dw2_du
+        fx[b + j] = -F0 * dvx
+        fy[b + j] = -F0 * dvy
+        mz[b + j] = -F0 * R * du
+        # sphere coordinates
+        v = np.sqrt(v2)
+        rho = np.sqrt(a)
+        live = rho > 0.0
+        sgn = 1.0 if u > 0.0 else (-1.0 if u < 0.0 else 0.0)
+        irho = 1.0 / rho if live else 0.0
+        iv1 = 1.0 / v if v > 0.0 else 0.0
+        work[3, j] = (2.0 / np.pi) * _atan_ratio(v, au)
+        work[4, j] = -vy * sgn * iv1 if v > 0.0 else 1.0
+        work[5, j] = vx * sgn * iv1
+        work[6, j] = sgn
+        work[7, j] = au * irho if live else 1.0
+        work[8, j] = v * irho
+
+
+def _sums_block(C, Cd, work, n, T, out):
+    """Rows 0–2 of ``out``: Σ C B T, Σ C B dT/dt, Σ C dB/dθ T (`fepost.friction.basis.sums`).
+
+    ``Cd`` holds the coefficients of the t-derivative in the same basis (so that
+    Σ C B dT/dt = Σ Cd B T); both have a multiple of four columns (zero-padded by
+    `coefficients`, ≥ 4) and the sums over l go four terms at a pass. Rows 3–6 of
+    ``out`` are scratch: cos kθ, sin kθ and the two partial sums. The loops index
+    2-D arrays directly (no row views, which cost a reference count each, and few
+    distinct arrays per loop, so that LLVM vectorises them).
+    """
+    L = C.shape[1]
+    for j in range(n):
+        x = 2.0 * work[3, j] - 1.0
+        T[0, j] = 1.0
+        T[1, j] = x
+        out[0, j] = 0.0
+        out[1, j] = 0.0
+        out[2, j] = 0.0
+        out[3, j] = 1.0
+        out[4, j] = 0.0
+    for l in range(2, L):
+        for j in range(n):
+            T[l, j] = (4.0 * work[3, j] - 2.0) * T[l - 1, j] - T[l - 2, j]
+    for row in range(C.shape[0]):
+        if row % 2 == 1:  # next harmonic: cos kθ, sin kθ by angle addition
+            for j in range(n):
+                a = out[3, j]
+                b = out[4, j]
+                out[3, j] = a * work[4, j] - b * work[5, j]
+                out[4, j] = b * work[4, j] + a * work[5, j]
+        for j in range(n):
+            out[5, j] = 0.0
+            out[6, j] = 0.0
+        for l in range(0, L, 4):
+            a0, a1, a2, a3 = C[row, l], C[row, l + 1], C[row, l + 2], C[row, l + 3]
+            d0, d1, d2, d3 = Cd[row, l], Cd[row, l + 1], Cd[row, l + 2], Cd[row, l + 3]
+            for j in range(n):
+                t0 = T[l, j]
+                t1 = T[l + 1, j]
+                t2 = T[l + 2, j]
+                t3 = T[l + 3, j]
+                out[5, j] += a0 * t0 + a1 * t1 + a2 * t2 + a3 * t3
+                out[6, j] += d0 * t0 + d1 * t1 + d2 * t2 + d3 * t3
+        if row == 0:
+            for j in range(n):
+                out[0, j] += out[5, j]
+                out[1, j] += out[6, j]
+        else:  # B = cos kθ (odd rows) or sin kθ; dB/dθ = −k sin kθ or k cos kθ
+            k = float((row + 1) // 2)
+            b = 3 if row % 2 == 1 else 4
+            db = 4 if row % 2 == 1 else 3
+            kk = -k if row % 2 == 1 else k
+            for j in range(n):
+                out[0, j] += out[b, j] * out[5, j]
+                out[1, j] += out[b, j] * out[6, j]
+                out[2, j] += kk * out[db, j] * out[5, j]
+
+
+def _correction_block(p, C, Cd, work, n, T, sums, fx, fy, mz, b):
+    R, F0 = p[0], p[1]
+    _sums_block(C, Cd, work, n, T, sums)
+    for j in range(n):
+        t = work[3, j]
+        cos1 = work[4, j]
+        sin1 = work[5, j]
+        sgn = work[6, j]
+        c = work[7, j]
+        sn = work[8, j]
+        s0 = sums[0, j]
+        om = 1.0 - t
+        w = t * t * t * om * om
+        dw = 3.0 * t * t * om * om - 2.0 * t * t * t * om
+        Ut = dw * s0 + w * sums[1, j]
+        Ur = (2.0 / np.pi) * c * c * Ut
+        rUr = (2.0 / np.pi) * c * sn * Ut
+        Uth_r = w * sums[2, j] * c / (sn if sn > 0.0 else 1.0)
+        fx[b + j] += sgn * F0 * (-Ur * sin1 - Uth_r * cos1)
+        fy[b + j] += sgn * F0 * (Ur * cos1 - Uth_r * sin1)
+        mz[b + j] += sgn * F0 * R * (rUr - w * s0)
+
+
+def _lateral_block(p, Cg, corr_g, work, n, T, sums, fy, mz, b):
+    """α ≠ 1: F_y ← α F_y, M_z += (α − 1) G (`GeneralisedModel.lateral_moment`)."""
+    R, F0 = p[0], p[1]
+    alpha = p[15]
+    q00, q01 = p[5], p[6]
+    if corr_g:
+        _sums_block(Cg, Cg, work, n, T, sums)
+    for j in range(n):
+        vx = work[0, j]
+        vy = work[1, j]
+        u = work[2, j]
+        v2 = vx * vx + vy * vy
+        rho2 = u * u + v2
+        irho3 = 1.0 / (rho2 * np.sqrt(rho2)) if rho2 > 0.0 else 0.0
+        jx = -vy
+        jy = vx
+        qjx = q00 * jx + q01 * jy
+        G = (p[16] * u * u * u + (p[17] * jx + p[18] * jy) * u * u - p[13] * vy * v2
+             - u * (q00 * v2 - jx * qjx)) * irho3
+        G = F0 * R * G
+        if corr_g:
+            t = work[3, j]
+            om = 1.0 - t
+            G += work[6, j] * F0 * R * (t * t * om * om) * sums[0, j]
+        fy[b + j] = alpha * fy[b + j]
+        mz[b + j] = mz[b + j] + (alpha - 1.0) * G
+
+
+def _loop(p, C, Cd, Cg, corr, corr_g, vx, vy, wz, fx, fy, mz):
+    n = vx.shape[0]
+    L = max(C.shape[1], Cg.shape[1])
+    work = np.empty((9, BLOCK))
+    T = np.empty((L, BLOCK))
+    sums = np.empty((9, BLOCK))
+    P = np.empty(BLOCK)
+    y = np.empty(BLOCK)
+    bits = P.view(np.int64)
+    guess = y.view(np.int64)
+    for b in range(0, n, BLOCK):
+        m = min(BLOCK, n - b)
+        _base_block(p, vx, vy, wz, b, m, work, P, bits, guess)
+        _inverse(P, y, m)
+        _forces_block(p, work, y, m, fx, fy, mz, b)
+        if corr:
+            _correction_block(p, C, Cd, work, m, T, sums, fx, fy, mz, b)
+        if p[15] != 1.0:
+            _lateral_block(p, Cg, corr_g, work, m, T, sums, fy, mz, b)
+
+
+if AVAILABLE:
+    _jit = numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
+    _atan_ratio = _jit(_atan_ratio)
+    _base_block = _jit(_base_block)
+    _inverse = _jit(_inverse)
+    _forces_block = _jit(_forces_block)
+    _sums_block = _jit(_sums_block)
+    _correction_block = _jit(_correction_block)
+    _lateral_block = _jit(_lateral_block)
+    _loop = _jit(_loop)
+
+
+def evaluate(coef: KernelCoefficients, vx: np.ndarray, vy: np.ndarray, wz: np.ndarray):
+    """(F_x, F_y, M_z) at flat float64 arrays of equal length, by the compiled loop.
+
+    Without numba the same loop runs as plain Python (correct, slow: for tests).
+    """
+    n = vx.shape[0]
+    fx, fy, mz = np.empty(n), np.empty(n), np.empty(n)
+    corr = bool(np.any(coef.C))  # as the numpy path: no correction, no sphere sums
+    corr_g = bool(np.any(coef.Cg))
+    _loop(coef.scalars, coef.C, coef.Cd, coef.Cg, corr, corr_g, vx, vy, wz, fx, fy, mz)
+    return fx, fy, mz
