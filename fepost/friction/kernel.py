@@ -23,6 +23,7 @@ import numpy as np
 from numpy.polynomial import chebyshev
 
 from .._arrays import frozen
+from ..errors import ArgumentError
 
 try:  # optional: the numpy path serves without it
     import numba
@@ -71,6 +72,11 @@ class KernelCoefficients:
     def __post_init__(self) -> None:
         for name in ("scalars", "C", "Cd", "Cg"):
             object.__setattr__(self, name, frozen(np.ascontiguousarray(getattr(self, name), float)))
+        if self.C.shape != self.Cd.shape or self.C.shape[1] % 4 or self.Cg.shape[1] % 4:
+            raise ArgumentError(
+                f"C and Cd must have one shape with a multiple of 4 columns, got {self.C.shape}, "
+                f"{self.Cd.shape} and Cg {self.Cg.shape}"
+            )
 
 
 def coefficients(model) -> KernelCoefficients:
@@ -103,13 +109,16 @@ def coefficients(model) -> KernelCoefficients:
     C = model.correction
     # d/dt T_l(2t − 1) = 2 T_l'(x): chebder's scale 2
     Cd = chebyshev.chebder(C, scl=2.0, axis=1) if C.shape[1] > 1 else np.zeros_like(C)
-    return KernelCoefficients(np.array(scalars, float), _padded(C), _padded(Cd), _padded(cg))
+    width = max(4, -(-C.shape[1] // 4) * 4)  # a multiple of four, ≥ 4
+    gwidth = max(4, -(-cg.shape[1] // 4) * 4)
+    return KernelCoefficients(
+        np.array(scalars, float), _padded(C, width), _padded(Cd, width), _padded(cg, gwidth)
+    )
 
 
-def _padded(C: np.ndarray) -> np.ndarray:
-    """C with zero columns up to a multiple of four (at least four: T_0, T_1 always exist)."""
-    L = max(4, -(-C.shape[1] // 4) * 4)
-    out = np.zeros((C.shape[0], L))
+def _padded(C: np.ndarray, width: int) -> np.ndarray:
+    """C with zero columns up to ``width``."""
+    out = np.zeros((C.shape[0], width))
     out[:, : C.shape[1]] = C
     return out
 
