@@ -76,7 +76,15 @@ def assert_same(model, got, ref):
 
 @pytest.mark.parametrize(
     "name",
-    ["hertz 72", "asymmetric 72", "tire-like 204", "anisotropic", "odd order (3, 5)", "base only", "substituted"],
+    [
+        "hertz 72",
+        "asymmetric 72",
+        "tire-like 204",
+        "anisotropic",
+        "odd order (3, 5)",
+        "base only",
+        "substituted",
+    ],
 )
 def test_kernel_equals_numpy_on_random_and_singular_kinematics(models, name):
     model = models[name]
@@ -93,7 +101,9 @@ def test_singular_points_have_their_exact_limits(models):
     velocity gives zero, pure spin the torque −sgn(ω_z) M0, pure sliding along x the
     force −F0 along x and none across."""
     model = models["hertz 72"]
-    fx, fy, mz = model.evaluate([0.0, 0.0, 0.0, 2.0], [0.0, 0.0, 0.0, 0.0], [0.0, 5.0, -5.0, 0.0], backend="numba")
+    fx, fy, mz = model.evaluate(
+        [0.0, 0.0, 0.0, 2.0], [0.0, 0.0, 0.0, 0.0], [0.0, 5.0, -5.0, 0.0], backend="numba"
+    )
     assert (fx[0], fy[0], mz[0]) == (0.0, 0.0, 0.0)
     assert mz[1] == pytest.approx(-model.M0, rel=IDENTITY)
     assert mz[2] == pytest.approx(model.M0, rel=IDENTITY)
@@ -135,7 +145,9 @@ def test_substituted_model_is_repacked(models):
 
 
 def test_bad_backend_names_the_argument(models):
-    with pytest.raises(ArgumentError, match=re.escape("backend must be one of auto, numba, numpy, got 'gpu'")):
+    with pytest.raises(
+        ArgumentError, match=re.escape("backend must be one of auto, numba, numpy, got 'gpu'")
+    ):
         models["hertz 72"].evaluate(0.1, 0.0, 1.0, backend="gpu")
 
 

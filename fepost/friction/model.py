@@ -213,7 +213,9 @@ class GeneralisedModel:
         if backend not in BACKENDS:
             raise ArgumentError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
         if backend == "numba" and not kernel.AVAILABLE:
-            raise ArgumentError("backend 'numba' needs numba (pip install fepost[fast]), which is not installed")
+            raise ArgumentError(
+                "backend 'numba' needs numba (pip install fepost[fast]), which is not installed"
+            )
         vx, vy, wz = np.broadcast_arrays(np.asarray(vx, float), np.asarray(vy, float), np.asarray(wz, float))
         shape = vx.shape
         fvx, fvy, fwz = (np.ascontiguousarray(a.ravel()) for a in (vx, vy, wz))
