@@ -297,9 +297,9 @@ def _sums_block(C, Cd, work, n, T, out):
         out[2, j] = 0.0
         out[3, j] = 1.0
         out[4, j] = 0.0
-    for l in range(2, L):
+    for m in range(2, L):
         for j in range(n):
-            T[l, j] = (4.0 * work[3, j] - 2.0) * T[l - 1, j] - T[l - 2, j]
+            T[m, j] = (4.0 * work[3, j] - 2.0) * T[m - 1, j] - T[m - 2, j]
     for row in range(C.shape[0]):
         if row % 2 == 1:  # next harmonic: cos kθ, sin kθ by angle addition
             for j in range(n):
@@ -310,14 +310,14 @@ def _sums_block(C, Cd, work, n, T, out):
         for j in range(n):
             out[5, j] = 0.0
             out[6, j] = 0.0
-        for l in range(0, L, 4):
-            a0, a1, a2, a3 = C[row, l], C[row, l + 1], C[row, l + 2], C[row, l + 3]
-            d0, d1, d2, d3 = Cd[row, l], Cd[row, l + 1], Cd[row, l + 2], Cd[row, l + 3]
+        for q in range(0, L, 4):
+            a0, a1, a2, a3 = C[row, q], C[row, q + 1], C[row, q + 2], C[row, q + 3]
+            d0, d1, d2, d3 = Cd[row, q], Cd[row, q + 1], Cd[row, q + 2], Cd[row, q + 3]
             for j in range(n):
-                t0 = T[l, j]
-                t1 = T[l + 1, j]
-                t2 = T[l + 2, j]
-                t3 = T[l + 3, j]
+                t0 = T[q, j]
+                t1 = T[q + 1, j]
+                t2 = T[q + 2, j]
+                t3 = T[q + 3, j]
                 out[5, j] += a0 * t0 + a1 * t1 + a2 * t2 + a3 * t3
                 out[6, j] += d0 * t0 + d1 * t1 + d2 * t2 + d3 * t3
         if row == 0:
