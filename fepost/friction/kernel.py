@@ -28,7 +28,7 @@ from ..errors import ArgumentError
 try:  # optional: the numpy path serves without it
     import numba
 except ImportError:  # pragma: no cover - exercised where numba is absent
-    numba = None
+    numba = None  # type: ignore[assignment]
 
 #: True when numba is importable and the compiled kernel is used.
 AVAILABLE = numba is not None
