@@ -277,67 +277,73 @@ def _forces_block(p, work, inv, n, fx, fy, mz, b):
         work[8, j] = v * irho
 
 
-def _sums_block(C, Cd, work, n, T, out):
-    """Rows 0–2 of ``out``: Σ C B T, Σ C B dT/dt, Σ C dB/dθ T (`fepost.friction.basis.sums`).
+def _sums_block(C, Cd, t, c1, s1, n, T, acc):
+    """acc[0–2]: Σ C B T, Σ C B dT/dt, Σ C dB/dθ T (`fepost.friction.basis.sums`) at the
+    block's points (t, cos θ, sin θ); acc[3–6] are scratch (cos kθ, sin kθ, partial sums).
 
     ``Cd`` holds the coefficients of the t-derivative in the same basis (so that
     Σ C B dT/dt = Σ Cd B T); both have a multiple of four columns (zero-padded by
-    `coefficients`, ≥ 4) and the sums over l go four terms at a pass. Rows 3–6 of
-    ``out`` are scratch: cos kθ, sin kθ and the two partial sums. The loops index
-    2-D arrays directly (no row views, which cost a reference count each, and few
-    distinct arrays per loop, so that LLVM vectorises them).
+    `coefficients`, ≥ 4). Each loop writes one array and reads few: LLVM vectorises
+    a loop only when it can check every written array against every other one it
+    touches, and gives up beyond a handful of checks.
     """
     L = C.shape[1]
+    s0, st, sth, ck, sk, pk, dpk = acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6]
     for j in range(n):
-        x = 2.0 * work[3, j] - 1.0
         T[0, j] = 1.0
-        T[1, j] = x
-        out[0, j] = 0.0
-        out[1, j] = 0.0
-        out[2, j] = 0.0
-        out[3, j] = 1.0
-        out[4, j] = 0.0
+    for j in range(n):
+        T[1, j] = 2.0 * t[j] - 1.0
     for m in range(2, L):
         for j in range(n):
-            T[m, j] = (4.0 * work[3, j] - 2.0) * T[m - 1, j] - T[m - 2, j]
+            T[m, j] = (4.0 * t[j] - 2.0) * T[m - 1, j] - T[m - 2, j]
+    s0[:n] = 0.0
+    st[:n] = 0.0
+    sth[:n] = 0.0
+    ck[:n] = 1.0
+    sk[:n] = 0.0
     for row in range(C.shape[0]):
         if row % 2 == 1:  # next harmonic: cos kθ, sin kθ by angle addition
             for j in range(n):
-                a = out[3, j]
-                b = out[4, j]
-                out[3, j] = a * work[4, j] - b * work[5, j]
-                out[4, j] = b * work[4, j] + a * work[5, j]
-        for j in range(n):
-            out[5, j] = 0.0
-            out[6, j] = 0.0
-        for q in range(0, L, 4):
-            a0, a1, a2, a3 = C[row, q], C[row, q + 1], C[row, q + 2], C[row, q + 3]
-            d0, d1, d2, d3 = Cd[row, q], Cd[row, q + 1], Cd[row, q + 2], Cd[row, q + 3]
-            for j in range(n):
-                t0 = T[q, j]
-                t1 = T[q + 1, j]
-                t2 = T[q + 2, j]
-                t3 = T[q + 3, j]
-                out[5, j] += a0 * t0 + a1 * t1 + a2 * t2 + a3 * t3
-                out[6, j] += d0 * t0 + d1 * t1 + d2 * t2 + d3 * t3
+                a = ck[j]
+                ck[j] = a * c1[j] - sk[j] * s1[j]
+                sk[j] = sk[j] * c1[j] + a * s1[j]
+        _combine(C, row, T, pk, n)
+        _combine(Cd, row, T, dpk, n)
         if row == 0:
-            for j in range(n):
-                out[0, j] += out[5, j]
-                out[1, j] += out[6, j]
-        else:  # B = cos kθ (odd rows) or sin kθ; dB/dθ = −k sin kθ or k cos kθ
+            _axpy(s0, 1.0, ck, pk, n)
+            _axpy(st, 1.0, ck, dpk, n)
+        elif row % 2 == 1:  # cos kθ; d/dθ = −k sin kθ
             k = float((row + 1) // 2)
-            b = 3 if row % 2 == 1 else 4
-            db = 4 if row % 2 == 1 else 3
-            kk = -k if row % 2 == 1 else k
-            for j in range(n):
-                out[0, j] += out[b, j] * out[5, j]
-                out[1, j] += out[b, j] * out[6, j]
-                out[2, j] += kk * out[db, j] * out[5, j]
+            _axpy(s0, 1.0, ck, pk, n)
+            _axpy(st, 1.0, ck, dpk, n)
+            _axpy(sth, -k, sk, pk, n)
+        else:  # sin kθ; d/dθ = k cos kθ
+            k = float(row // 2)
+            _axpy(s0, 1.0, sk, pk, n)
+            _axpy(st, 1.0, sk, dpk, n)
+            _axpy(sth, k, ck, pk, n)
+
+
+def _combine(C, row, T, out, n):
+    """out = Σ_l C[row, l] T[l] over the block, four terms a pass."""
+    a0, a1, a2, a3 = C[row, 0], C[row, 1], C[row, 2], C[row, 3]
+    for j in range(n):
+        out[j] = a0 * T[0, j] + a1 * T[1, j] + a2 * T[2, j] + a3 * T[3, j]
+    for q in range(4, C.shape[1], 4):
+        a0, a1, a2, a3 = C[row, q], C[row, q + 1], C[row, q + 2], C[row, q + 3]
+        for j in range(n):
+            out[j] += a0 * T[q, j] + a1 * T[q + 1, j] + a2 * T[q + 2, j] + a3 * T[q + 3, j]
+
+
+def _axpy(y, k, b, p, n):
+    """y += k b p over the block."""
+    for j in range(n):
+        y[j] += k * b[j] * p[j]
 
 
 def _correction_block(p, C, Cd, work, n, T, sums, fx, fy, mz, b):
     R, F0 = p[0], p[1]
-    _sums_block(C, Cd, work, n, T, sums)
+    _sums_block(C, Cd, work[3], work[4], work[5], n, T, sums)
     for j in range(n):
         t = work[3, j]
         cos1 = work[4, j]
@@ -364,7 +370,7 @@ def _lateral_block(p, Cg, corr_g, work, n, T, sums, fy, mz, b):
     alpha = p[15]
     q00, q01 = p[5], p[6]
     if corr_g:
-        _sums_block(Cg, Cg, work, n, T, sums)
+        _sums_block(Cg, Cg, work[3], work[4], work[5], n, T, sums)
     for j in range(n):
         vx = work[0, j]
         vy = work[1, j]
@@ -417,6 +423,8 @@ if AVAILABLE:
     _base_block = _jit(_base_block)
     _inverse = _jit(_inverse)
     _forces_block = _jit(_forces_block)
+    _combine = _jit(_combine)
+    _axpy = _jit(_axpy)
     _sums_block = _jit(_sums_block)
     _correction_block = _jit(_correction_block)
     _lateral_block = _jit(_lateral_block)
