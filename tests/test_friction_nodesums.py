@@ -124,6 +124,21 @@ def test_inputs_untouched_and_shapes_kept():
     np.testing.assert_array_equal(wz, keep[1])
 
 
+def test_auto_takes_the_compiled_sums_for_large_jobs(monkeypatch):
+    import fepost.friction.exact as exact
+
+    quad = quadrature("hertz")
+    vx, vy, wz = kinematics(quad)
+    monkeypatch.setattr(exact, "KERNEL_MIN_ELEMENTS", vx.size * quad.x.size)
+    big = friction_resultants(quad, vx, vy, wz, backend="auto")
+    compiled = friction_resultants(quad, vx, vy, wz, backend="numba")
+    small = friction_resultants(quad, vx[1:], vy[1:], wz[1:], backend="auto")
+    numpy = friction_resultants(quad, vx[1:], vy[1:], wz[1:], backend="numpy")
+    for name in ("Fx", "Fy", "Mz"):
+        np.testing.assert_array_equal(getattr(big, name), getattr(compiled, name))
+        np.testing.assert_array_equal(getattr(small, name), getattr(numpy, name))
+
+
 def test_bad_backend_names_the_argument():
     with pytest.raises(ArgumentError, match=re.escape("backend must be one of auto, numba, numpy, got 'c'")):
         friction_resultants(quadrature("hertz"), 0.1, 0.0, 1.0, backend="c")

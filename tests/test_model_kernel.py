@@ -10,15 +10,18 @@ coefficients), so they may differ by round-off only; measured ~3e-15.
 from __future__ import annotations
 
 import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
 from fepost.errors import ArgumentError
 from fepost.friction import kernel
+from fepost.friction import model as model_module
 from fepost.friction.build import build_model
 from fepost.friction.law import FrictionLaw
-from fepost.friction.model import KERNEL_MIN_POINTS, GeneralisedModel
+from fepost.friction.model import GeneralisedModel
 from fepost.friction.reference_maps import asymmetric, ellipse_quad, tire_like
 
 pytest.importorskip("numba", reason="numba (the optional 'fast' extra) is not installed")
@@ -111,9 +114,10 @@ def test_singular_points_have_their_exact_limits(models):
     assert abs(fy[3]) <= IDENTITY * model.F0
 
 
-def test_auto_backend_switches_at_the_threshold(models):
+def test_auto_backend_switches_at_the_threshold(models, monkeypatch):
+    monkeypatch.setattr(model_module, "KERNEL_MIN_POINTS", 64)
     model = models["asymmetric 72"]
-    vx, vy, wz = random_kinematics(KERNEL_MIN_POINTS, seed=3)
+    vx, vy, wz = random_kinematics(64, seed=3)
     big = model(vx, vy, wz)
     for a, b in zip(big, model.evaluate(vx, vy, wz, backend="numba"), strict=True):
         np.testing.assert_array_equal(a, b)
@@ -162,6 +166,7 @@ def test_newton_root_covers_every_normal_double():
     P = np.concatenate([np.exp(np.linspace(-700, 700, 20001)), [1e-300, 5e-310, 0.0, -1.0]])
     y = np.empty_like(P)
     y.view(np.int64)[:] = kernel._MAGIC - P.view(np.int64) // 6
+    kernel.prepare()
     kernel._inverse(P, y, P.size)
     live = P > 0
     ref = P[live].astype(np.longdouble) ** (np.longdouble(-5) / np.longdouble(6))
@@ -176,5 +181,21 @@ def test_atan_matches_the_library_to_round_off():
     y = np.abs(rng.normal(size=5000)) * np.exp(rng.uniform(-30, 30, 5000))
     x = np.abs(rng.normal(size=5000)) * np.exp(rng.uniform(-30, 30, 5000))
     y[:3], x[:3] = (0.0, 1.0, 2.0), (1.0, 0.0, 2.0)
+    kernel.prepare()
     got = np.array([kernel._atan_ratio(a, b) for a, b in zip(y, x, strict=True)])
     np.testing.assert_allclose(got, np.arctan2(y, x), rtol=4e-16, atol=0)
+
+
+def test_short_jobs_do_not_import_numba():
+    """numba's import (~1 s) stays off short commands: the model and the exact
+    integrals at their default backend below the thresholds never load it."""
+    code = (
+        "import sys\n"
+        "from fepost.friction.build import build_model\n"
+        "from fepost.friction.law import FrictionLaw\n"
+        "from fepost.friction.reference_maps import ellipse_quad\n"
+        "m = build_model(ellipse_quad('hertz', 1.5), FrictionLaw(f=0.3), order=(4, 8))\n"
+        "m([0.1] * 5000, 0.0, 1.0)\n"
+        "assert 'numba' not in sys.modules, 'numba was imported'\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=300)

@@ -231,6 +231,10 @@ def _g_and_gradient(quad, law, sigma_ref, px, py) -> tuple[np.ndarray, np.ndarra
 BACKENDS = ("auto", "numba", "numpy")
 #: Kinematic points per task of the compiled node sums (threads share the tasks).
 KERNEL_BLOCK = 64
+#: ``backend="auto"`` takes the compiled node sums from this many (points × nodes)
+#: on: numpy needs about half a second for them, what importing numba costs once per
+#: process (a short command such as ``fepost coefficients`` stays with numpy).
+KERNEL_MIN_ELEMENTS = 1 << 24
 
 
 @dataclass(frozen=True)
@@ -264,8 +268,9 @@ def friction_resultants(
     0 (or ``False``) integrates the raw discontinuous field (for studies only).
     ``threads``: worker threads over chunks of kinematic points (default: CPU count).
     ``backend``: the node sums by ``"numba"`` (compiled, `fepost.friction.nodesums`,
-    the optional numba dependency), ``"numpy"``, or ``"auto"`` (default: numba when
-    installed); the same numbers to round-off.
+    the optional numba dependency; ~10x faster), ``"numpy"``, or ``"auto"`` (default:
+    numba when installed and the job has `KERNEL_MIN_ELEMENTS` points × nodes or
+    more); the same numbers to round-off.
     """
     if not isinstance(quad, PressureQuadrature):
         raise ArgumentError(f"quad must be a PressureQuadrature, got {type(quad).__name__}")
@@ -285,7 +290,8 @@ def friction_resultants(
     sigma_ref = law.reference_pressure(quad.mean_pressure) if law.pressure_coef else 1.0
     setting = _Setting(quad=quad, law=law, sigma_ref=sigma_ref, order=order)
     workers = threads or os.cpu_count() or 1
-    if backend == "numpy" or not nodesums.AVAILABLE:
+    big = vx.size * quad.x.size >= KERNEL_MIN_ELEMENTS
+    if backend == "numpy" or (backend == "auto" and not (nodesums.AVAILABLE and big)):
         sx, sy = _numpy_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
     else:
         sx, sy = _compiled_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)

@@ -24,14 +24,10 @@ from numpy.polynomial import chebyshev
 
 from .._arrays import frozen
 from ..errors import ArgumentError
+from . import compiled
 
-try:  # optional: the numpy path serves without it
-    import numba
-except ImportError:  # pragma: no cover - exercised where numba is absent
-    numba = None  # type: ignore[assignment]
-
-#: True when numba is importable and the compiled kernel is used.
-AVAILABLE = numba is not None
+#: True when numba is importable (the compiled kernel can be used).
+AVAILABLE = compiled.AVAILABLE
 
 #: Order of the scalars in `KernelCoefficients.scalars`.
 SCALARS = (
@@ -417,25 +413,34 @@ def _loop(p, C, Cd, Cg, corr, corr_g, vx, vy, wz, fx, fy, mz):
             _lateral_block(p, Cg, corr_g, work, m, T, sums, fy, mz, b)
 
 
-if AVAILABLE:
-    _jit = numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
-    _atan_ratio = _jit(_atan_ratio)
-    _base_block = _jit(_base_block)
-    _inverse = _jit(_inverse)
-    _forces_block = _jit(_forces_block)
-    _combine = _jit(_combine)
-    _axpy = _jit(_axpy)
-    _sums_block = _jit(_sums_block)
-    _correction_block = _jit(_correction_block)
-    _lateral_block = _jit(_lateral_block)
-    _loop = _jit(_loop)
+_COMPILED = False
+_FUNCTIONS = (
+    "_atan_ratio",
+    "_base_block",
+    "_inverse",
+    "_forces_block",
+    "_combine",
+    "_axpy",
+    "_sums_block",
+    "_correction_block",
+    "_lateral_block",
+    "_loop",
+)
+
+
+def prepare() -> None:
+    """Compile the kernel with numba (once per process; from numba's disk cache after
+    the first time). `evaluate` calls it; without numba it raises ImportError."""
+    # no fastmath, not even contraction into FMAs: whether LLVM's run-time overlap
+    # checks send a block through a vectorised or a scalar loop depends on where the
+    # scratch arrays lie, and only without contraction do both round alike (the same
+    # input gives the same bits on every call)
+    compiled.compile_functions(globals(), _FUNCTIONS, fastmath=set())
 
 
 def evaluate(coef: KernelCoefficients, vx: np.ndarray, vy: np.ndarray, wz: np.ndarray):
-    """(F_x, F_y, M_z) at flat float64 arrays of equal length, by the compiled loop.
-
-    Without numba the same loop runs as plain Python (correct, slow: for tests).
-    """
+    """(F_x, F_y, M_z) at flat float64 arrays of equal length, by the compiled loop."""
+    prepare()
     n = vx.shape[0]
     fx, fy, mz = np.empty(n), np.empty(n), np.empty(n)
     corr = bool(np.any(coef.C))  # as the numpy path: no correction, no sphere sums

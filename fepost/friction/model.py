@@ -71,8 +71,9 @@ FORMAT = "fepost-friction-model/1"
 #: Points per evaluation chunk (keeps the working arrays in cache-sized blocks).
 CHUNK = 1 << 14
 #: ``backend="auto"`` uses the compiled kernel (`fepost.friction.kernel`, needs numba)
-#: from this many points on; fewer go through numpy, which needs no compilation.
-KERNEL_MIN_POINTS = 1 << 12
+#: from this many points on: numpy takes a fraction of a second for them, about what
+#: importing numba costs once per process (fewer points stay with numpy).
+KERNEL_MIN_POINTS = 1 << 20
 #: The evaluation backends of `GeneralisedModel.evaluate`.
 BACKENDS = ("auto", "numba", "numpy")
 #: Weight exponents of the potential correction (pure spin, pure sliding) ...

@@ -20,7 +20,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernel import AVAILABLE, numba
+from . import compiled
+
+#: True when numba is importable (the compiled node sums can be used).
+AVAILABLE = compiled.AVAILABLE
+_COMPILED = False
 
 #: Columns of `columns`: the distinct node weights (g = μσ dA without the speed factor).
 COLUMNS = ("g", "g y", "g x", "dA", "dA x", "dA y", "dA xy", "dA y²", "dA x²")
@@ -82,9 +86,11 @@ def _sums(vx, vy, wz, x, y, W, speed_coef, rmax, sx, sy):
         sy[i, 6] = y6
 
 
-if AVAILABLE:
-    # reassoc: the sums over nodes may run as vector partial sums (round-off only)
-    _sums = numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"reassoc", "contract"})(_sums)
+def prepare() -> None:
+    """Compile the node sums with numba (once per process; from numba's disk cache
+    after the first time). reassoc: the sums over nodes may run as vector partial
+    sums (round-off only)."""
+    compiled.compile_functions(globals(), ("_sums",), fastmath={"reassoc", "contract"})
 
 
 def node_sums(
@@ -99,6 +105,7 @@ def node_sums(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The (points, 7) sums ŵx @ bx and ŵy @ by of `fepost.friction.exact` for flat
     float arrays of kinematics, nodes ``x``, ``y`` (m) and ``weights`` from `columns`."""
+    prepare()
     n = vx.shape[0]
     sx = np.empty((n, 7))
     sy = np.empty((n, 7))
