@@ -126,6 +126,8 @@ BLOCK = 256
 _MAGIC = 0x4A97C00000000000
 #: Newton steps for P^(−1/6) from that guess (6 % → round-off in four; one more for margin).
 _NEWTON = 5
+#: The smallest normal double (its reciprocal is finite).
+_NORMAL = 2.2250738585072014e-308
 #: P below this (only with degenerate tensors, the kinematics are normalised) takes `pow`.
 _TINY = 1e-280
 # Cephes' atan (S. L. Moshier): rational approximation on |x| ≤ 0.66 after reduction.
@@ -164,8 +166,8 @@ def _atan_ratio(y, x):
     return off + a
 
 
-def _base_block(p, vx, vy, wz, b, n, work, P, bits, guess):
-    """Normalise the block's kinematics (rows 0–2 of ``work``: v_x, v_y, u over
+def _base_block(p, vx, vy, wz, b, n, kin, P, bits, guess):
+    """Normalise the block's kinematics (rows of ``kin``: v_x, v_y, u over
     max(|v_x|, |v_y|, |u|); every resultant is of degree 0) and its P."""
     R = p[0]
     k5, k6 = p[3], p[4]
@@ -175,14 +177,15 @@ def _base_block(p, vx, vy, wz, b, n, work, P, bits, guess):
         x = vx[b + j]
         y = vy[b + j]
         u = wz[b + j] * R
-        s = max(abs(x), abs(y), abs(u))
-        k = 1.0 / s if s > 0.0 else 0.0
+        # 1/s without a branch (a mispredicted branch costs more than the arithmetic
+        # here): s = 0 means all three are 0, and they stay 0 whatever k is
+        k = 1.0 / max(abs(x), abs(y), abs(u), _NORMAL)
         x *= k
         y *= k
         u *= k
-        work[0, j] = x
-        work[1, j] = y
-        work[2, j] = u
+        kin[0, j] = x
+        kin[1, j] = y
+        kin[2, j] = u
         u2 = u * u
         v2 = x * x + y * y
         qv = x * (q00 * x + q01 * y) + y * (q01 * x + q11 * y)
@@ -207,18 +210,23 @@ def _inverse(P, y, n):
             y[j] = 1.0 / P[j] ** (5.0 / 6.0)
 
 
-def _forces_block(p, work, inv, n, fx, fy, mz, b):
-    """The base resultants, and the sphere coordinates into rows 3–8 of ``work``:
-    t, cos θ, sin θ, sgn ω_z, c = cos(πt/2), sn = sin(πt/2)."""
+def _forces_block(p, kin, inv, n, res, sph):
+    """The base resultants into ``res`` and the sphere coordinates into ``sph``: t,
+    cos θ, sin θ, sgn ω_z, c = cos(πt/2), sn = sin(πt/2).
+
+    Reads and writes go to different arrays: LLVM checks at run time that the
+    arrays a vectorised loop reads do not overlap those it writes, and counts rows
+    of one array as one range, so writing some rows of an array while reading
+    others would always send the block down the scalar loop."""
     R, F0 = p[0], p[1]
     k5, k6 = p[3], p[4]
     q00, q01, q11 = p[5], p[6], p[7]
     s00, s01, s11 = p[8], p[9], p[10]
     gx, gy, xx, xy = p[11], p[12], p[13], p[14]
     for j in range(n):
-        vx = work[0, j]
-        vy = work[1, j]
-        u = work[2, j]
+        vx = kin[0, j]
+        vy = kin[1, j]
+        u = kin[2, j]
         iv = inv[j]
         u2 = u * u
         v2 = vx * vx + vy * vy
@@ -236,8 +244,8 @@ def _forces_block(p, work, inv, n, fx, fy, mz, b):
         du = (u * v2 * qv + 2.0 * k5 * u * u2 * sv + k6 * u * u2 * u2) * iv
         jx = -vy
         jy = vx
-        a = u2 + v2
-        ia = 1.0 / a if a > 0.0 else 0.0
+        a = u2 + v2  # ≥ 1 after normalisation, 0 only at rest (then every term is 0)
+        ia = 1.0 / max(a, 0.5)
         au = abs(u)
         au3 = au * au * au
         gj = gx * jx + gy * jy
@@ -255,22 +263,24 @@ def _forces_block(p, work, inv, n, fx, fy, mz, b):
         dvx -= xy * w2 + xj * dw2_dv2 * 2.0 * vx
         dvy -= -xx * w2 + xj * dw2_dv2 * 2.0 * vy
         du -= xj * dw2_du
-        fx[b + j] = -F0 * dvx
-        fy[b + j] = -F0 * dvy
-        mz[b + j] = -F0 * R * du
+        res[0, j] = -F0 * dvx
+        res[1, j] = -F0 * dvy
+        res[2, j] = -F0 * R * du
         # sphere coordinates
+        # sphere coordinates, branch-free: selects between values computed anyway
         v = np.sqrt(v2)
-        rho = np.sqrt(a)
-        live = rho > 0.0
-        sgn = 1.0 if u > 0.0 else (-1.0 if u < 0.0 else 0.0)
-        irho = 1.0 / rho if live else 0.0
-        iv1 = 1.0 / v if v > 0.0 else 0.0
-        work[3, j] = (2.0 / np.pi) * _atan_ratio(v, au)
-        work[4, j] = -vy * sgn * iv1 if v > 0.0 else 1.0
-        work[5, j] = vx * sgn * iv1
-        work[6, j] = sgn
-        work[7, j] = au * irho if live else 1.0
-        work[8, j] = v * irho
+        live = a > 0.0
+        sgn = (1.0 if u > 0.0 else 0.0) - (1.0 if u < 0.0 else 0.0)
+        irho = np.sqrt(ia)
+        iv1 = 1.0 / max(v, _NORMAL)
+        sph[0, j] = (2.0 / np.pi) * _atan_ratio(v, au)
+        cos1 = -vy * sgn * iv1
+        sph[1, j] = cos1 if v > 0.0 else 1.0
+        sph[2, j] = vx * sgn * iv1
+        sph[3, j] = sgn
+        c = au * irho
+        sph[4, j] = c if live else 1.0
+        sph[5, j] = v * irho
 
 
 def _sums_block(C, Cd, t, c1, s1, n, T, acc):
@@ -337,16 +347,17 @@ def _axpy(y, k, b, p, n):
         y[j] += k * b[j] * p[j]
 
 
-def _correction_block(p, C, Cd, work, n, T, sums, fx, fy, mz, b):
+def _correction_block(p, C, Cd, sph, n, T, sums, cor):
+    """The correction's resultants into ``cor`` (module docstring of the model)."""
     R, F0 = p[0], p[1]
-    _sums_block(C, Cd, work[3], work[4], work[5], n, T, sums)
+    _sums_block(C, Cd, sph[0], sph[1], sph[2], n, T, sums)
     for j in range(n):
-        t = work[3, j]
-        cos1 = work[4, j]
-        sin1 = work[5, j]
-        sgn = work[6, j]
-        c = work[7, j]
-        sn = work[8, j]
+        t = sph[0, j]
+        cos1 = sph[1, j]
+        sin1 = sph[2, j]
+        sgn = sph[3, j]
+        c = sph[4, j]
+        sn = sph[5, j]
         s0 = sums[0, j]
         om = 1.0 - t
         w = t * t * t * om * om
@@ -355,25 +366,24 @@ def _correction_block(p, C, Cd, work, n, T, sums, fx, fy, mz, b):
         Ur = (2.0 / np.pi) * c * c * Ut
         rUr = (2.0 / np.pi) * c * sn * Ut
         Uth_r = w * sums[2, j] * c / (sn if sn > 0.0 else 1.0)
-        fx[b + j] += sgn * F0 * (-Ur * sin1 - Uth_r * cos1)
-        fy[b + j] += sgn * F0 * (Ur * cos1 - Uth_r * sin1)
-        mz[b + j] += sgn * F0 * R * (rUr - w * s0)
+        cor[0, j] = sgn * F0 * (-Ur * sin1 - Uth_r * cos1)
+        cor[1, j] = sgn * F0 * (Ur * cos1 - Uth_r * sin1)
+        cor[2, j] = sgn * F0 * R * (rUr - w * s0)
 
 
-def _lateral_block(p, Cg, corr_g, work, n, T, sums, fy, mz, b):
-    """α ≠ 1: F_y ← α F_y, M_z += (α − 1) G (`GeneralisedModel.lateral_moment`)."""
+def _lateral_block(p, Cg, corr_g, kin, sph, n, T, sums, lat):
+    """G = ∬ x τ_y dA of the isotropic law into ``lat`` (`GeneralisedModel.lateral_moment`)."""
     R, F0 = p[0], p[1]
-    alpha = p[15]
     q00, q01 = p[5], p[6]
     if corr_g:
-        _sums_block(Cg, Cg, work[3], work[4], work[5], n, T, sums)
+        _sums_block(Cg, Cg, sph[0], sph[1], sph[2], n, T, sums)
     for j in range(n):
-        vx = work[0, j]
-        vy = work[1, j]
-        u = work[2, j]
+        vx = kin[0, j]
+        vy = kin[1, j]
+        u = kin[2, j]
         v2 = vx * vx + vy * vy
-        rho2 = u * u + v2
-        irho3 = 1.0 / (rho2 * np.sqrt(rho2)) if rho2 > 0.0 else 0.0
+        rho2 = max(u * u + v2, 0.5)  # ≥ 1 after normalisation, 0 only at rest (G = 0)
+        irho3 = 1.0 / (rho2 * np.sqrt(rho2))
         jx = -vy
         jy = vx
         qjx = q00 * jx + q01 * jy
@@ -383,34 +393,62 @@ def _lateral_block(p, Cg, corr_g, work, n, T, sums, fy, mz, b):
             - p[13] * vy * v2
             - u * (q00 * v2 - jx * qjx)
         ) * irho3
-        G = F0 * R * G
-        if corr_g:
-            t = work[3, j]
+        lat[j] = F0 * R * G
+    if corr_g:
+        for j in range(n):
+            t = sph[0, j]
             om = 1.0 - t
-            G += work[6, j] * F0 * R * (t * t * om * om) * sums[0, j]
-        fy[b + j] = alpha * fy[b + j]
-        mz[b + j] = mz[b + j] + (alpha - 1.0) * G
+            lat[j] += sph[3, j] * F0 * R * (t * t * om * om) * sums[0, j]
+
+
+def _store_block(p, corr, res, cor, lat, n, fx, fy, mz, b):
+    """F_x, F_y, M_z of the block: base + correction; α ≠ 1: F_y ← α F_y, M_z += (α − 1) G."""
+    alpha = p[15]
+    if corr:
+        for j in range(n):
+            fx[b + j] = res[0, j] + cor[0, j]
+        for j in range(n):
+            fy[b + j] = res[1, j] + cor[1, j]
+        for j in range(n):
+            mz[b + j] = res[2, j] + cor[2, j]
+    else:
+        for j in range(n):
+            fx[b + j] = res[0, j]
+        for j in range(n):
+            fy[b + j] = res[1, j]
+        for j in range(n):
+            mz[b + j] = res[2, j]
+    if alpha != 1.0:
+        for j in range(n):
+            fy[b + j] = alpha * fy[b + j]
+        for j in range(n):
+            mz[b + j] = mz[b + j] + (alpha - 1.0) * lat[j]
 
 
 def _loop(p, C, Cd, Cg, corr, corr_g, vx, vy, wz, fx, fy, mz):
     n = vx.shape[0]
     L = max(C.shape[1], Cg.shape[1])
-    work = np.empty((9, BLOCK))
+    kin = np.empty((3, BLOCK))
+    sph = np.empty((6, BLOCK))
+    res = np.empty((3, BLOCK))
+    cor = np.empty((3, BLOCK))
+    lat = np.empty(BLOCK)
     T = np.empty((L, BLOCK))
-    sums = np.empty((9, BLOCK))
+    sums = np.empty((7, BLOCK))
     P = np.empty(BLOCK)
     y = np.empty(BLOCK)
     bits = P.view(np.int64)
     guess = y.view(np.int64)
     for b in range(0, n, BLOCK):
         m = min(BLOCK, n - b)
-        _base_block(p, vx, vy, wz, b, m, work, P, bits, guess)
+        _base_block(p, vx, vy, wz, b, m, kin, P, bits, guess)
         _inverse(P, y, m)
-        _forces_block(p, work, y, m, fx, fy, mz, b)
+        _forces_block(p, kin, y, m, res, sph)
         if corr:
-            _correction_block(p, C, Cd, work, m, T, sums, fx, fy, mz, b)
+            _correction_block(p, C, Cd, sph, m, T, sums, cor)
         if p[15] != 1.0:
-            _lateral_block(p, Cg, corr_g, work, m, T, sums, fy, mz, b)
+            _lateral_block(p, Cg, corr_g, kin, sph, m, T, sums, lat)
+        _store_block(p, corr, res, cor, lat, m, fx, fy, mz, b)
 
 
 _COMPILED = False
@@ -424,6 +462,7 @@ _FUNCTIONS = (
     "_sums_block",
     "_correction_block",
     "_lateral_block",
+    "_store_block",
     "_loop",
 )
 
