@@ -283,9 +283,10 @@ def _forces_block(p, kin, inv, n, res, sph):
         sph[5, j] = v * irho
 
 
-def _sums_block(C, Cd, t, c1, s1, n, T, acc):
+def _sums_block(C, Cd, t, c1, s1, n, T, acc, ck, sk, pk, dpk):
     """acc[0–2]: Σ C B T, Σ C B dT/dt, Σ C dB/dθ T (`fepost.friction.basis.sums`) at the
-    block's points (t, cos θ, sin θ); acc[3–6] are scratch (cos kθ, sin kθ, partial sums).
+    block's points (t, cos θ, sin θ); ck, sk, pk, dpk are scratch (cos kθ, sin kθ, the
+    partial sums), separate arrays (see `_forces_block`).
 
     ``Cd`` holds the coefficients of the t-derivative in the same basis (so that
     Σ C B dT/dt = Σ Cd B T); both have a multiple of four columns (zero-padded by
@@ -294,7 +295,7 @@ def _sums_block(C, Cd, t, c1, s1, n, T, acc):
     touches, and gives up beyond a handful of checks.
     """
     L = C.shape[1]
-    s0, st, sth, ck, sk, pk, dpk = acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6]
+    s0, st, sth = acc[0], acc[1], acc[2]
     for j in range(n):
         T[0, j] = 1.0
     for j in range(n):
@@ -347,10 +348,10 @@ def _axpy(y, k, b, p, n):
         y[j] += k * b[j] * p[j]
 
 
-def _correction_block(p, C, Cd, sph, n, T, sums, cor):
+def _correction_block(p, C, Cd, sph, n, T, sums, ck, sk, pk, dpk, cor):
     """The correction's resultants into ``cor`` (module docstring of the model)."""
     R, F0 = p[0], p[1]
-    _sums_block(C, Cd, sph[0], sph[1], sph[2], n, T, sums)
+    _sums_block(C, Cd, sph[0], sph[1], sph[2], n, T, sums, ck, sk, pk, dpk)
     for j in range(n):
         t = sph[0, j]
         cos1 = sph[1, j]
@@ -371,12 +372,12 @@ def _correction_block(p, C, Cd, sph, n, T, sums, cor):
         cor[2, j] = sgn * F0 * R * (rUr - w * s0)
 
 
-def _lateral_block(p, Cg, corr_g, kin, sph, n, T, sums, lat):
+def _lateral_block(p, Cg, corr_g, kin, sph, n, T, sums, ck, sk, pk, dpk, lat):
     """G = ∬ x τ_y dA of the isotropic law into ``lat`` (`GeneralisedModel.lateral_moment`)."""
     R, F0 = p[0], p[1]
     q00, q01 = p[5], p[6]
     if corr_g:
-        _sums_block(Cg, Cg, sph[0], sph[1], sph[2], n, T, sums)
+        _sums_block(Cg, Cg, sph[0], sph[1], sph[2], n, T, sums, ck, sk, pk, dpk)
     for j in range(n):
         vx = kin[0, j]
         vy = kin[1, j]
@@ -434,7 +435,11 @@ def _loop(p, C, Cd, Cg, corr, corr_g, vx, vy, wz, fx, fy, mz):
     cor = np.empty((3, BLOCK))
     lat = np.empty(BLOCK)
     T = np.empty((L, BLOCK))
-    sums = np.empty((7, BLOCK))
+    sums = np.empty((3, BLOCK))
+    ck = np.empty(BLOCK)
+    sk = np.empty(BLOCK)
+    pk = np.empty(BLOCK)
+    dpk = np.empty(BLOCK)
     P = np.empty(BLOCK)
     y = np.empty(BLOCK)
     bits = P.view(np.int64)
@@ -445,9 +450,9 @@ def _loop(p, C, Cd, Cg, corr, corr_g, vx, vy, wz, fx, fy, mz):
         _inverse(P, y, m)
         _forces_block(p, kin, y, m, res, sph)
         if corr:
-            _correction_block(p, C, Cd, sph, m, T, sums, cor)
+            _correction_block(p, C, Cd, sph, m, T, sums, ck, sk, pk, dpk, cor)
         if p[15] != 1.0:
-            _lateral_block(p, Cg, corr_g, kin, sph, m, T, sums, lat)
+            _lateral_block(p, Cg, corr_g, kin, sph, m, T, sums, ck, sk, pk, dpk, lat)
         _store_block(p, corr, res, cor, lat, m, fx, fy, mz, b)
 
 
