@@ -310,9 +310,18 @@ def _sums_block(C, Cd, t, c1, s1, n, T, acc, ck, sk, pk, dpk):
         T[0, j] = 1.0
     for j in range(n):
         T[1, j] = 2.0 * t[j] - 1.0
+    # the recurrence runs on two rows of their own (ck, sk hold T_{m−1}, T_{m−2}
+    # until the harmonics need them): reading rows of T while writing another
+    # would fail the overlap check
+    for j in range(n):
+        ck[j] = 2.0 * t[j] - 1.0
+        sk[j] = 1.0
     for m in range(2, L):
         for j in range(n):
-            T[m, j] = (4.0 * t[j] - 2.0) * T[m - 1, j] - T[m - 2, j]
+            new = (4.0 * t[j] - 2.0) * ck[j] - sk[j]
+            T[m, j] = new
+            sk[j] = ck[j]
+            ck[j] = new
     s0[:n] = 0.0
     st[:n] = 0.0
     sth[:n] = 0.0
