@@ -40,27 +40,7 @@ from . import compiled
 AVAILABLE = compiled.AVAILABLE
 
 #: Order of the scalars in `KernelCoefficients.scalars`.
-SCALARS = (
-    "R",
-    "F0",
-    "U0",
-    "U0^5",
-    "U0^6",
-    "Q00",
-    "Q01",
-    "Q11",
-    "S00",
-    "S01",
-    "S11",
-    "gx",
-    "gy",
-    "xcx",
-    "xcy",
-    "alpha",
-    "g0",
-    "g1x",
-    "g1y",
-)
+SCALARS = tuple("R F0 U0 U0^5 U0^6 Q00 Q01 Q11 S00 S01 S11 gx gy xcx xcy alpha g0 g1x g1y".split())
 
 
 @dataclass(frozen=True)
@@ -89,28 +69,9 @@ def coefficients(model) -> KernelCoefficients:
     """Pack a `GeneralisedModel` for `evaluate` (off-diagonals from the upper triangle,
     as the numpy path reads them)."""
     U0 = model.U0
-    Q, S = model.Q, model.S
-    scalars = [
-        model.R,
-        model.F0,
-        U0,
-        U0**5,
-        U0**6,
-        Q[0, 0],
-        Q[0, 1],
-        Q[1, 1],
-        S[0, 0],
-        S[0, 1],
-        S[1, 1],
-        model.g[0],
-        model.g[1],
-        model.xc[0],
-        model.xc[1],
-        model.anisotropy,
-        model.g0,
-        model.g1[0],
-        model.g1[1],
-    ]
+    Q, S, g, xc, g1 = model.Q, model.S, model.g, model.xc, model.g1
+    scalars = [model.R, model.F0, U0, U0**5, U0**6, Q[0, 0], Q[0, 1], Q[1, 1], S[0, 0], S[0, 1]]
+    scalars += [S[1, 1], g[0], g[1], xc[0], xc[1], model.anisotropy, model.g0, g1[0], g1[1]]
     cg = np.zeros((1, 1)) if model.correction_g is None else model.correction_g
     C = model.correction
     # d/dt T_l(2t − 1) = 2 T_l'(x): chebder's scale 2
