@@ -2,21 +2,27 @@
 
 Times ``friction_resultants`` for 1,000 random kinematic points (half with the
 instantaneous centre of rotation inside the patch, half outside, a few pure
-sliding and pure spin) on the default friction grid, and compares with a fine
-grid. Errors are relative to the natural scales: |ΔF|/(fN) for Fx, Fy and
-|ΔM_z|/M0 with M0 = f∬σ r dA, the pure-spin torque.
+sliding and pure spin) on the default friction grid, before and after in one
+run: the numpy node sums (``backend="numpy"``, the implementation before the
+compiled one) and the compiled node sums (``backend="numba"``,
+`fepost.friction.nodesums`), medians of alternating runs; and compares both with
+a fine grid. Errors are relative to the natural scales: |ΔF|/(fN) for Fx, Fy and
+|ΔM_z|/M0 with M0 = f∬σ r dA, the pure-spin torque; ``numpy-numba`` is the
+largest difference between the two paths on the same grid (round-off).
 
-Run: ``.venv/bin/python benchmarks/bench_friction.py [--points 1000] [--nr 32 --nphi 64]``
+Run: ``.venv/bin/python benchmarks/bench_friction.py [--points 1000] [--nr 32 --nphi 64] [--threads 1]``
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
 
 from fepost.analytic import pressure_function
+from fepost.friction import nodesums
 from fepost.friction.exact import friction_resultants
 from fepost.friction.law import FrictionLaw
 from fepost.friction.quadrature import FRICTION_NPHI, FRICTION_NR, PressureQuadrature, edge_grid
@@ -48,15 +54,23 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--nr", type=int, default=FRICTION_NR)
     parser.add_argument("--nphi", type=int, default=FRICTION_NPHI)
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--threads", type=int, default=None, help="worker threads (default: CPU count)")
     args = parser.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     vx, vy, wz = kinematics(args.points, rng)
     law = FrictionLaw(f=0.8)
+    backends = ("numpy", "numba") if nodesums.AVAILABLE else ("numpy",)
+    load = os.getloadavg()[0]
     print(
         f"{args.points} kinematic points, grid {args.nr}x{args.nphi} (sine radial rule), "
-        f"reference grid 256x512"
+        f"reference grid 256x512; threads {args.threads or os.cpu_count()}; medians of {args.runs}"
     )
-    print(f"{'map':<18}{'time (s)':>10}{'max |dF|/fN':>14}{'max |dM|/M0':>14}{'inside':>8}")
+    if not nodesums.AVAILABLE:
+        print("(numba not installed: numpy node sums only; pip install fepost[fast])")
+    head = "".join(f"{'s, ' + b:>14}{'cpu s':>8}" for b in backends)
+    cols = f"{'speed-up':>10}{'max |dF|/fN':>13}{'max |dM|/M0':>13}{'numpy-numba':>13}{'inside':>8}"
+    print(f"{'map':<16}{head}{cols}")
     for profile, k_x in (
         ("hertz", 0.0),
         ("hertz", 0.13),
@@ -66,18 +80,38 @@ def main(argv: list[str] | None = None) -> None:
     ):
         quad = quadrature(profile, args.nr, args.nphi, k_x)
         fine = quadrature(profile, 256, 512, k_x)
-        friction_resultants(quad, vx[:8], vy[:8], wz[:8], law)  # warm up
-        t0 = time.perf_counter()
-        res = friction_resultants(quad, vx, vy, wz, law)
-        elapsed = time.perf_counter() - t0
+        times: dict[str, list[float]] = {b: [] for b in backends}
+        cpu: dict[str, list[float]] = {b: [] for b in backends}
+        res = {}
+        for b in backends:
+            friction_resultants(quad, vx[:8], vy[:8], wz[:8], law, backend=b)  # warm up (numba: compile)
+        for _ in range(args.runs):
+            for b in backends:
+                t0, c0 = time.perf_counter(), time.process_time()
+                res[b] = friction_resultants(quad, vx, vy, wz, law, backend=b, threads=args.threads)
+                times[b].append(time.perf_counter() - t0)
+                cpu[b].append(time.process_time() - c0)
         ref = friction_resultants(fine, vx, vy, wz, law)
         fn = law.f * fine.load
         m0 = law.f * float(fine.sigma @ (np.hypot(fine.x, fine.y) * fine.dA))
-        dF = max(np.max(np.abs(res.Fx - ref.Fx)), np.max(np.abs(res.Fy - ref.Fy))) / fn
-        dM = np.max(np.abs(res.Mz - ref.Mz)) / m0
+        last = res[backends[-1]]
+        dF = max(np.max(np.abs(last.Fx - ref.Fx)), np.max(np.abs(last.Fy - ref.Fy))) / fn
+        dM = np.max(np.abs(last.Mz - ref.Mz)) / m0
+        med = {b: float(np.median(t)) for b, t in times.items()}
+        up = med["numpy"] / med[backends[-1]]
+        same = 0.0
+        if len(backends) == 2:
+            a, c = res["numpy"], res["numba"]
+            same = max(
+                float(np.max(np.abs(a.Fx - c.Fx))) / fn,
+                float(np.max(np.abs(a.Fy - c.Fy))) / fn,
+                float(np.max(np.abs(a.Mz - c.Mz))) / m0,
+            )
         inside = np.count_nonzero(np.hypot(vx, vy) < np.abs(wz) * RADIUS)
+        cells = "".join(f"{med[b]:>14.3f}{float(np.median(cpu[b])):>8.3f}" for b in backends)
         name = f"{profile} k={k_x:g}"
-        print(f"{name:<18}{elapsed:>10.3f}{dF:>14.2e}{dM:>14.2e}{inside:>8d}")
+        print(f"{name:<16}{cells}{up:>10.1f}{dF:>13.2e}{dM:>13.2e}{same:>13.1e}{inside:>8d}")
+    print(f"load average before/after: {load:.2f} / {os.getloadavg()[0]:.2f} ({os.cpu_count()} CPUs)")
 
 
 if __name__ == "__main__":

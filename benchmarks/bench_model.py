@@ -12,8 +12,14 @@ both spin signs) of
 * ``model``: the generalised model (base + the fitted correction),
 
 as |ΔF|/F0 and |ΔM_z|/M0 against the exact Coulomb integrals, then the
-evaluation speed of the three (median of several runs on 10⁶ random points; the
-machine may be shared, so the ratio to the closed forms is the stable figure).
+evaluation speed (median of several alternating runs on 10⁶ random points) of
+the closed forms and of the base, the default model and a 204-number model, each
+by numpy and by the compiled kernel (`fepost.friction.kernel`, when numba is
+installed). The machine may be shared: the load average is printed, and the
+ratios (to the closed forms, numpy to kernel) are the stable figures. Run on one
+core for the one-core figures:
+
+``taskset -c 0 .venv/bin/python benchmarks/bench_model.py --speed-only``
 
 Run: ``.venv/bin/python benchmarks/bench_model.py [--order K L] [--n-beta 37 --n-t 65]``
 """
@@ -21,11 +27,13 @@ Run: ``.venv/bin/python benchmarks/bench_model.py [--order K L] [--n-beta 37 --n
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from pathlib import Path
 
 import numpy as np
 
+from fepost.friction import kernel
 from fepost.friction.accuracy import rolling_shift
 from fepost.friction.build import build_model
 from fepost.friction.closed_form import paper_coefficients, paper_model
@@ -36,6 +44,7 @@ from fepost.friction.sphere import error_map
 from fepost.friction.tensors import map_tensors
 
 F = 0.3
+LOAD = os.getloadavg()
 ASPECTS = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0)
 FAMILIES = {
     "uniform ellipse": lambda a: ellipse_quad("uniform", a),
@@ -109,30 +118,47 @@ def sample_rows(order, n_beta, n_t):
 
 
 def speed(model, runs: int = 7, n: int = 1_000_000) -> None:
+    """Evaluations per second on one thread: medians of ``runs`` alternating runs, by
+    wall clock and by the process's CPU time (the second is less sensitive to other
+    jobs on a shared machine, not to a busy sibling hyperthread)."""
     rng = np.random.default_rng(0)
     vx, vy = rng.normal(size=(2, n))
     wz = rng.normal(size=n) * 10.0
     paper = paper_model(model.F0, model.M0, 1.0, 8.0, 0.1, model.R)
     big = build_model(ellipse_quad("uniform", 3.0), FrictionLaw(f=F), order=(8, 12), check=False)
     K, L = model.order
-    cands = {
-        "paper closed forms": paper,
-        "base": model.without_correction(),
-        f"model ({(2 * K + 1) * L} numbers)": model,
-        "model (204 numbers)": big,
-    }
-    times = {k: [] for k in cands}
+    cands = {"paper closed forms": paper}
+    for label, m in (
+        ("base", model.without_correction()),
+        (f"model ({(2 * K + 1) * L} numbers)", model),
+        ("model (204 numbers)", big),
+    ):
+        cands[f"{label}, numpy"] = lambda a, b, c, m=m: m.evaluate(a, b, c, backend="numpy")
+        if kernel.AVAILABLE:
+            m.evaluate(vx[:8192], vy[:8192], wz[:8192], backend="numba")  # compile (or load the cache)
+            cands[f"{label}, numba kernel"] = lambda a, b, c, m=m: m.evaluate(a, b, c, backend="numba")
+    times: dict[str, list[float]] = {k: [] for k in cands}
+    cpu: dict[str, list[float]] = {k: [] for k in cands}
     for _ in range(runs):
         for k, fn in cands.items():
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             fn(vx, vy, wz)
             times[k].append(time.perf_counter() - t0)
+            cpu[k].append(time.process_time() - c0)
     ref = float(np.median(times["paper closed forms"]))
-    print("\n| evaluator | median s per 10^6 points | evaluations/s | time / closed forms |")
-    print("|---|---|---|---|")
+    print(f"\nload average before/after: {LOAD[0]:.2f} / {os.getloadavg()[0]:.2f} ({os.cpu_count()} CPUs)")
+    if not kernel.AVAILABLE:
+        print("(numba not installed: no kernel rows; pip install fepost[fast])")
+    print("| evaluator | median s per 10^6 points | evaluations/s (wall) | evaluations/s (CPU) ", end="")
+    print("| time / closed forms |")
+    print("|---|---|---|---|---|")
     for k, ts in times.items():
         med = float(np.median(ts))
-        print(f"| {k} | {med:.3f} | {n / med:.3g} | {med / ref:.2f} |")
+        print(f"| {k} | {med:.3f} | {n / med:.3g} | {n / float(np.median(cpu[k])):.3g} | {med / ref:.2f} |")
+    for label in ("base", f"model ({(2 * K + 1) * L} numbers)", "model (204 numbers)"):
+        if kernel.AVAILABLE:
+            r = float(np.median(times[f"{label}, numpy"]) / np.median(times[f"{label}, numba kernel"]))
+            print(f"kernel speed-up, {label}: {r:.1f}x")
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -40,6 +40,7 @@ from threadpoolctl import threadpool_limits
 
 from .._arrays import frozen
 from ..errors import ArgumentError
+from . import nodesums
 from .law import FrictionLaw
 from .quadrature import Ellipse, PressureQuadrature
 
@@ -74,7 +75,10 @@ class Resultants:
         return {"Fx": self.Fx.tolist(), "Fy": self.Fy.tolist(), "Mz": self.Mz.tolist()}
 
 
-def _kinematics(vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
+def checked_kinematics(vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
+    """``vx``, ``vy`` (m/s), ``wz`` (rad/s) as flat float arrays of their broadcast shape,
+    and that shape; `fepost.errors.ArgumentError` naming the argument for a value that
+    is not a finite number or shapes that do not broadcast."""
     arrays = {}
     for name, value, unit in (("vx", vx, "m/s"), ("vy", vy, "m/s"), ("wz", wz, "rad/s")):
         try:
@@ -223,6 +227,26 @@ def _g_and_gradient(quad, law, sigma_ref, px, py) -> tuple[np.ndarray, np.ndarra
     return g0, grads[0], grads[1]
 
 
+#: The node-sum backends of `friction_resultants`.
+BACKENDS = ("auto", "numba", "numpy")
+#: Kinematic points per task of the compiled node sums (threads share the tasks).
+KERNEL_BLOCK = 64
+#: ``backend="auto"`` takes the compiled node sums from this many (points × nodes)
+#: on: numpy needs about half a second for them, what importing numba costs once per
+#: process (a short command such as ``fepost coefficients`` stays with numpy).
+KERNEL_MIN_ELEMENTS = 1 << 24
+
+
+@dataclass(frozen=True)
+class _Setting:
+    """What one call integrates: the map, the law, σ_ref (Pa) and the subtraction order."""
+
+    quad: PressureQuadrature
+    law: FrictionLaw
+    sigma_ref: float
+    order: int
+
+
 def friction_resultants(
     quad: PressureQuadrature,
     vx,
@@ -232,6 +256,7 @@ def friction_resultants(
     *,
     subtract: bool | int = True,
     threads: int | None = None,
+    backend: str = "auto",
 ) -> Resultants:
     """Exact friction force (N) and torque (N·m) on the tire for each kinematic point.
 
@@ -242,6 +267,10 @@ def friction_resultants(
     2 (or ``True``, default) removes g(p0) + ∇g(p0)·(p − p0), 1 only g(p0),
     0 (or ``False``) integrates the raw discontinuous field (for studies only).
     ``threads``: worker threads over chunks of kinematic points (default: CPU count).
+    ``backend``: the node sums by ``"numba"`` (compiled, `fepost.friction.nodesums`,
+    the optional numba dependency; ~10x faster), ``"numpy"``, or ``"auto"`` (default:
+    numba when installed and the job has `KERNEL_MIN_ELEMENTS` points × nodes or
+    more); the same numbers to round-off.
     """
     if not isinstance(quad, PressureQuadrature):
         raise ArgumentError(f"quad must be a PressureQuadrature, got {type(quad).__name__}")
@@ -253,67 +282,111 @@ def friction_resultants(
         raise ArgumentError(f"subtract must be True, False, 0, 1 or 2, got {subtract!r}")
     if threads is not None and (isinstance(threads, bool) or int(threads) != threads or threads < 1):
         raise ArgumentError(f"threads must be a positive integer, got {threads!r}")
-    vx, vy, wz, shape = _kinematics(vx, vy, wz)
+    if backend not in BACKENDS:
+        raise ArgumentError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
+    if backend == "numba" and not nodesums.AVAILABLE:
+        raise ArgumentError("backend 'numba' needs numba (pip install fepost[fast]), which is not installed")
+    vx, vy, wz, shape = checked_kinematics(vx, vy, wz)
     sigma_ref = law.reference_pressure(quad.mean_pressure) if law.pressure_coef else 1.0
-    nodes = _nodes(quad, law, sigma_ref)
+    setting = _Setting(quad=quad, law=law, sigma_ref=sigma_ref, order=order)
+    workers = threads or os.cpu_count() or 1
+    big = vx.size * quad.x.size >= KERNEL_MIN_ELEMENTS
+    if backend == "numpy" or (backend == "auto" and not (nodesums.AVAILABLE and big)):
+        sx, sy = _numpy_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
+    else:
+        sx, sy = _compiled_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
+    with threadpool_limits(limits=1, user_api="blas"):
+        fx, fy, mz = _finish(setting, vx=vx, vy=vy, wz=wz, sx=sx, sy=sy)
+    return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))
+
+
+def _in_parallel(work, starts: range, workers: int) -> None:
+    """``work(start)`` for each start, on up to ``workers`` threads."""
+    if workers > 1 and len(starts) > 1:
+        with ThreadPoolExecutor(max_workers=min(workers, len(starts))) as pool:
+            list(pool.map(work, starts))
+    else:
+        for start in starts:
+            work(start)
+
+
+def _numpy_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.ndarray, np.ndarray]:
+    """The node sums (points, 7) by whole-array numpy and BLAS, over chunks of points."""
+    quad, law = setting.quad, setting.law
+    nodes = _nodes(quad, law, setting.sigma_ref)
     k = vx.size
     sx = np.zeros((k, nodes.bx.shape[1]))
     sy = np.zeros((k, nodes.by.shape[1]))
     block = max(1, CHUNK_ELEMENTS // max(1, quad.x.size))
-    starts = range(0, k, block)
 
     def work(start: int) -> None:
         sl = slice(start, start + block)
         sx[sl], sy[sl] = _chunk(nodes, law, vx[sl], vy[sl], wz[sl])
 
-    workers = threads or os.cpu_count() or 1
     # Parallel over chunks, one BLAS thread each: a multi-threaded BLAS under our
     # own thread pool oversubscribes the cores (5x slower on a busy 2-core machine).
     with threadpool_limits(limits=1, user_api="blas"):
-        if workers > 1 and len(starts) > 1:
-            with ThreadPoolExecutor(max_workers=min(workers, len(starts))) as pool:
-                list(pool.map(work, starts))
-        else:
-            for start in starts:
-                work(start)
-        return _finish(quad, law, sigma_ref, order, vx, vy, wz, sx, sy, shape)
+        _in_parallel(work, range(0, k, block), workers)
+    return sx, sy
 
 
-def _finish(quad, law, sigma_ref, order, vx, vy, wz, sx, sy, shape) -> Resultants:
-    """Resultants from the node sums, with the ICR subtraction where it applies."""
+def _compiled_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.ndarray, np.ndarray]:
+    """The node sums (points, 7) by the compiled loop (`fepost.friction.nodesums`)."""
+    quad, law = setting.quad, setting.law
+    g = law.f * law.pressure_factor(quad.sigma, setting.sigma_ref) * quad.sigma * quad.dA
+    x = np.ascontiguousarray(quad.x, float)
+    y = np.ascontiguousarray(quad.y, float)
+    weights = nodesums.columns(x, y, g, np.asarray(quad.dA, float))
     k = vx.size
+    sx = np.empty((k, 7))
+    sy = np.empty((k, 7))
 
-    alpha = law.anisotropy
+    def work(start: int) -> None:
+        sl = slice(start, start + KERNEL_BLOCK)
+        sx[sl], sy[sl] = nodesums.node_sums(
+            vx[sl], vy[sl], wz[sl], x=x, y=y, weights=weights, speed_coef=law.speed_coef
+        )
+
+    _in_parallel(work, range(0, k, KERNEL_BLOCK), workers)
+    return sx, sy
+
+
+def _finish(setting: _Setting, *, vx, vy, wz, sx, sy) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(F_x, F_y, M_z) from the node sums, with the ICR subtraction where it applies."""
+    alpha = setting.law.anisotropy
     fx = -sx[:, 0]
     fy = -alpha * sy[:, 0]
     mz = -(alpha * sy[:, 1] - sx[:, 1])
+    if not setting.order:
+        return fx, fy, mz
+    spin = wz != 0
+    p0x = np.zeros(vx.size)
+    p0y = np.zeros(vx.size)
+    p0x[spin] = -vy[spin] / wz[spin]
+    p0y[spin] = vx[spin] / wz[spin]
+    i = np.flatnonzero(spin & (setting.quad.domain.level(p0x, p0y) < 1.0))
+    if i.size:
+        dx, dy, dm = _subtraction(setting, px=p0x[i], py=p0y[i], sgn=np.sign(wz[i]), X=sx[i], Y=sy[i])
+        fx[i] += dx
+        fy[i] += dy
+        mz[i] += dm
+    return fx, fy, mz
 
-    if order:
-        spin = wz != 0
-        p0x = np.zeros(k)
-        p0y = np.zeros(k)
-        p0x[spin] = -vy[spin] / wz[spin]
-        p0y[spin] = vx[spin] / wz[spin]
-        i = np.flatnonzero(spin & (quad.domain.level(p0x, p0y) < 1.0))
-        if i.size:
-            _subtract(fx, fy, mz, i, quad, law, sigma_ref, order, sx, sy, p0x, p0y, np.sign(wz))
-    return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))
 
-
-def _subtract(fx, fy, mz, i, quad, law, sigma_ref, order, sx, sy, p0x, p0y, sgn) -> None:
-    """In place, for the points ``i`` whose ICR p0 is inside: swap the node sums of
-    L ŵ, L = g0 + G·(p − p0), for their exact integrals over the domain."""
-    px, py = p0x[i], p0y[i]
-    if order == 2:
-        g0, gx, gy = _g_and_gradient(quad, law, sigma_ref, px, py)
+def _subtraction(setting: _Setting, *, px, py, sgn, X, Y) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For points whose ICR p0 = (px, py) is inside, with node sums X, Y (rows of sx, sy):
+    the change of (F_x, F_y, M_z) when the node sums of L ŵ, L = g0 + G·(p − p0), are
+    swapped for their exact integrals over the domain."""
+    quad, law = setting.quad, setting.law
+    if setting.order == 2:
+        g0, gx, gy = _g_and_gradient(quad, law, setting.sigma_ref, px, py)
     else:
         s0 = np.asarray(quad.sigma_at(px, py), float)
-        g0 = law.f * law.pressure_factor(s0, sigma_ref) * s0
+        g0 = law.f * law.pressure_factor(s0, setting.sigma_ref) * s0
         gx = gy = np.zeros_like(g0)
     alpha = law.anisotropy
     c0 = g0 - gx * px - gy * py  # L = c0 + gx·x + gy·y
-    X = sx[i]  # columns 2..6: ŵx @ dA·(1, x, y, xy, y²)
-    Y = sy[i]  # columns 2..6: ŵy @ dA·(1, x, y, x², xy)
+    # columns 2..6 of X: ŵx @ dA·(1, x, y, xy, y²); of Y: ŵy @ dA·(1, x, y, x², xy)
     node_x = c0 * X[:, 2] + gx * X[:, 3] + gy * X[:, 4]
     node_y = c0 * Y[:, 2] + gx * Y[:, 3] + gy * Y[:, 4]
     node_m = alpha * (c0 * Y[:, 3] + gx * Y[:, 5] + gy * Y[:, 6]) - (
@@ -321,14 +394,11 @@ def _subtract(fx, fy, mz, i, quad, law, sigma_ref, order, sx, sy, p0x, p0y, sgn)
     )
     r = ray_integrals(quad.domain, px, py)
     ix, iy, cc, cs, ss, qccc, qccs, qcss, qsss = r.T
-    s = sgn[i]
-    exact_x = s * (-g0 * iy - (gx * cs + gy * ss))
-    exact_y = s * (g0 * ix + gx * cc + gy * cs)
-    exact_m = s * (
+    exact_x = sgn * (-g0 * iy - (gx * cs + gy * ss))
+    exact_y = sgn * (g0 * ix + gx * cc + gy * cs)
+    exact_m = sgn * (
         g0 * (alpha * px * ix + py * iy + alpha * cc + ss)
         + gx * (alpha * px * cc + py * cs + alpha * qccc + qcss)
         + gy * (alpha * px * cs + py * ss + alpha * qccs + qsss)
     )
-    fx[i] += node_x - exact_x
-    fy[i] += alpha * (node_y - exact_y)
-    mz[i] += node_m - exact_m
+    return node_x - exact_x, alpha * (node_y - exact_y), node_m - exact_m

@@ -54,6 +54,7 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from types import MappingProxyType
 from typing import Any
 
@@ -61,14 +62,20 @@ import numpy as np
 
 from .._arrays import frozen
 from ..errors import ArgumentError, DataError
-from . import basis
-from .exact import Resultants, _kinematics
+from . import basis, kernel
+from .exact import Resultants, checked_kinematics
 from .law import store_reals
 
 #: Format tag of the JSON export.
 FORMAT = "fepost-friction-model/1"
 #: Points per evaluation chunk (keeps the working arrays in cache-sized blocks).
 CHUNK = 1 << 14
+#: ``backend="auto"`` uses the compiled kernel (`fepost.friction.kernel`, needs numba)
+#: from this many points on: numpy takes a fraction of a second for them, about what
+#: importing numba costs once per process (fewer points stay with numpy).
+KERNEL_MIN_POINTS = 1 << 20
+#: The evaluation backends of `GeneralisedModel.evaluate`.
+BACKENDS = ("auto", "numba", "numpy")
 #: Weight exponents of the potential correction (pure spin, pure sliding) ...
 POTENTIAL_WEIGHT = (3, 2)
 #: ... and of the anisotropic-torque correction.
@@ -178,6 +185,7 @@ class GeneralisedModel:
                     raise ArgumentError(f"{name} must be positive and finite, got {value!r}")
             new.__dict__[name] = value
         new.__dict__["accuracy"] = MappingProxyType({})
+        new.__dict__.pop("kernel_coefficients", None)  # packed from the old numbers
         return new
 
     def without_correction(self) -> GeneralisedModel:
@@ -193,21 +201,43 @@ class GeneralisedModel:
         velocities ``vx``, ``vy`` (m/s) and spin ``wz`` (rad/s); arrays broadcast.
 
         No input checks beyond broadcasting (the fast path for time integration);
-        :meth:`resultants` checks its inputs.
+        :meth:`resultants` checks its inputs. Same as ``evaluate(vx, vy, wz)``.
         """
+        return self.evaluate(vx, vy, wz)
+
+    def evaluate(self, vx, vy, wz, *, backend: str = "auto") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """`__call__` with a choice of ``backend``: ``"numba"`` the compiled kernel
+        (`fepost.friction.kernel`, the optional numba dependency), ``"numpy"`` whole-array
+        numpy, ``"auto"`` (default) the kernel from `KERNEL_MIN_POINTS` points on when
+        numba is installed, numpy otherwise. All give the same numbers to round-off.
+        """
+        if backend not in BACKENDS:
+            raise ArgumentError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
+        if backend == "numba" and not kernel.AVAILABLE:
+            raise ArgumentError(
+                "backend 'numba' needs numba (pip install fepost[fast]), which is not installed"
+            )
         vx, vy, wz = np.broadcast_arrays(np.asarray(vx, float), np.asarray(vy, float), np.asarray(wz, float))
         shape = vx.shape
-        fvx, fvy, fwz = vx.ravel(), vy.ravel(), wz.ravel()
+        fvx, fvy, fwz = (np.ascontiguousarray(a.ravel()) for a in (vx, vy, wz))
         n = fvx.size
-        fx, fy, mz = np.empty(n), np.empty(n), np.empty(n)
-        for start in range(0, n, CHUNK):
-            sl = slice(start, start + CHUNK)
-            fx[sl], fy[sl], mz[sl] = self._evaluate(fvx[sl], fvy[sl], fwz[sl])
+        if backend == "numba" or (backend == "auto" and kernel.AVAILABLE and n >= KERNEL_MIN_POINTS):
+            fx, fy, mz = kernel.evaluate(self.kernel_coefficients, fvx, fvy, fwz)
+        else:
+            fx, fy, mz = np.empty(n), np.empty(n), np.empty(n)
+            for start in range(0, n, CHUNK):
+                sl = slice(start, start + CHUNK)
+                fx[sl], fy[sl], mz[sl] = self._evaluate(fvx[sl], fvy[sl], fwz[sl])
         return fx.reshape(shape), fy.reshape(shape), mz.reshape(shape)
+
+    @cached_property
+    def kernel_coefficients(self) -> kernel.KernelCoefficients:
+        """The numbers packed for the compiled kernel (computed once per model)."""
+        return kernel.coefficients(self)
 
     def resultants(self, vx, vy, wz) -> Resultants:
         """:meth:`__call__` with checked inputs, as a :class:`~fepost.friction.exact.Resultants`."""
-        vx, vy, wz, shape = _kinematics(vx, vy, wz)
+        vx, vy, wz, shape = checked_kinematics(vx, vy, wz)
         fx, fy, mz = self(vx, vy, wz)
         return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))
 
@@ -238,7 +268,9 @@ class GeneralisedModel:
 
     def _evaluate(self, vx, vy, wz):
         R, F0, U0 = self.R, self.F0, self.U0
-        u = wz * R
+        # every resultant is of degree 0 in (v, u): scale the largest component to 1,
+        # so that P ~ |v|⁶ neither underflows nor overflows (as the compiled kernel)
+        vx, vy, u = _normalised(vx, vy, wz * R)
         u2 = u * u
         v2 = vx * vx + vy * vy
         Q, S = self.Q, self.S
@@ -409,6 +441,13 @@ class GeneralisedModel:
         except json.JSONDecodeError as exc:
             raise DataError(f"model JSON is not valid JSON ({exc.msg} at line {exc.lineno})") from None
         return cls.from_dict(data)
+
+
+def _normalised(vx, vy, u):
+    """(v_x, v_y, u) over max(|v_x|, |v_y|, |u|) (zeros stay zeros)."""
+    s = np.maximum(np.maximum(np.abs(vx), np.abs(vy)), np.abs(u))
+    k = np.divide(1.0, s, out=np.zeros_like(s), where=s > 0)
+    return vx * k, vy * k, u * k
 
 
 def _sphere_coordinates(vx, vy, u):

@@ -1,0 +1,201 @@
+"""The compiled kernel of the generalised friction model (fepost.friction.kernel) against
+the numpy path, on many random kinematics and on the singular ones.
+
+Tolerance: IDENTITY (1e-12 of F0 for forces, of M0 for the torque): the two paths
+evaluate the same formulas in a different order (the kernel's P^(−5/6) by Newton
+steps, its atan by Cephes' rational form, its t-derivative by Chebyshev derivative
+coefficients), so they may differ by round-off only; measured ~3e-15.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from fepost.errors import ArgumentError
+from fepost.friction import kernel
+from fepost.friction import model as model_module
+from fepost.friction.build import build_model
+from fepost.friction.law import FrictionLaw
+from fepost.friction.model import GeneralisedModel
+from fepost.friction.reference_maps import asymmetric, ellipse_quad, tire_like
+
+pytest.importorskip("numba", reason="numba (the optional 'fast' extra) is not installed")
+
+IDENTITY = 1e-12
+
+
+@pytest.fixture(scope="module")
+def models() -> dict[str, GeneralisedModel]:
+    hertz = build_model(ellipse_quad("hertz", 1.5), FrictionLaw(f=0.3), order=(4, 8), check=False)
+    return {
+        "hertz 72": hertz,
+        "asymmetric 72": build_model(asymmetric(2.0), FrictionLaw(f=0.3), order=(4, 8), check=False),
+        "tire-like 204": build_model(tire_like(2.5), FrictionLaw(f=0.5), order=(8, 12), check=False),
+        "anisotropic": build_model(
+            asymmetric(1.5), FrictionLaw(f=0.3, anisotropy=0.7), order=(4, 8), check=False
+        ),
+        "odd order (3, 5)": build_model(ellipse_quad("uniform", 2.0), FrictionLaw(f=0.4), order=(3, 5)),
+        "base only": hertz.without_correction(),
+        "substituted": hertz.substituted(F0=2.0 * hertz.F0, g=[0.05, -0.02], xc=[0.1, 0.03]),
+    }
+
+
+def singular_kinematics() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pure spin (both signs), pure sliding (all directions), zero velocity, their
+    neighbourhoods (ε and 1/ε down to 1e-12) and extreme magnitudes."""
+    ang = np.linspace(0.0, 2.0 * np.pi, 13)
+    rows = [(0.0, 0.0, 0.0), (0.0, 0.0, 3.0), (0.0, 0.0, -3.0), (-0.0, 0.0, -0.0)]
+    rows += [(np.cos(a), np.sin(a), 0.0) for a in ang]
+    for eps in (1e-12, 1e-9, 1e-6, 1e-3):
+        for a in ang[::3]:
+            for s in (1.0, -1.0):
+                rows.append((eps * np.cos(a), eps * np.sin(a), s * 10.0))  # near pure spin (R ~ 0.1 m)
+                rows.append((np.cos(a), np.sin(a), s * eps))  # near pure sliding
+    for scale in (1e-200, 1e-60, 1e60, 1e200):
+        rows += [(scale, -0.5 * scale, 7.0 * scale), (0.0, 0.0, scale), (scale, 0.0, 0.0)]
+    vx, vy, wz = np.array(rows, float).T
+    return vx, vy, wz
+
+
+def random_kinematics(n: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    vx, vy = rng.normal(size=(2, n)) * np.exp(rng.uniform(-5, 5, n))
+    wz = rng.normal(size=n) * np.exp(rng.uniform(-3, 5, n))
+    return vx, vy, wz
+
+
+def assert_same(model, got, ref):
+    for name, a, b in zip(("Fx", "Fy", "Mz"), got, ref, strict=True):
+        scale = model.M0 if name == "Mz" else model.F0
+        assert np.all(np.isfinite(a)), name
+        err = np.max(np.abs(a - b)) / scale
+        assert err <= IDENTITY, f"{name}: {err:.3g}"
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "hertz 72",
+        "asymmetric 72",
+        "tire-like 204",
+        "anisotropic",
+        "odd order (3, 5)",
+        "base only",
+        "substituted",
+    ],
+)
+def test_kernel_equals_numpy_on_random_and_singular_kinematics(models, name):
+    model = models[name]
+    vx, vy, wz = random_kinematics(20_000, seed=len(name))
+    svx, svy, swz = singular_kinematics()
+    vx, vy, wz = (np.concatenate([a, b]) for a, b in ((vx, svx), (vy, svy), (wz, swz)))
+    ref = model.evaluate(vx, vy, wz, backend="numpy")
+    got = model.evaluate(vx, vy, wz, backend="numba")
+    assert_same(model, got, ref)
+
+
+def test_singular_points_have_their_exact_limits(models):
+    """Independent of the numpy path (module docstring of fepost.friction.model): zero
+    velocity gives zero, pure spin the torque −sgn(ω_z) M0, pure sliding along x the
+    force −F0 along x and none across."""
+    model = models["hertz 72"]
+    fx, fy, mz = model.evaluate(
+        [0.0, 0.0, 0.0, 2.0], [0.0, 0.0, 0.0, 0.0], [0.0, 5.0, -5.0, 0.0], backend="numba"
+    )
+    assert (fx[0], fy[0], mz[0]) == (0.0, 0.0, 0.0)
+    assert mz[1] == pytest.approx(-model.M0, rel=IDENTITY)
+    assert mz[2] == pytest.approx(model.M0, rel=IDENTITY)
+    assert fx[3] == pytest.approx(-model.F0, rel=IDENTITY)
+    assert abs(fy[3]) <= IDENTITY * model.F0
+
+
+def test_auto_backend_switches_at_the_threshold(models, monkeypatch):
+    monkeypatch.setattr(model_module, "KERNEL_MIN_POINTS", 64)
+    model = models["asymmetric 72"]
+    vx, vy, wz = random_kinematics(64, seed=3)
+    big = model(vx, vy, wz)
+    for a, b in zip(big, model.evaluate(vx, vy, wz, backend="numba"), strict=True):
+        np.testing.assert_array_equal(a, b)
+    small = model(vx[:10], vy[:10], wz[:10])
+    for a, b in zip(small, model.evaluate(vx[:10], vy[:10], wz[:10], backend="numpy"), strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_shapes_broadcast_and_inputs_stay_untouched(models):
+    model = models["hertz 72"]
+    vx = np.linspace(-1, 1, 6).reshape(2, 3)
+    keep = vx.copy()
+    fx, fy, mz = model.evaluate(vx, 0.1, np.array([[1.0], [-2.0]]), backend="numba")
+    assert fx.shape == fy.shape == mz.shape == (2, 3)
+    np.testing.assert_array_equal(vx, keep)
+    ref = model.evaluate(vx, 0.1, np.array([[1.0], [-2.0]]), backend="numpy")
+    assert_same(model, (fx, fy, mz), ref)
+
+
+def test_substituted_model_is_repacked(models):
+    model = models["hertz 72"]
+    _ = model.kernel_coefficients  # packed and cached ...
+    other = model.substituted(F0=3.0 * model.F0, M0=3.0 * model.M0)  # same Û0: the model scales
+    vx, vy, wz = random_kinematics(100, seed=5)
+    old = model.evaluate(vx, vy, wz, backend="numba")
+    new = other.evaluate(vx, vy, wz, backend="numba")
+    for a, b, scale in zip(new, old, (model.F0, model.F0, model.M0), strict=True):
+        np.testing.assert_allclose(a, 3.0 * b, rtol=0, atol=IDENTITY * scale)
+
+
+def test_bad_backend_names_the_argument(models):
+    with pytest.raises(
+        ArgumentError, match=re.escape("backend must be one of auto, numba, numpy, got 'gpu'")
+    ):
+        models["hertz 72"].evaluate(0.1, 0.0, 1.0, backend="gpu")
+
+
+def test_newton_root_covers_every_normal_double():
+    """The kernel's P^(−5/6) (bit-pattern guess + Newton) over the whole normal range
+    and below `kernel._TINY` (where the kernel falls back to pow), against an
+    extended-precision power: double pow itself is off by up to 3e-14 there (−5/6 is
+    rounded, and ln P reaches 700), the Newton steps by at most 16 ulp (y to ~2 ulp: the
+    round-off of P y⁶ in the fixed point; then 5x that in y⁵, plus its three roundings)."""
+    if np.finfo(np.longdouble).eps > 1e-18:
+        pytest.skip("needs an extended-precision long double for the reference")
+    P = np.concatenate([np.exp(np.linspace(-700, 700, 20001)), [1e-300, 5e-310, 0.0, -1.0]])
+    y = np.empty_like(P)
+    y.view(np.int64)[:] = kernel._MAGIC - P.view(np.int64) // 6
+    kernel.prepare()
+    kernel._inverse(P, y, P.size)
+    live = P > 0
+    ref = P[live].astype(np.longdouble) ** (np.longdouble(-5) / np.longdouble(6))
+    err = np.abs(y[live].astype(np.longdouble) / ref - 1)
+    assert float(np.max(err[P[live] >= kernel._TINY])) <= 16 * np.finfo(float).eps
+    assert float(np.max(err)) <= 1e-13  # pow where P < _TINY: its exponent's rounding x ln P
+    assert np.all(y[~live] == 0.0)
+
+
+def test_atan_matches_the_library_to_round_off():
+    rng = np.random.default_rng(0)
+    y = np.abs(rng.normal(size=5000)) * np.exp(rng.uniform(-30, 30, 5000))
+    x = np.abs(rng.normal(size=5000)) * np.exp(rng.uniform(-30, 30, 5000))
+    y[:3], x[:3] = (0.0, 1.0, 2.0), (1.0, 0.0, 2.0)
+    kernel.prepare()
+    got = np.array([kernel._atan_ratio(a, b) for a, b in zip(y, x, strict=True)])
+    np.testing.assert_allclose(got, np.arctan2(y, x), rtol=4e-16, atol=0)
+
+
+def test_short_jobs_do_not_import_numba():
+    """numba's import (~1 s) stays off short commands: the model and the exact
+    integrals at their default backend below the thresholds never load it."""
+    code = (
+        "import sys\n"
+        "from fepost.friction.build import build_model\n"
+        "from fepost.friction.law import FrictionLaw\n"
+        "from fepost.friction.reference_maps import ellipse_quad\n"
+        "m = build_model(ellipse_quad('hertz', 1.5), FrictionLaw(f=0.3), order=(4, 8))\n"
+        "m([0.1] * 5000, 0.0, 1.0)\n"
+        "assert 'numba' not in sys.modules, 'numba was imported'\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=300)
