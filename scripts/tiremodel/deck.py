@@ -44,21 +44,19 @@ CASES = {
 }
 
 
-def write_deck(
-    path,
-    mesh: TireMesh,
-    case: LoadCase,
-    rim_travel: float,
-    inflation_only: bool = False,
-) -> dict:
-    """Write the deck; ``rim_travel`` is the total downward rim displacement (m)."""
+def model_lines(mesh: TireMesh, title: str, road=None) -> list[str]:
+    """Deck lines of the model (nodes, elements, sets, surfaces, materials, cyclic
+    equations, contact pair), everything before the boundary conditions and steps.
+
+    ``road``: the road block (default ``ccxdeck.build_road()``).
+    """
     p = mesh.params
-    road = cx.build_road()
+    road = cx.build_road() if road is None else road
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
     out = []
     w = out.append
     w("*HEADING")
-    w(f"fepost tire sector, case {case.name}")
+    w(title)
     out += cx.node_block(mesh.nodes, road)
     out += cx.element_block("C3D8I", "TIRE", range(1, et + 1), mesh.hexes)
     out += cx.road_elements(road, nt, et)
@@ -76,7 +74,6 @@ def write_deck(
     bead = set(int(n) for n in mesh.bead_nodes)
     ref = int(mesh.bead_nodes[0]) + 1
     w("*EQUATION")
-    n_eq = 0
     for n in mesh.cut_nodes:
         n = int(n)
         if n in bead:
@@ -92,8 +89,25 @@ def write_deck(
         (d1, c1), (d2, c2) = terms
         w(f"{n + 1}, {d1}, {c1:.9f}, {n + 1}, {d2}, {c2:.9f}, ")
         out[-1] += f"{ref}, {d1}, {-c1:.9f}, {ref}, {d2}, {-c2:.9f}"
-        n_eq += 1
     out += cx.contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE, CONTACT_TYPE)
+    return out
+
+
+def write_deck(
+    path,
+    mesh: TireMesh,
+    case: LoadCase,
+    rim_travel: float,
+    inflation_only: bool = False,
+) -> dict:
+    """Write the deck; ``rim_travel`` is the total downward rim displacement (m)."""
+    road = cx.build_road()
+    nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
+    out = model_lines(mesh, f"fepost tire sector, case {case.name}", road)
+    w = out.append
+    bead = set(int(n) for n in mesh.bead_nodes)
+    n_eq = sum(1 for n in mesh.cut_nodes if int(n) not in bead)
+    table = face_lookup(mesh.hexes)
     w("*BOUNDARY")
     w("ROADN, 1, 3")
     w("BEAD, 1, 3")
