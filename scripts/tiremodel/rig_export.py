@@ -202,6 +202,7 @@ def write_run(mesh: TireMesh, res: RunResult, out: Path, info: dict, origin=(0.0
         "over the deformed contact faces: Fx, Fy (N), Mz about the origin (N m), N (N)",
         "history": _history_block(res, origin),
         "friction": dk.FRICTION,
+        "units": "SI (m, N, Pa)",
         "arrays": ARRAYS,
         "deck_sha256": res.deck_sha256,
         "runtime_s": round(res.runtime_s, 1),
