@@ -55,6 +55,17 @@ def test_moment_is_transferred_to_the_origin():
     assert r.Mz == pytest.approx(-10.0)
 
 
+def test_force_is_turned_into_the_tire_frame():
+    # the tire turned by +90 degrees: the road's -x is the tire's +y; Mz is frame-free,
+    # taken about the moved origin (1, 0): the force (-1, 0) at the reference (0, 0) gives 0
+    r = reaction_resultants([-1.0, 0.0, 10.0], [0.0, 0.0, 2.0], [0.0, 0.0], [1.0, 0.0], math.pi / 2)
+    assert (r.Fx, r.Fy) == pytest.approx((0.0, 1.0))
+    assert r.Mz == pytest.approx(2.0)
+    r = reaction_resultants([0.0, -1.0, 10.0], [0.0, 0.0, 0.0], [0.0, 0.0], [1.0, 0.0], math.pi / 2)
+    assert (r.Fx, r.Fy) == pytest.approx((-1.0, 0.0))
+    assert r.Mz == pytest.approx(1.0)  # (0 - 1) * (-1) - 0
+
+
 # ---------------------------------------------------------------- bad input
 
 
@@ -74,8 +85,9 @@ def _good() -> dict:
             "force": [-3000.0, 0.0, 10000.0],
             "moment": [0.0, 0.0, 0.0],
             "ref_position": [0.0, 0.0, 0.0],
-            "ref_displacement": [-0.03, 0.0, 0.0],
+            "ref_displacement": [0.0, 0.0, 0.0],
         },
+        "tire_motion": {"rotation_z": 0.0, "origin_position": [0.03, 0.0]},
         "units": "SI (m, N, Pa)",
     }
 
@@ -95,6 +107,8 @@ def test_good_sidecar_reads(tmp_path):
         (lambda d: d.pop("origin"), "missing key 'origin'"),
         (lambda d: d["reaction"]["force"].__setitem__(0, float("nan")), "not finite"),
         (lambda d: d["kinematics"].__setitem__("vx", "fast"), "must be a number"),
+        (lambda d: d["tire_motion"].pop("rotation_z"), "tire_motion.rotation_z must be a number"),
+        (lambda d: d["tire_motion"].__setitem__("origin_position", [1.0]), "origin_position must be"),
         (lambda d: d.__setitem__("units", "mm-t-s"), "units 'mm-t-s' not supported"),
         (lambda d: d["reaction"]["force"].__setitem__(2, -5.0), "N > 0"),
         (lambda d: d["reaction"].__setitem__("force", [1.0, 2.0]), "must be a list of 3 numbers"),

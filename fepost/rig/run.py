@@ -11,13 +11,21 @@ A rig run is an FE export (``<run>.vtu`` or any other mesh) with a sidecar
                 road's constraint: ``force`` [3] (N) at the reference node,
                 ``moment`` [3] (N m) about the reference node's current
                 position ``ref_position`` + ``ref_displacement`` (m)
+``tire_motion`` optional {``rotation_z``, ``origin_position``}: when the tire
+                (not the road) was moved, the angle (rad) by which the tire's
+                frame is turned against the road's at the end of the run and
+                where the static patch origin then is (m, road's frame); the
+                reactions are in the road's frame. Default: no rotation, the
+                origin where it was.
 ``units``       optional; when present it must name SI (m, N, Pa)
 
 Signs. The solver's reaction at the road's constraint is the force the support
 exerts on the road; the road is in equilibrium between the support and the
 tire, so this reaction equals the force of the road on the tire, which is what
-the measured data hold. The moment is transferred from the reference node to
-the origin o: Mz(o) = Mz(ref) + (r_ref - o) x F.
+the measured data hold. The force is turned into the tire's frame,
+F_tire = Rot(-rotation_z) F, and the moment is transferred from the reference
+node to the moved origin o: Mz(o) = Mz(ref) + (r_ref - o) x F (Mz is the same
+in both frames).
 """
 
 from __future__ import annotations
@@ -122,15 +130,18 @@ def _check_units(side: Path, data: dict) -> None:
         raise DataError(f"{side}: units {units!r} not supported (the rig sidecar must be in SI: m, N, Pa)")
 
 
-def reaction_resultants(force, moment, ref, origin) -> Resultants:
+def reaction_resultants(force, moment, ref, origin, rotation: float = 0.0) -> Resultants:
     """Road-on-tire resultants from the solver's reaction at the road's reference node.
 
     ``force``, ``moment``: the reaction (N, N m) at the reference node, which sits
-    at ``ref`` (m, current position); ``origin``: the static patch origin (m).
+    at ``ref`` (m, current position), in the road's frame; ``origin``: the static
+    patch origin (m, road's frame, where it is at the end of the run);
+    ``rotation``: angle (rad) of the tire's frame against the road's.
     """
     fx, fy, fz = (float(v) for v in force)
     dx, dy = float(ref[0]) - float(origin[0]), float(ref[1]) - float(origin[1])
-    return Resultants(Fx=fx, Fy=fy, Mz=float(moment[2]) + dx * fy - dy * fx, N=fz)
+    c, s = math.cos(rotation), math.sin(rotation)
+    return Resultants(Fx=c * fx + s * fy, Fy=-s * fx + c * fy, Mz=float(moment[2]) + dx * fy - dy * fx, N=fz)
 
 
 def read_run(path, *, shear: bool = True) -> RigRun:
@@ -149,8 +160,15 @@ def read_run(path, *, shear: bool = True) -> RigRun:
     rec = _block(side, data, "reaction")
     force = _vector(side, rec, "force", "reaction")
     moment = _vector(side, rec, "moment", "reaction")
-    ref = np.add(_vector(side, rec, "ref_position", "reaction"), _vector(side, rec, "ref_displacement", "reaction"))
-    res = reaction_resultants(force, moment, ref, o)
+    ref = np.add(
+        _vector(side, rec, "ref_position", "reaction"), _vector(side, rec, "ref_displacement", "reaction")
+    )
+    rotation, moved = 0.0, o[:2]
+    if "tire_motion" in data:
+        mot = _block(side, data, "tire_motion")
+        rotation = _number(side, "tire_motion.rotation_z", mot.get("rotation_z", "missing"))
+        moved = _vector(side, mot, "origin_position", "tire_motion", sizes=(2, 3))
+    res = reaction_resultants(force, moment, ref, moved, rotation)
     if not res.N > 0.0:
         raise DataError(f"{side}: reaction.force z = {res.N:g} N; the road must push the tire up (N > 0)")
     sh = None

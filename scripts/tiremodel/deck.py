@@ -44,11 +44,21 @@ CASES = {
 }
 
 
-def model_lines(mesh: TireMesh, title: str, road=None) -> list[str]:
+def cut_nodes(mesh: TireMesh) -> list[int]:
+    """0-based indices of the sector cut-face nodes that carry an equation (bead nodes excluded)."""
+    bead = set(int(n) for n in mesh.bead_nodes)
+    return [int(n) for n in mesh.cut_nodes if int(n) not in bead]
+
+
+def model_lines(mesh: TireMesh, title: str, road=None, cut_refs: int | None = None) -> list[str]:
     """Deck lines of the model (nodes, elements, sets, surfaces, materials, cyclic
     equations, contact pair), everything before the boundary conditions and steps.
 
-    ``road``: the road block (default ``ccxdeck.build_road()``).
+    ``road``: the road block (default ``ccxdeck.build_road()``). ``cut_refs``:
+    if given, each cut-face node gets its own reference node (numbers from
+    ``cut_refs`` on, in the order of ``cut_nodes``, at the cut node's position,
+    set CUTREF) instead of the one bead node, so that a rigid motion of the rim
+    that is not a rotation about the axle can be prescribed at the cut faces too.
     """
     p = mesh.params
     road = cx.build_road() if road is None else road
@@ -71,13 +81,16 @@ def model_lines(mesh: TireMesh, title: str, road=None) -> list[str]:
     w(cx.ROAD_SECTION)
     # sector cut faces: tangential displacement equals the rim's (rigid-rim
     # cyclic condition): t . u_node - t . u_ref = 0, t = circumferential direction
-    bead = set(int(n) for n in mesh.bead_nodes)
     ref = int(mesh.bead_nodes[0]) + 1
+    if cut_refs is not None:
+        w("*NODE, NSET=CUTREF")
+        for i, n in enumerate(cut_nodes(mesh)):
+            x, y, z = mesh.nodes[n]
+            w(f"{cut_refs + i}, {x:.9e}, {y:.9e}, {z:.9e}")
     w("*EQUATION")
-    for n in mesh.cut_nodes:
-        n = int(n)
-        if n in bead:
-            continue
+    for i, n in enumerate(cut_nodes(mesh)):
+        if cut_refs is not None:
+            ref = cut_refs + i
         x, _, z = mesh.nodes[n]
         rx, rz = x, z - p.axle_z
         rr = math.hypot(rx, rz)
@@ -105,8 +118,7 @@ def write_deck(
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
     out = model_lines(mesh, f"fepost tire sector, case {case.name}", road)
     w = out.append
-    bead = set(int(n) for n in mesh.bead_nodes)
-    n_eq = sum(1 for n in mesh.cut_nodes if int(n) not in bead)
+    n_eq = len(cut_nodes(mesh))
     table = face_lookup(mesh.hexes)
     w("*BOUNDARY")
     w("ROADN, 1, 3")

@@ -20,6 +20,7 @@ Frames and signs (checked in the first runs and by ``fepost rig``'s tests):
 from __future__ import annotations
 
 import json
+import math
 import os
 from pathlib import Path
 
@@ -33,11 +34,11 @@ from .rig_run import RunResult
 
 ARRAYS = {
     "CPRESS": "contact pressure at the end of the slide (CalculiX CPRESS), Pa, >= 0",
-    "shear": "shear traction of the road on the tire at the end of the slide, Pa, "
-    "(tau_x, tau_y, 0) = -(CSHEAR1, CSHEAR2, 0) of CalculiX (which are on the road)",
-    "slip": "accumulated tangential slip (CSLIP1, CSLIP2, 0) as CalculiX writes it, m",
-    "displacement": "nodal displacement at the end of the slide (CalculiX U), m; "
-    "deformed = points + displacement",
+    "shear": "shear traction of the road on the tire at the end of the slide, Pa, in the tire's "
+    "frame: (tau_x, tau_y, 0) = -Rot(-wz t)(CSHEAR1, CSHEAR2) of CalculiX (which act on the road)",
+    "slip": "accumulated tangential slip (CSLIP1, CSLIP2, 0) as CalculiX writes it, m (road's frame)",
+    "displacement": "nodal displacement at the end of the slide without the rim's rigid motion, "
+    "tire's frame, m; deformed = points + displacement (CalculiX U, moved back by the rim's motion)",
 }
 STATIC_ARRAYS = {
     "CPRESS": "contact pressure after the vertical load, before the slide (CalculiX CPRESS), Pa",
@@ -79,26 +80,62 @@ def _write_text(path: Path, text: str) -> None:
     os.replace(tmp, path)
 
 
-def moment_about_origin(res: RunResult, origin=(0.0, 0.0)) -> np.ndarray:
-    """Mz of the road on the tire about ``origin`` per increment (N m), from the printed reactions."""
+def tire_frame(res: RunResult, t: float, origin=(0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+    """(rotation Rot(-wz t) from the road's frame to the tire's, moved position of the origin) at ``t``."""
+    th, a = rd.tire_motion(res.kin, origin, float(t))
+    c, s = math.cos(th), math.sin(th)
+    return np.array([[c, s], [-s, c]]), a @ np.array([origin[0], origin[1], 1.0])
+
+
+def resultants(res: RunResult, origin=(0.0, 0.0)) -> np.ndarray:
+    """(k, 3): Fx, Fy of the road on the tire in the tire's frame (N) and Mz about the moved origin (N m)."""
     h = res.history
-    ref = np.asarray(res.nodes.ref_xy) + h.ref_u[:, :2]
-    d = ref - np.asarray(origin)
-    return h.rot_rf[:, 2] + d[:, 0] * h.ref_rf[:, 1] - d[:, 1] * h.ref_rf[:, 0]
+    out = np.zeros((h.time.size, 3))
+    for i, t in enumerate(h.time):
+        rot, c_t = tire_frame(res, t, origin)
+        f = h.ref_rf[i, :2]
+        ref = np.asarray(res.nodes.ref_xy) + h.ref_u[i, :2]
+        d = ref - c_t
+        out[i, :2] = rot @ f
+        out[i, 2] = h.rot_rf[i, 2] + d[0] * f[1] - d[1] * f[0]
+    return out
+
+
+def tire_fields(mesh: TireMesh, res: RunResult, origin=(0.0, 0.0)):
+    """Contact-surface fields at the end of the slide in the tire's frame.
+
+    Returns (points, quads, displacement without the rim's rigid motion, shear
+    traction of the road on the tire, CPRESS, slip as CalculiX writes it).
+    """
+    pts, quads, used = contact_surface(mesh)
+    rot, _ = tire_frame(res, res.history.time[-1], origin)
+    _, a = rd.tire_motion(res.kin, origin, float(res.history.time[-1]))
+    y = pts + res.u[used]  # deformed, road's frame
+    # back to the tire's frame: invert x -> R x + b
+    back = (y[:, :2] - a[:, 2]) @ rot.T
+    disp = np.column_stack([back - pts[:, :2], res.u[used, 2]])
+    c = res.contact
+    tau = np.column_stack([-c["CSHEAR1"][used], -c["CSHEAR2"][used]]) @ rot.T
+    zero = np.zeros(used.size)
+    return (
+        pts,
+        quads,
+        disp,
+        np.column_stack([tau, zero]),
+        np.clip(c["CPRESS"][used], 0.0, None),
+        np.column_stack([c["CSLIP1"][used], c["CSLIP2"][used], zero]),
+    )
 
 
 def shear_resultants(mesh: TireMesh, res: RunResult, origin=(0.0, 0.0)) -> dict:
-    """Integrals of the exported shear traction and pressure over the deformed contact faces."""
-    pts, quads, used = contact_surface(mesh)
-    x = pts + res.u[used]
-    tx = -res.contact["CSHEAR1"][used]
-    ty = -res.contact["CSHEAR2"][used]
-    cp = np.clip(res.contact["CPRESS"][used], 0.0, None)
+    """Integrals of the shear traction and pressure over the deformed contact faces, tire's frame."""
+    pts, quads, disp, tau, cp, _ = tire_fields(mesh, res, origin)
+    x = pts + disp
     dx, dy = x[:, 0] - origin[0], x[:, 1] - origin[1]
     return {
-        "Fx": quad_integral(x, quads, tx),
-        "Fy": quad_integral(x, quads, ty),
-        "Mz": quad_integral(x, quads, dx * ty - dy * tx),
+        "Fx": quad_integral(x, quads, tau[:, 0]),
+        "Fy": quad_integral(x, quads, tau[:, 1]),
+        "Mz": quad_integral(x, quads, dx * tau[:, 1] - dy * tau[:, 0]),
         "N": quad_integral(x, quads, cp),
     }
 
@@ -134,36 +171,29 @@ def write_static(mesh: TireMesh, res: RunResult, out: Path, info: dict) -> dict:
 
 def _history_block(res: RunResult, origin) -> dict:
     h = res.history
-    path = np.hypot(h.ref_u[:, 0], h.ref_u[:, 1])  # the reference node's travel (pure sliding)
     kin = res.kin
     # reference sliding path of the run at each increment: |v| t and |wz| R_REF t in quadrature
     ref_path = np.hypot(kin.vx, kin.vy) ** 2 + (kin.wz * rd.R_REF) ** 2
+    r = resultants(res, origin)
     return {
         "time": _vec(h.time, 6),
         "path": _vec(np.sqrt(ref_path) * h.time, 6),
-        "Fx": _vec(h.ref_rf[:, 0]),
-        "Fy": _vec(h.ref_rf[:, 1]),
+        "Fx": _vec(r[:, 0]),
+        "Fy": _vec(r[:, 1]),
         "Fz": _vec(h.ref_rf[:, 2]),
-        "Mz": _vec(moment_about_origin(res, origin)),
-        "road_rotation": _vec(h.rot_u[:, 2]),
-        "ref_travel": _vec(path, 6),
-        "note": "per increment of the slide step: time = pseudo-time t in [0, 1]; path = "
-        "sqrt(|v|^2 + (wz R_ref)^2) t (m, R_ref = rig reference radius); F: road's force on "
-        "the tire (N); Mz: about the static patch origin (N m); road_rotation: rad",
+        "Mz": _vec(r[:, 2]),
+        "tire_rotation": _vec(kin.wz * h.time),
+        "note": "per increment of the slide: time = pseudo-time t in [0, 1]; path = "
+        "sqrt(|v|^2 + (wz R_ref)^2) t (m, R_ref = rig reference radius); Fx, Fy: road's force "
+        "on the tire in the tire's frame (N); Mz about the (moved) static patch origin (N m); "
+        "tire_rotation: the rim's rotation wz t (rad)",
     }
 
 
 def write_run(mesh: TireMesh, res: RunResult, out: Path, info: dict, origin=(0.0, 0.0)) -> dict:
     """Write ``<run>.vtu``, ``<run>.dat.txt`` and ``<run>.json`` into ``out``; return the sidecar."""
-    pts, quads, used = contact_surface(mesh)
-    c = res.contact
-    zero = np.zeros(used.size)
-    arrays = {
-        "CPRESS": np.clip(c["CPRESS"][used], 0.0, None),
-        "shear": np.column_stack([-c["CSHEAR1"][used], -c["CSHEAR2"][used], zero]),
-        "slip": np.column_stack([c["CSLIP1"][used], c["CSLIP2"][used], zero]),
-        "displacement": res.u[used],
-    }
+    pts, quads, disp, tau, cp, slip = tire_fields(mesh, res, origin)
+    arrays = {"CPRESS": cp, "shear": tau, "slip": slip, "displacement": disp}
     out.mkdir(parents=True, exist_ok=True)
     _write_vtu(out / f"{res.name}.vtu", pts, quads, arrays)
     _write_text(out / f"{res.name}.dat.txt", res.dat_excerpt)
@@ -178,8 +208,9 @@ def write_run(mesh: TireMesh, res: RunResult, out: Path, info: dict, origin=(0.0
         "kinematics_units": "m and rad per unit pseudo-time (quasi-static: only the direction "
         "of (vx, vy) and the ratio wz R / |v| matter)",
         "kinematics_definition": "sliding velocity (vx, vy) of the static patch origin relative to "
-        "the road and spin wz of the tire relative to the road about +z (THEORY section 3); "
-        "the rim is held, the road moves rigidly with the opposite velocity field",
+        "the road and spin wz of the tire relative to the road about +z (THEORY section 3), in the "
+        "tire's frame; the road is held, the rim moves rigidly (turned by wz t about the "
+        "instantaneous centre, or translated by (vx, vy) t)",
         "origin": [_num(origin[0]), _num(origin[1]), 0.0],
         "origin_definition": "static patch origin (centre of pressure of the static map), m",
         "reaction": {
@@ -193,21 +224,32 @@ def write_run(mesh: TireMesh, res: RunResult, out: Path, info: dict, origin=(0.0
             "time": _num(h.time[-1] + 2.0, 7),
             "source": f"CalculiX .dat, last increment of the slide step ({res.name}.dat.txt): RF of "
             "the rigid road's reference node (force) and rotation node (moment)",
-            "sign": "RF at the road's nodes = force (moment) of the road on the tire; the moment is "
-            "about the reference node's current position (ref_position + ref_displacement)",
+            "sign": "RF at the road's nodes = force (moment) of the road on the tire, in the road's "
+            "frame; the moment is about the reference node's current position (ref_position + "
+            "ref_displacement)",
+        },
+        "tire_motion": {
+            "rotation_z": _num(k.wz * h.time[-1], 12),
+            "origin_position": _vec(tire_frame(res, h.time[-1], origin)[1], 10),
+            "note": "the tire's frame at the end of the slide: turned by rotation_z (rad) about +z "
+            "against the road's frame; the static patch origin has moved to origin_position (m, "
+            "road's frame). Forces in the tire's frame = Rot(-rotation_z) force; torque about the "
+            "moved origin",
         },
         "static_load": _vec(res.static_load),
         "shear_integral": {key: _num(v) for key, v in shear.items()},
         "shear_integral_note": "exact integrals of the exported bilinear shear traction (and CPRESS) "
-        "over the deformed contact faces: Fx, Fy (N), Mz about the origin (N m), N (N)",
+        "over the deformed contact faces, tire's frame: Fx, Fy (N), Mz about the origin (N m), N (N)",
         "history": _history_block(res, origin),
         "friction": dk.FRICTION,
         "units": "SI (m, N, Pa)",
         "arrays": ARRAYS,
         "deck_sha256": res.deck_sha256,
         "runtime_s": round(res.runtime_s, 1),
-        "runtime_s_note": "wall time of this run's CalculiX solve (inflation, load, slide; one "
-        "thread, nice 10, on a shared 2-core machine); the inflation pre-run is shared",
+        "base_runtime_s": round(res.base_runtime_s, 1),
+        "runtime_s_note": "wall time of this run's CalculiX solve (the slide, restarted from the "
+        "shared base run of inflation and vertical load, whose wall time is base_runtime_s); one "
+        "thread, nice 10, on a shared 2-core machine",
         **info,
     }
     _write_text(out / f"{res.name}.json", json.dumps(side, indent=2) + "\n")

@@ -20,7 +20,7 @@ from . import deck as dk
 from . import rig_deck as rd
 from .geometry import TireParams, build_mesh, coarse_params
 from .rig_export import write_run, write_static
-from .rig_run import inflation_rim_travel, solve_run
+from .rig_run import inflation_rim_travel, solve_base, solve_run
 from .solve import ccx_version, find_ccx
 
 SPIN_ANGLES = (40.0, 60.0, 20.0, 75.0)  # combined runs, degrees
@@ -74,6 +74,8 @@ def run_programme(
     mesh = build_mesh(params)
     rim_travel, clearance, t_infl = inflation_rim_travel(mesh, work, exe)
     log(f"rig: inflation pre-run {t_infl:.0f} s, clearance {clearance * 1e3:.2f} mm")
+    base = solve_base(mesh, rim_travel, work / "base", exe)
+    log(f"rig: base run (inflation + vertical load) {base.runtime_s:.0f} s")
     info = {
         "solver": ccx_version(exe),
         "mesh": {
@@ -94,10 +96,11 @@ def run_programme(
             "poisson_ratio": dk.NU_RUBBER,
             "contact": f"node-to-surface penalty, {dk.CONTACT_SLOPE:.3g} Pa/m; Coulomb friction "
             f"{dk.FRICTION}, stick slope {dk.STICK_SLOPE:.3g} Pa/m",
-            "road": "rigid body (*RIGID BODY) with a reference and a rotation node",
+            "road": "rigid body (*RIGID BODY), held at its reference and rotation nodes; the rim moves",
             "slide_path": rd.SLIDE_PATH,
             "r_ref": rd.R_REF,
             "max_increment": inc,
+            "slide_steps": rd.substeps(inc),
         },
     }
     runs = programme()
@@ -107,7 +110,7 @@ def run_programme(
     for name, d, a, s in runs:
         kin = rd.kinematics(d, a, s)
         t0 = time.perf_counter()
-        res = solve_run(mesh, name, kin, rim_travel, work / name, exe, inc)
+        res = solve_run(mesh, base, name, kin, rim_travel, work / name, exe, inc)
         if not (out / "static.json").exists():
             write_static(mesh, res, out, info)
         side = write_run(mesh, res, out, {**info, "direction_deg": d, "spin_angle_deg": a, "spin_sign": s})
