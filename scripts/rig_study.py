@@ -149,6 +149,31 @@ def write_outputs(out: Path, rows, summary, static, n_runs: int) -> None:
     (out / "table.md").write_text("\n".join(md) + "\n")
 
 
+def convergence(rig: Path, static, friction: float) -> list[str]:
+    """Markdown rows: the same run on a finer mesh (``fine/``) or a smaller increment (``inc05/``)."""
+    from fepost.rig import read_run
+
+    R = static.coefficients.R
+    lines = []
+    for sub, what in (("fine", "finer mesh"), ("inc05", "half the increment")):
+        for side in sorted((rig / sub).glob("*.json")):
+            if "kinematics" not in json.loads(side.read_text()):
+                continue
+            base = rig / side.with_suffix(".vtu").name
+            if not base.exists():
+                continue
+            a = read_run(base, shear=False).reaction
+            b = read_run(side.with_suffix(".vtu"), shear=False).reaction
+            fn = friction * a.N
+            df = float(np.hypot(b.Fx - a.Fx, b.Fy - a.Fy)) / fn
+            lines.append(
+                f"| {side.stem} | {what} | {a.Fx / fn:.4f}, {a.Fy / fn:.4f}, {a.Mz / (fn * R):.4f} | "
+                f"{b.Fx / (friction * b.N):.4f}, {b.Fy / (friction * b.N):.4f}, "
+                f"{b.Mz / (friction * b.N * R):.4f} | {df:.4f} | {abs(b.Mz - a.Mz) / (fn * R):.4f} |"
+            )
+    return lines
+
+
 def figures(out: Path, rows) -> None:
     import matplotlib
 
@@ -206,6 +231,17 @@ def main(argv=None) -> int:
     table, static, preds = predictions(args.rig, runs, args.friction)
     rows, summary = misfit_table(table, static, preds, args.friction)
     write_outputs(args.out, rows, summary, static, len(runs))
+    conv = convergence(args.rig, static, args.friction)
+    if conv:
+        head = [
+            "",
+            "Convergence (Fx, Fy in fN, Mz in fNR; R as above):",
+            "",
+            "| run | repeated with | programme | repeat | \\|dF\\| / fN | \\|dMz\\| / fNR |",
+            "|---|---|---|---|---|---|",
+        ]
+        with open(args.out / "table.md", "a") as fh:
+            fh.write("\n".join(head + conv) + "\n")
     figures(args.out, rows)
     print((args.out / "table.md").read_text())
     return 0

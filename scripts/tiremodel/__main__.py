@@ -62,7 +62,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     a.add_argument("--debug", action="store_true", help="show tracebacks")
     r = sub.add_parser("rig", help="slide/spin programme on the small tire (meshes/rig/)")
-    r.add_argument("--mesh", choices=["coarse", "tiny", "full"], default="coarse")
+    r.add_argument("--mesh", choices=["tiny", "coarse", "full"], default="tiny")
     r.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
     r.add_argument("--only", nargs="+", default=None, help="solve only these runs (names)")
     r.add_argument("--out", type=Path, default=REPO / "meshes" / "rig")

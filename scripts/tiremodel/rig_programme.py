@@ -49,7 +49,7 @@ def programme() -> list[tuple[str, float, float, int]]:
 
 
 def mesh_params(kind: str) -> TireParams:
-    """``tiny`` (tests), ``coarse`` (the programme) or ``full`` (the sample's mesh, convergence)."""
+    """``tiny`` (the programme and the tests), ``coarse`` (the convergence check) or ``full``."""
     if kind == "tiny":
         return TireParams(n_crown=4, n_shoulder=2, n_side=2, n_wall=1, n_fine=8, n_coarse=2)
     if kind == "coarse":
@@ -63,7 +63,7 @@ def run_programme(
     out: Path,
     work: Path,
     *,
-    mesh_kind: str = "coarse",
+    mesh_kind: str = "tiny",
     inc: float = 0.1,
     only: list[str] | None = None,
     log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True),
