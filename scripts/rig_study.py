@@ -89,7 +89,7 @@ def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], lis
             "vx": r.vx,
             "vy": r.vy,
             "wz": r.wz,
-            "spin_ratio": abs(r.wz) * R / max(np.hypot(r.vx, r.vy), 1e-300),
+            "spin_ratio": abs(r.wz) * R / np.hypot(r.vx, r.vy) if (r.vx, r.vy) != (0.0, 0.0) else np.inf,
             "Fx_fe": fe[i, 0] / unit[i, 0],
             "Fy_fe": fe[i, 1] / unit[i, 1],
             "Mz_fe": fe[i, 2] / unit[i, 2],
@@ -199,15 +199,20 @@ def figures(out: Path, rows) -> None:
         rs = rs + spin
         ang = np.array([np.degrees(np.arctan(r["spin_ratio"])) * np.sign(r["wz"] or 1.0) for r in rs])
         order = np.argsort(ang)
-        fig, ax = plt.subplots(1, 2, figsize=(9, 3.6))
+        fig, ax = plt.subplots(1, 3, figsize=(12, 3.6))
+        c, s_ = np.cos(np.radians(d)), np.sin(np.radians(d))
         for key, (col, mk) in styles.items():
-            f = np.hypot([r[f"Fx_{key}"] for r in rs], [r[f"Fy_{key}"] for r in rs])[order]
-            m = np.array([r[f"Mz_{key}"] for r in rs])[order]
+            fx = np.array([r[f"Fx_{key}"] for r in rs])
+            fy = np.array([r[f"Fy_{key}"] for r in rs])
+            m = np.array([r[f"Mz_{key}"] for r in rs])
             label = "FE (CalculiX)" if key == "fe" else MODELS[key]
-            ax[0].plot(ang[order], f, marker=mk, color=col, lw=0.8, label=label)
-            ax[1].plot(ang[order], m, marker=mk, color=col, lw=0.8)
-        ax[0].set_ylabel("|F| / fN")
-        ax[1].set_ylabel("Mz / fNR")
+            # along and across the sliding direction d (across: +90 degrees from it)
+            along, across = fx * c + fy * s_, -fx * s_ + fy * c
+            for a, y in zip(ax, (along, across, m), strict=True):
+                a.plot(ang[order], y[order], marker=mk, color=col, lw=0.8, label=label)
+        ax[0].set_ylabel("F along v / fN")
+        ax[1].set_ylabel("F across v (+90 deg) / fN")
+        ax[2].set_ylabel("Mz / fNR")
         for a in ax:
             a.set_xlabel("spin angle atan(wz R / |v|), deg (sign of wz)")
             a.grid(alpha=0.3)
