@@ -17,7 +17,7 @@ the slide (the rim is held at its height), so (a), (b) and (d) are scaled by
 N_run / N_static (the Coulomb forces are proportional to the load at a fixed
 pressure shape). Misfits are in units of f N (forces) and f N R (torque),
 N the run's load, R the static patch radius. Writes ``misfit.csv`` (per run),
-``table.md`` (RMS and max per model) and figures ``rig_<direction>.png``.
+``table.txt`` (RMS and max per model) and figures ``rig_<direction>.png``.
 """
 
 from __future__ import annotations
@@ -146,7 +146,7 @@ def write_outputs(out: Path, rows, summary, static, n_runs: int) -> None:
         md.append(
             f"| {s['model']} | {s['rms_F']:.4f} | {s['max_F']:.4f} | {s['rms_Mz']:.4f} | {s['max_Mz']:.4f} |"
         )
-    (out / "table.md").write_text("\n".join(md) + "\n")
+    (out / "table.txt").write_text("\n".join(md) + "\n")
 
 
 def convergence(rig: Path, static, friction: float) -> list[str]:
@@ -245,10 +245,10 @@ def main(argv=None) -> int:
             "| run | repeated with | programme | repeat | \\|dF\\| / fN | \\|dMz\\| / fNR |",
             "|---|---|---|---|---|---|",
         ]
-        with open(args.out / "table.md", "a") as fh:
+        with open(args.out / "table.txt", "a") as fh:
             fh.write("\n".join(head + conv) + "\n")
     figures(args.out, rows)
-    print((args.out / "table.md").read_text())
+    print((args.out / "table.txt").read_text())
     return 0
 
 
