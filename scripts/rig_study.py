@@ -164,12 +164,14 @@ def convergence(rig: Path, static, friction: float) -> list[str]:
                 continue
             a = read_run(base, shear=False).reaction
             b = read_run(side.with_suffix(".vtu"), shear=False).reaction
-            fn = friction * a.N
-            df = float(np.hypot(b.Fx - a.Fx, b.Fy - a.Fy)) / fn
+            ua, ub = friction * a.N, friction * b.N  # each in its own f N
+            pa = np.array([a.Fx / ua, a.Fy / ua, a.Mz / (ua * R)])
+            pb = np.array([b.Fx / ub, b.Fy / ub, b.Mz / (ub * R)])
+            df = float(np.hypot(*(pb[:2] - pa[:2])))
             lines.append(
-                f"| {side.stem} | {what} | {a.Fx / fn:.4f}, {a.Fy / fn:.4f}, {a.Mz / (fn * R):.4f} | "
-                f"{b.Fx / (friction * b.N):.4f}, {b.Fy / (friction * b.N):.4f}, "
-                f"{b.Mz / (friction * b.N * R):.4f} | {df:.4f} | {abs(b.Mz - a.Mz) / (fn * R):.4f} |"
+                f"| {side.stem} | {what} | {pa[0]:.4f}, {pa[1]:.4f}, {pa[2]:.4f} | "
+                f"{pb[0]:.4f}, {pb[1]:.4f}, {pb[2]:.4f} | {df:.4f} | {abs(pb[2] - pa[2]):.4f} | "
+                f"{b.N / a.N - 1:+.2%} |"
             )
     return lines
 
@@ -240,10 +242,10 @@ def main(argv=None) -> int:
     if conv:
         head = [
             "",
-            "Convergence (Fx, Fy in fN, Mz in fNR; R as above):",
+            "Convergence (Fx, Fy in fN, Mz in fNR, each run in its own N; R as above):",
             "",
-            "| run | repeated with | programme | repeat | \\|dF\\| / fN | \\|dMz\\| / fNR |",
-            "|---|---|---|---|---|---|",
+            "| run | repeated with | programme | repeat | \\|dF\\| / fN | \\|dMz\\| / fNR | N change |",
+            "|---|---|---|---|---|---|---|",
         ]
         with open(args.out / "table.txt", "a") as fh:
             fh.write("\n".join(head + conv) + "\n")
