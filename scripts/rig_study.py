@@ -17,7 +17,8 @@ the slide (the rim is held at its height), so (a), (b) and (d) are scaled by
 N_run / N_static (the Coulomb forces are proportional to the load at a fixed
 pressure shape). Misfits are in units of f N (forces) and f N R (torque),
 N the run's load, R the static patch radius. Writes ``misfit.csv`` (per run),
-``table.txt`` (RMS and max per model) and figures ``rig_<direction>.png``.
+``table.txt`` (RMS and max per model), figures ``rig_<direction>.png`` and the
+forces against the sliding path, ``rig_history.png``.
 """
 
 from __future__ import annotations
@@ -225,6 +226,32 @@ def figures(out: Path, rows) -> None:
         plt.close(fig)
 
 
+def history_figure(rig: Path, out: Path, runs: list[Path], friction: float) -> None:
+    """Forces against the sliding path (the steady state): |F| / fN and Mz / fN R_ref per increment."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(9, 3.6))
+    for run in runs:
+        side = json.loads(run.with_suffix(".json").read_text())
+        h = side["history"]
+        fn = friction * np.array(h["Fz"])
+        path = np.array(h["path"]) * 1e3
+        ax[0].plot(path, np.hypot(h["Fx"], h["Fy"]) / fn, lw=0.7)
+        ax[1].plot(path, np.array(h["Mz"]) / (fn * side["model"]["r_ref"]), lw=0.7)
+    ax[0].set_ylabel("|F| / fN")
+    ax[1].set_ylabel("Mz / fN R_ref")
+    for a in ax:
+        a.set_xlabel("reference sliding path, mm")
+        a.grid(alpha=0.3)
+    fig.suptitle(f"all {len(runs)} runs, per increment")
+    fig.tight_layout()
+    fig.savefig(out / "rig_history.png", dpi=80)
+    plt.close(fig)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rig", type=Path, default=REPO / "meshes" / "rig")
@@ -250,6 +277,7 @@ def main(argv=None) -> int:
         with open(args.out / "table.txt", "a") as fh:
             fh.write("\n".join(head + conv) + "\n")
     figures(args.out, rows)
+    history_figure(args.rig, args.out, runs, args.friction)
     print((args.out / "table.txt").read_text())
     return 0
 
