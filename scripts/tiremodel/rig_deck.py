@@ -18,7 +18,8 @@ at that point. Why the tire moves and not the road: with a turning road (the mas
 of the contact) CalculiX 2.20 turned the friction traction away from the slip
 direction by about the road's rotation angle (a uniform -10.5 degrees after an
 11 degree turn, the force direction drifting with the path); with the road
-fixed the traction is along the slip (checked per node in the export).
+fixed the traction is along the slip (median deviation about 1 degree over the
+loaded nodes of a test run).
 
 Steps 1 and 2 are the same for every run: they are solved once (the "base"
 deck, which writes a CalculiX restart file) and each run restarts from the end
