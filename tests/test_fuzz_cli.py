@@ -287,6 +287,7 @@ def _required(command: str, folder: Path) -> list[str]:
         "diagnose": ["--simulation", missing, "--measured", folder / "good.csv", "--out", folder / "out-d"],
         "predict": [missing, "--kinematics", folder / "good.csv", "--out", folder / "pred.csv"],
         "sweep": [missing, "--out", folder / "out-sweep"],
+        "rig": [missing, "--out", folder / "rig.csv"],
     }.get(command, [])
 
 
@@ -305,7 +306,7 @@ def test_hostile_option_values(capsys, data, command, monkeypatch):
     folder, _, _ = data
     # a hostile --out value is a relative folder (``--out=abc``): keep what it writes in the scratch folder
     monkeypatch.chdir(folder)
-    if command not in ("coefficients", "table1", "report", "diagnose", "predict", "sweep"):
+    if command not in ("coefficients", "table1", "report", "diagnose", "predict", "sweep", "rig"):
         pytest.fail(f"new command {command!r}: add its required arguments to _required()")
     base = _required(command, folder)
     missing = folder / "missing.vtu"

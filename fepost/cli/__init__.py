@@ -40,6 +40,7 @@ COMMANDS = [
     "diagnose",
     "predict",
     "sweep",
+    "rig",
 ]
 
 #: Exit statuses of ``fepost`` (the ``--help`` epilog and docs/cli-exit-codes.md).

@@ -5,6 +5,9 @@
 - ``aircraft [--coarse] [--out DIR] [--jobs N]``: the aircraft main-gear tire
   (meshes/aircraft/: load sweep 25-150 % of the rated load and the rolling
   stand-in at the rated load);
+- ``rig [--mesh coarse|tiny|full] [--only RUN ...] [--out DIR] [--work DIR]``:
+  the slide/spin programme on the small tire (meshes/rig/: the road moves
+  rigidly with a sliding velocity and a spin, Coulomb friction 0.3);
 - ``check-elements``: tip deflection of a rubber cantilever (C3D8I / C3D8,
   K/G = 100 / 1000) against Timoshenko's beam, the locking check behind the
   element choice.
@@ -58,6 +61,15 @@ def _parser() -> argparse.ArgumentParser:
         help="keep the CalculiX files here; runs already completed there with the same deck are reused",
     )
     a.add_argument("--debug", action="store_true", help="show tracebacks")
+    r = sub.add_parser("rig", help="slide/spin programme on the small tire (meshes/rig/)")
+    r.add_argument("--mesh", choices=["tiny", "coarse", "full"], default="tiny")
+    r.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
+    r.add_argument("--only", nargs="+", default=None, help="solve only these runs (names)")
+    r.add_argument("--out", type=Path, default=REPO / "meshes" / "rig")
+    r.add_argument(
+        "--work", type=Path, required=True, help="CalculiX work folder; finished runs there are reused"
+    )
+    r.add_argument("--debug", action="store_true", help="show tracebacks")
     c = sub.add_parser("check-elements", help="cantilever check of the rubber elements against Timoshenko")
     c.add_argument("--debug", action="store_true", help="show tracebacks")
     return ap
@@ -109,6 +121,11 @@ def main(argv: list[str] | None = None) -> int:
             from .element_check import main as check_main
 
             return check_main()
+        if args.command == "rig":
+            from .rig_programme import run_programme
+
+            run_programme(args.out, args.work, mesh_kind=args.mesh, inc=args.inc, only=args.only)
+            return 0
         if args.command == "aircraft":
             from .aircraft_build import build_aircraft
 

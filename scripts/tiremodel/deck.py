@@ -44,21 +44,29 @@ CASES = {
 }
 
 
-def write_deck(
-    path,
-    mesh: TireMesh,
-    case: LoadCase,
-    rim_travel: float,
-    inflation_only: bool = False,
-) -> dict:
-    """Write the deck; ``rim_travel`` is the total downward rim displacement (m)."""
+def cut_nodes(mesh: TireMesh) -> list[int]:
+    """0-based indices of the sector cut-face nodes that carry an equation (bead nodes excluded)."""
+    bead = set(int(n) for n in mesh.bead_nodes)
+    return [int(n) for n in mesh.cut_nodes if int(n) not in bead]
+
+
+def model_lines(mesh: TireMesh, title: str, road=None, cut_refs: int | None = None) -> list[str]:
+    """Deck lines of the model (nodes, elements, sets, surfaces, materials, cyclic
+    equations, contact pair), everything before the boundary conditions and steps.
+
+    ``road``: the road block (default ``ccxdeck.build_road()``). ``cut_refs``:
+    if given, each cut-face node gets its own reference node (numbers from
+    ``cut_refs`` on, in the order of ``cut_nodes``, at the cut node's position,
+    set CUTREF) instead of the one bead node, so that a rigid motion of the rim
+    that is not a rotation about the axle can be prescribed at the cut faces too.
+    """
     p = mesh.params
-    road = cx.build_road()
+    road = cx.build_road() if road is None else road
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
     out = []
     w = out.append
     w("*HEADING")
-    w(f"fepost tire sector, case {case.name}")
+    w(title)
     out += cx.node_block(mesh.nodes, road)
     out += cx.element_block("C3D8I", "TIRE", range(1, et + 1), mesh.hexes)
     out += cx.road_elements(road, nt, et)
@@ -73,14 +81,16 @@ def write_deck(
     w(cx.ROAD_SECTION)
     # sector cut faces: tangential displacement equals the rim's (rigid-rim
     # cyclic condition): t . u_node - t . u_ref = 0, t = circumferential direction
-    bead = set(int(n) for n in mesh.bead_nodes)
     ref = int(mesh.bead_nodes[0]) + 1
+    if cut_refs is not None:
+        w("*NODE, NSET=CUTREF")
+        for i, n in enumerate(cut_nodes(mesh)):
+            x, y, z = mesh.nodes[n]
+            w(f"{cut_refs + i}, {x:.9e}, {y:.9e}, {z:.9e}")
     w("*EQUATION")
-    n_eq = 0
-    for n in mesh.cut_nodes:
-        n = int(n)
-        if n in bead:
-            continue
+    for i, n in enumerate(cut_nodes(mesh)):
+        if cut_refs is not None:
+            ref = cut_refs + i
         x, _, z = mesh.nodes[n]
         rx, rz = x, z - p.axle_z
         rr = math.hypot(rx, rz)
@@ -92,8 +102,24 @@ def write_deck(
         (d1, c1), (d2, c2) = terms
         w(f"{n + 1}, {d1}, {c1:.9f}, {n + 1}, {d2}, {c2:.9f}, ")
         out[-1] += f"{ref}, {d1}, {-c1:.9f}, {ref}, {d2}, {-c2:.9f}"
-        n_eq += 1
     out += cx.contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE, CONTACT_TYPE)
+    return out
+
+
+def write_deck(
+    path,
+    mesh: TireMesh,
+    case: LoadCase,
+    rim_travel: float,
+    inflation_only: bool = False,
+) -> dict:
+    """Write the deck; ``rim_travel`` is the total downward rim displacement (m)."""
+    road = cx.build_road()
+    nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
+    out = model_lines(mesh, f"fepost tire sector, case {case.name}", road)
+    w = out.append
+    n_eq = len(cut_nodes(mesh))
+    table = face_lookup(mesh.hexes)
     w("*BOUNDARY")
     w("ROADN, 1, 3")
     w("BEAD, 1, 3")

@@ -1,0 +1,286 @@
+"""The friction model against the FE with friction: misfit of four predictions over the rig runs.
+
+    python scripts/rig_study.py [--rig meshes/rig] [--out docs/rig]
+
+Reads the slide/spin runs of ``meshes/rig/`` (``fepost.rig``: forces of the road
+on the tire from CalculiX's reactions) and compares them with
+
+(a) the paper's closed forms with the static map's coefficients,
+(b) the exact Coulomb integrals over the static map,
+(c) the exact Coulomb integrals over each run's own (deformed, end-of-slide)
+    pressure map, placed in the static patch's frame,
+(d) fepost's generalised model built from the static map,
+
+all through ``fepost.predict`` (``fepost.friction.predict``). The predictions
+over a static map carry the static load; the FE load changes a little during
+the slide (the rim is held at its height), so (a), (b) and (d) are scaled by
+N_run / N_static (the Coulomb forces are proportional to the load at a fixed
+pressure shape). Misfits are in units of f N (forces) and f N R (torque),
+N the run's load, R the static patch radius. Writes ``misfit.csv`` (per run),
+``table.txt`` (RMS and max per model), figures ``rig_<direction>.png`` and the
+forces against the sliding path, ``rig_history.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+MODELS = {
+    "paper": "(a) paper's closed forms",
+    "exact": "(b) exact integrals, static map",
+    "own": "(c) exact integrals, run's own map",
+    "model": "(d) generalised model",
+}
+
+
+def _runs(rig: Path) -> list[Path]:
+    out = []
+    for side in sorted(rig.glob("*.json")):
+        data = json.loads(side.read_text())
+        if "kinematics" in data:
+            out.append(side.with_suffix(".vtu"))
+    return out
+
+
+def predictions(rig: Path, runs: list[Path], friction: float):
+    """FE table, static analysis and a dict model -> (n, 3) predicted (Fx, Fy, Mz)."""
+    from fepost.analysis import analyse
+    from fepost.friction.predict import predict
+    from fepost.rig import rig_table
+
+    table = rig_table(runs)
+    vx = np.array([r.vx for r in table.runs])
+    vy = np.array([r.vy for r in table.runs])
+    wz = np.array([r.wz for r in table.runs])
+    static = analyse(rig / "static.vtu", friction=friction)
+    p = predict(static, vx, vy, wz)
+    n_static = static.coefficients.N
+    scale = np.array([r.reaction.N for r in table.runs]) / n_static
+    out = {}
+    for key, res in (("paper", p.paper), ("exact", p.exact), ("model", p.generalised)):
+        out[key] = np.column_stack([res.Fx, res.Fy, res.Mz]) * scale[:, None]
+    own = []
+    for i, run in enumerate(runs):
+        a = analyse(rig / "static.vtu", run, friction=friction)
+        q = predict(a, vx[i : i + 1], vy[i : i + 1], wz[i : i + 1])
+        own.append([q.exact.Fx[0], q.exact.Fy[0], q.exact.Mz[0]])
+    out["own"] = np.array(own)
+    return table, static, out
+
+
+def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], list[dict]]:
+    """Per-run rows and the summary (RMS, max) per model, in f N and f N R."""
+    fe = np.array([[r.reaction.Fx, r.reaction.Fy, r.reaction.Mz] for r in table.runs])
+    n = np.array([r.reaction.N for r in table.runs])
+    R = static.coefficients.R
+    unit = np.column_stack([friction * n, friction * n, friction * n * R])
+    rows = []
+    for i, r in enumerate(table.runs):
+        row = {
+            "run": Path(r.source).stem,
+            "vx": r.vx,
+            "vy": r.vy,
+            "wz": r.wz,
+            "spin_ratio": abs(r.wz) * R / np.hypot(r.vx, r.vy) if (r.vx, r.vy) != (0.0, 0.0) else np.inf,
+            "Fx_fe": fe[i, 0] / unit[i, 0],
+            "Fy_fe": fe[i, 1] / unit[i, 1],
+            "Mz_fe": fe[i, 2] / unit[i, 2],
+        }
+        for key, p in preds.items():
+            for j, q in enumerate(("Fx", "Fy", "Mz")):
+                row[f"{q}_{key}"] = p[i, j] / unit[i, j]
+        rows.append(row)
+    summary = []
+    for key in MODELS:
+        d = (preds[key] - fe) / unit
+        df = np.hypot(d[:, 0], d[:, 1])
+        summary.append(
+            {
+                "model": MODELS[key],
+                "rms_F": float(np.sqrt(np.mean(df**2))),
+                "max_F": float(df.max()),
+                "rms_Mz": float(np.sqrt(np.mean(d[:, 2] ** 2))),
+                "max_Mz": float(np.abs(d[:, 2]).max()),
+            }
+        )
+    # the decomposition: (b) - (c) isolates the pressure redistribution, (c) - FE the compliance
+    for label, a, b in (("(b) - (c): pressure redistribution", "exact", "own"),):
+        d = (preds[a] - preds[b]) / unit
+        df = np.hypot(d[:, 0], d[:, 1])
+        summary.append(
+            {
+                "model": label,
+                "rms_F": float(np.sqrt(np.mean(df**2))),
+                "max_F": float(df.max()),
+                "rms_Mz": float(np.sqrt(np.mean(d[:, 2] ** 2))),
+                "max_Mz": float(np.abs(d[:, 2]).max()),
+            }
+        )
+    return rows, summary
+
+
+def write_outputs(out: Path, rows, summary, static, n_runs: int) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    keys = list(rows[0])
+    lines = [",".join(keys)]
+    for row in rows:
+        lines.append(",".join(row[k] if isinstance(row[k], str) else f"{row[k]:.6g}" for k in keys))
+    (out / "misfit.csv").write_text("\n".join(lines) + "\n")
+    c = static.coefficients
+    md = [
+        f"Misfit over {n_runs} rig runs (forces in f N, torque in f N R; N the run's load, "
+        f"R = {c.R:.4g} m the static patch radius; f = {c.f}).",
+        "",
+        "| prediction | RMS \\|dF\\| / fN | max \\|dF\\| / fN | RMS dMz / fNR | max \\|dMz\\| / fNR |",
+        "|---|---|---|---|---|",
+    ]
+    for s in summary:
+        md.append(
+            f"| {s['model']} | {s['rms_F']:.4f} | {s['max_F']:.4f} | {s['rms_Mz']:.4f} | {s['max_Mz']:.4f} |"
+        )
+    (out / "table.txt").write_text("\n".join(md) + "\n")
+
+
+def convergence(rig: Path, static, friction: float) -> list[str]:
+    """Markdown rows: the same run on a finer mesh (``fine/``) or a smaller increment (``inc05/``)."""
+    from fepost.rig import read_run
+
+    R = static.coefficients.R
+    lines = []
+    for sub, what in (("fine", "finer mesh"), ("inc05", "half the increment")):
+        for side in sorted((rig / sub).glob("*.json")):
+            if "kinematics" not in json.loads(side.read_text()):
+                continue
+            base = rig / side.with_suffix(".vtu").name
+            if not base.exists():
+                continue
+            a = read_run(base, shear=False).reaction
+            b = read_run(side.with_suffix(".vtu"), shear=False).reaction
+            ua, ub = friction * a.N, friction * b.N  # each in its own f N
+            pa = np.array([a.Fx / ua, a.Fy / ua, a.Mz / (ua * R)])
+            pb = np.array([b.Fx / ub, b.Fy / ub, b.Mz / (ub * R)])
+            df = float(np.hypot(*(pb[:2] - pa[:2])))
+            lines.append(
+                f"| {side.stem} | {what} | {pa[0]:.4f}, {pa[1]:.4f}, {pa[2]:.4f} | "
+                f"{pb[0]:.4f}, {pb[1]:.4f}, {pb[2]:.4f} | {df:.4f} | {abs(pb[2] - pa[2]):.4f} | "
+                f"{b.N / a.N - 1:+.2%} |"
+            )
+    return lines
+
+
+def figures(out: Path, rows) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    dirs: dict[int, list[dict]] = {}
+    for r in rows:
+        if r["vx"] == r["vy"] == 0.0:
+            d = -1  # pure spin: on every direction's plot
+        else:
+            d = int(round(np.degrees(np.arctan2(r["vy"], r["vx"]))))
+        dirs.setdefault(d, []).append(r)
+    spin = dirs.pop(-1, [])
+    styles = {
+        "fe": ("k", "o"),
+        "paper": ("C0", "s"),
+        "exact": ("C1", "^"),
+        "own": ("C2", "v"),
+        "model": ("C3", "x"),
+    }
+    for d, rs in sorted(dirs.items()):
+        rs = rs + spin
+        ang = np.array([np.degrees(np.arctan(r["spin_ratio"])) * np.sign(r["wz"] or 1.0) for r in rs])
+        order = np.argsort(ang)
+        fig, ax = plt.subplots(1, 3, figsize=(12, 3.6))
+        c, s_ = np.cos(np.radians(d)), np.sin(np.radians(d))
+        for key, (col, mk) in styles.items():
+            fx = np.array([r[f"Fx_{key}"] for r in rs])
+            fy = np.array([r[f"Fy_{key}"] for r in rs])
+            m = np.array([r[f"Mz_{key}"] for r in rs])
+            label = "FE (CalculiX)" if key == "fe" else MODELS[key]
+            # along and across the sliding direction d (across: +90 degrees from it)
+            along, across = fx * c + fy * s_, -fx * s_ + fy * c
+            for a, y in zip(ax, (along, across, m), strict=True):
+                a.plot(ang[order], y[order], marker=mk, color=col, lw=0.8, label=label)
+        ax[0].set_ylabel("F along v / fN")
+        ax[1].set_ylabel("F across v (+90 deg) / fN")
+        ax[2].set_ylabel("Mz / fNR")
+        for a in ax:
+            a.set_xlabel("spin angle atan(wz R / |v|), deg (sign of wz)")
+            a.grid(alpha=0.3)
+        ax[0].legend(fontsize=7)
+        fig.suptitle(f"sliding direction {d} deg")
+        fig.tight_layout()
+        fig.savefig(out / f"rig_{d:03d}.png", dpi=80)
+        plt.close(fig)
+
+
+def history_figure(rig: Path, out: Path, runs: list[Path], friction: float) -> None:
+    """Forces against the sliding path (the steady state): |F| / fN and Mz / fN R_ref per increment."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(9, 3.6))
+    for run in runs:
+        side = json.loads(run.with_suffix(".json").read_text())
+        h = side["history"]
+        fn = friction * np.array(h["Fz"])
+        path = np.array(h["path"]) * 1e3
+        ax[0].plot(path, np.hypot(h["Fx"], h["Fy"]) / fn, lw=0.7)
+        ax[1].plot(path, np.array(h["Mz"]) / (fn * side["model"]["r_ref"]), lw=0.7)
+    ax[0].set_ylabel("|F| / fN")
+    ax[1].set_ylabel("Mz / fN R_ref")
+    for a in ax:
+        a.set_xlabel("reference sliding path, mm")
+        a.grid(alpha=0.3)
+    fig.suptitle(f"all {len(runs)} runs, per increment")
+    fig.tight_layout()
+    fig.savefig(out / "rig_history.png", dpi=80)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rig", type=Path, default=REPO / "meshes" / "rig")
+    ap.add_argument("--out", type=Path, default=REPO / "docs" / "rig")
+    ap.add_argument("--friction", type=float, default=0.3)
+    args = ap.parse_args(argv)
+    runs = _runs(args.rig)
+    if not runs:
+        print(f"rig_study: no rig runs in {args.rig}", file=sys.stderr)
+        return 2
+    table, static, preds = predictions(args.rig, runs, args.friction)
+    rows, summary = misfit_table(table, static, preds, args.friction)
+    write_outputs(args.out, rows, summary, static, len(runs))
+    conv = convergence(args.rig, static, args.friction)
+    if conv:
+        head = [
+            "",
+            "Convergence (Fx, Fy in fN, Mz in fNR, each run in its own N; R as above):",
+            "",
+            "| run | repeated with | programme | repeat | \\|dF\\| / fN | \\|dMz\\| / fNR | N change |",
+            "|---|---|---|---|---|---|---|",
+        ]
+        with open(args.out / "table.txt", "a") as fh:
+            fh.write("\n".join(head + conv) + "\n")
+    figures(args.out, rows)
+    history_figure(args.rig, args.out, runs, args.friction)
+    print((args.out / "table.txt").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

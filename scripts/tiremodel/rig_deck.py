@@ -1,0 +1,226 @@
+"""CalculiX decks of the slide/spin rig: the small tire sector slid and spun on a fixed rigid road.
+
+Steps (all quasi-static, NLGEOM):
+
+1. inflation (as the static case);
+2. vertical rim travel (as the static case);
+3. the rim (the bead nodes) moves rigidly in the road plane so that every
+   tire point has, relative to the road, the constant velocity field of a
+   sliding velocity (vx, vy) of the static patch origin c plus a spin wz about
+   the road normal; the road stays put.
+
+The road is one rigid body (``*RIGID BODY``) whose reference node (at c) and
+rotation node are held: their reactions are the road's total force and moment.
+The sector's cut faces keep the condition of the static case (their
+circumferential displacement is the rim's: the rest of the tire moves with the
+rim), each against its own reference node that follows the rim's rigid motion
+at that point. Why the tire moves and not the road: with a turning road (the master surface
+of the contact) CalculiX 2.20 turned the friction traction away from the slip
+direction by about the road's rotation angle (a uniform -10.5 degrees after an
+11 degree turn, the force direction drifting with the path); with the road
+fixed the traction is along the slip (median deviation about 1 degree over the
+loaded nodes of a test run).
+
+Steps 1 and 2 are the same for every run: they are solved once (the "base"
+deck, which writes a CalculiX restart file) and each run restarts from the end
+of step 2 (``*RESTART, READ``) with its own slide.
+
+Kinematics. The relative sliding velocity of the tire point x against the road
+is (THEORY section 3) ``w(x) = (vx - wz (y - cy), vy + wz (x - cx))``, in the
+tire's own (moving) frame. For wz != 0 that is a rotation at the rate wz about
+the point P = c + (-vy/wz, vx/wz) where w = 0 (the instantaneous centre of
+rotation), fixed in the tire and on the road; for wz = 0 a translation by
+(vx, vy) t. The rim is turned about the vertical axis through P by wz t. The
+forces measured on the road are in the road's frame; the tire's frame is
+turned by wz t, and the patch origin has moved to P + Rot(wz t) (c - P):
+``fepost rig`` turns the forces into the tire's frame and takes the torque
+about the moved origin (the sidecar records both).
+
+Quasi-static. There is no inertia and no rate in the material or the friction
+law, so the "velocities" are displacements per unit of the step's pseudo-time
+T = 1: only the direction of the sliding velocity and the ratio of spin to
+sliding (wz R / |v|) matter for rigid-slip Coulomb friction, not their size.
+
+Road reactions. The reference node's RF is the total force of the road on the
+tire (the constraint holds the road against the tire's push), the rotation
+node's RF the moment about the reference node; both are printed per increment.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import ccxdeck as cx
+from . import deck as dk
+from .geometry import TireMesh
+from .meshing import face_lookup
+
+SLIDE_PATH = 0.06  # m, reference sliding path of a run: |v| T + |wz| R_REF T combined in quadrature
+R_REF = 0.10  # m, reference patch radius used to scale the spin
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """Sliding velocity (vx, vy) of the static patch origin relative to the road and spin wz.
+
+    Units: m and rad per unit pseudo-time (the slide step lasts T = 1).
+    """
+
+    vx: float
+    vy: float
+    wz: float
+
+    def pivot(self, origin: tuple[float, float]) -> tuple[float, float] | None:
+        """The instantaneous centre of rotation P (m), None for pure sliding."""
+        if self.wz == 0.0:
+            return None
+        return origin[0] - self.vy / self.wz, origin[1] + self.vx / self.wz
+
+
+def kinematics(direction_deg: float, spin_angle_deg: float, spin_sign: int) -> Kinematics:
+    """Kinematics of one run with the reference path ``SLIDE_PATH``.
+
+    ``spin_angle_deg``: 0 = pure sliding, 90 = pure spin; |v| = S cos(a),
+    |wz| R_REF = S sin(a). ``direction_deg``: direction of the sliding velocity
+    from +x towards +y. ``spin_sign``: sign of wz.
+    """
+    a = math.radians(spin_angle_deg)
+    d = math.radians(direction_deg)
+    v = SLIDE_PATH * math.cos(a)
+    wz = spin_sign * SLIDE_PATH * math.sin(a) / R_REF
+    vx, vy = v * math.cos(d), v * math.sin(d)
+    # exact zeros where they belong (pure spin, axis directions): the deck stays clean
+    r = 12
+    return Kinematics(round(vx, r) + 0.0, round(vy, r) + 0.0, round(wz, r) + 0.0)
+
+
+@dataclass(frozen=True)
+class RigNodes:
+    ref: int  # 1-based CalculiX node number of the rigid body's reference node
+    rot: int  # ... of its rotation node
+    ref_xy: tuple[float, float]  # m, reference position of the reference node (z = 0)
+
+
+def _outputs(w, frequency: int) -> None:
+    # CalculiX 2.20 uses one output frequency for the .frd and the .dat requests; the
+    # last increment of each step is always written
+    w(f"*NODE FILE, NSET=TIREN, FREQUENCY={frequency}")
+    w("U")
+    w(f"*CONTACT FILE, FREQUENCY={frequency}")
+    w("CDIS, CSTR")
+    w(f"*NODE PRINT, NSET=REFN, FREQUENCY={frequency}")
+    w("U, RF")
+    w(f"*NODE PRINT, NSET=ROTN, FREQUENCY={frequency}")
+    w("U, RF")
+    w(f"*NODE PRINT, NSET=BEAD, TOTALS=ONLY, FREQUENCY={frequency}")
+    w("RF")
+
+
+def write_base_deck(path, mesh: TireMesh, rim_travel: float, origin: tuple[float, float]) -> RigNodes:
+    """Steps 1-2 (inflation, vertical rim travel) with the rigid road; writes a restart file."""
+    road = cx.build_road()
+    nt, nr = mesh.nodes.shape[0], road.nodes.shape[0]
+    out = dk.model_lines(mesh, "fepost tire sector, slide/spin rig", road, cut_refs=nt + nr + 3)
+    w = out.append
+    nodes = RigNodes(ref=nt + nr + 1, rot=nt + nr + 2, ref_xy=(float(origin[0]), float(origin[1])))
+    w("*NODE, NSET=NALL")
+    w(f"{nodes.ref}, {origin[0]:.9e}, {origin[1]:.9e}, 0.0")
+    w(f"{nodes.rot}, {origin[0]:.9e}, {origin[1]:.9e}, 0.0")
+    w("*NSET, NSET=REFN")
+    w(str(nodes.ref))
+    w("*NSET, NSET=ROTN")
+    w(str(nodes.rot))
+    w(f"*RIGID BODY, NSET=ROADN, REF NODE={nodes.ref}, ROT NODE={nodes.rot}")
+    w("*BOUNDARY")
+    w("REFN, 1, 3")
+    w("ROTN, 1, 3")
+    w("BEAD, 1, 3")
+    w("CUTREF, 1, 3")
+    table = face_lookup(mesh.hexes)
+    w("*STEP, NLGEOM, INC=400")
+    w("*STATIC")
+    w("0.25, 1.0, 1e-5, 0.5")
+    w("*DLOAD")
+    out += cx.pressure_load(mesh.hexes, mesh.inner_quads, dk.PRESSURE, table)
+    _outputs(w, 1000)
+    w("*END STEP")
+    w("*STEP, NLGEOM, INC=400")
+    w("*STATIC")
+    w("0.05, 1.0, 1e-6, 0.1")
+    w("*BOUNDARY")
+    w(f"BEAD, 3, 3, {-rim_travel:.9e}")
+    w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
+    _outputs(w, 1000)
+    w("*RESTART, WRITE, FREQUENCY=1")
+    w("*END STEP")
+    with open(path, "w") as fh:
+        fh.write("\n".join(out) + "\n")
+    return nodes
+
+
+def tire_motion(kin: Kinematics, origin: tuple[float, float], t: float) -> tuple[float, np.ndarray]:
+    """Rigid motion of the rim at pseudo-time ``t``: (rotation angle about z, rad; 2x3 affine map).
+
+    The road stays put; the tire turns by wz t about the vertical axis through
+    the instantaneous centre P (for wz = 0: translates by (vx, vy) t). The map
+    ``A`` sends a reference point (x, y, 1) to its moved (x, y).
+    """
+    pivot = kin.pivot(origin)
+    if pivot is None:
+        return 0.0, np.array([[1.0, 0.0, kin.vx * t], [0.0, 1.0, kin.vy * t]])
+    th = kin.wz * t
+    c, s = math.cos(th), math.sin(th)
+    rot = np.array([[c, -s], [s, c]])
+    p = np.asarray(pivot)
+    return th, np.column_stack([rot, p - rot @ p])
+
+
+def substeps(inc: float) -> int:
+    """Number of slide steps K for the largest increment ``inc`` (pseudo-time)."""
+    if not 0.0 < inc <= 1.0:
+        raise ValueError(f"increment {inc} outside (0, 1]")
+    return math.ceil(1.0 / inc - 1e-9)
+
+
+def write_slide_deck(
+    path, mesh: TireMesh, kin: Kinematics, rim_travel: float, origin: tuple[float, float], inc: float
+) -> None:
+    """The run's deck: restart from the base's step 2, then K slide steps of pseudo-time 1/K.
+
+    Each step prescribes the rim (bead) nodes at the exact rigid motion of its
+    end (``tire_motion``); within a step CalculiX ramps them linearly (the
+    chord), off the arc by at most d (wz/K)^2 / 8 for a bead node at distance d
+    from P (below 0.1 mm here, a strain of the rim below 2e-4).
+    """
+    k = substeps(inc)
+    dt = 1.0 / k
+    # the rim's nodes and the cut faces' reference nodes (numbered after the road's
+    # reference and rotation nodes) follow the rim's rigid motion
+    nt = mesh.nodes.shape[0]
+    cut = dk.cut_nodes(mesh)
+    first = nt + cx.build_road().nodes.shape[0] + 3
+    bead = np.unique(mesh.bead_nodes)
+    numbers = [int(n) + 1 for n in bead] + list(range(first, first + len(cut)))
+    pos = np.vstack([mesh.nodes[bead, :2], mesh.nodes[cut, :2]])
+    xy1 = np.column_stack([pos, np.ones(len(numbers))])
+    out = ["*RESTART, READ, STEP=2"]
+    w = out.append
+    for i in range(1, k + 1):
+        _, a = tire_motion(kin, origin, i * dt)
+        u = xy1 @ a.T - xy1[:, :2]
+        w("*STEP, NLGEOM, INC=400")
+        w("*STATIC")
+        w(f"{dt / 2 if i == 1 else dt:.6g}, {dt:.6g}, 1e-8, {dt:.6g}")
+        w("*BOUNDARY")
+        for n, (ux, uy) in zip(numbers, u, strict=True):
+            w(f"{n}, 1, 1, {ux:.12e}")
+            w(f"{n}, 2, 2, {uy:.12e}")
+        w(f"BEAD, 3, 3, {-rim_travel:.9e}")
+        w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
+        _outputs(w, 1)
+        w("*END STEP")
+    with open(path, "w") as fh:
+        fh.write("\n".join(out) + "\n")

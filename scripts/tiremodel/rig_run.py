@@ -1,0 +1,194 @@
+"""Solve the slide/spin rig runs with CalculiX and collect what the export needs.
+
+Shared by all runs of one mesh: the inflation pre-run (where the inflated
+crown sits, hence the rim travel of the static case's 29 mm deflection) and
+the base run (inflation and vertical load with the rigid road, which writes a
+CalculiX restart file). Each run restarts from the base. A work folder is
+reused when it holds a finished solution of the same decks (the programme can
+be stopped and resumed).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import deck as dk
+from . import rig_deck as rd
+from .frd import read_dat_blocks, read_frd
+from .geometry import TireMesh
+from .solve import ModelError, run_ccx
+
+DEFLECTION = 0.029  # m, as the static sample case
+SLIDE_START = 2.0  # total time at the start of the slide step (steps 1 and 2 last 1 each)
+
+
+@dataclass(frozen=True)
+class History:
+    """The road's reactions per increment of the slide step, as printed by CalculiX."""
+
+    time: np.ndarray  # (k,) step time in [0, 1] (pseudo-time of the slide)
+    ref_u: np.ndarray  # (k, 3) m, displacement of the rigid road's reference node
+    ref_rf: np.ndarray  # (k, 3) N, reaction at the reference node = force of the road on the tire
+    rot_u: np.ndarray  # (k, 3) rad, rotation vector of the road
+    rot_rf: np.ndarray  # (k, 3) N m, reaction moment at the rotation node, about the reference node
+    # (all in the road's frame; the road is held, so ref_u and rot_u stay zero)
+    bead_rf: np.ndarray  # (k, 3) N, total reaction on the rim nodes
+
+
+@dataclass(frozen=True)
+class Base:
+    """The shared inflation + vertical-load solution the runs restart from."""
+
+    nodes: rd.RigNodes
+    restart: Path  # CalculiX restart file (.rout)
+    static_load: np.ndarray  # (3,) N, road's force on the tire at the end of the vertical step
+    static_cpress: np.ndarray  # (n_tire,) Pa, end of the vertical step
+    static_u: np.ndarray  # (n_tire, 3) m
+    runtime_s: float
+    deck_sha256: str
+
+
+@dataclass(frozen=True)
+class RunResult:
+    name: str
+    kin: rd.Kinematics
+    nodes: rd.RigNodes
+    history: History
+    static_load: np.ndarray  # (3,) N, as Base
+    static_cpress: np.ndarray
+    static_u: np.ndarray
+    contact: dict  # name -> (n_tire,) CalculiX CONTACT components at the end of the slide
+    u: np.ndarray  # (n_tire, 3) m, end of the slide
+    runtime_s: float  # the run's own solve (restart from the base)
+    base_runtime_s: float
+    deck_sha256: str
+    dat_excerpt: str  # the .dat records of the last slide increment, verbatim
+
+
+def inflation_rim_travel(mesh: TireMesh, workdir: Path, exe: str) -> tuple[float, float, float]:
+    """(rim travel, inflated clearance, wall time): the static case's pre-run, reused when present."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    inp = workdir / "inflate.inp"
+    dk.write_deck(inp, mesh, dk.CASES["static"], 0.0, inflation_only=True)
+    t = _solve_once(exe, inp, "")
+    r0 = read_frd(inp.with_suffix(".frd"))
+    _, u0 = r0.field(max(r0.last), "U")
+    slave = np.unique(mesh.contact_quads)
+    z = float((mesh.nodes[slave, 2] + u0[slave, 2]).min())
+    if z <= 0.0:
+        raise ModelError("inflated tire already touches the road")
+    return z + DEFLECTION, z, t
+
+
+def _solve_once(exe: str, inp: Path, key: str) -> float:
+    """Run ccx unless a finished solution of this deck (and ``key``) is there; return its wall time."""
+    digest = hashlib.sha256(inp.read_bytes() + key.encode()).hexdigest()
+    stamp = inp.with_suffix(".done")
+    if stamp.exists() and stamp.read_text().split()[0] == digest and inp.with_suffix(".frd").exists():
+        return float(stamp.read_text().split()[1])
+    stamp.unlink(missing_ok=True)
+    t = run_ccx(exe, inp, threads=1)
+    stamp.write_text(f"{digest} {t:.1f}\n")
+    return t
+
+
+def _nodal(mesh: TireMesh, frd: Path, step: int | None = None):
+    """(CONTACT components, U) of the last increment of ``step`` (default: the last step)."""
+    nt = mesh.nodes.shape[0]
+    res = read_frd(frd)
+    if res.node_ids[:nt].tolist() != list(range(1, nt + 1)):
+        raise ModelError(f"unexpected node numbering in {frd.name}")
+    step = max(res.last) if step is None else step
+    comps, c = res.field(step, "CONTACT")
+    return {k: c[:nt, i] for i, k in enumerate(comps)}, res.field(step, "U")[1][:nt]
+
+
+def solve_base(mesh: TireMesh, rim_travel: float, workdir: Path, exe: str) -> Base:
+    """Solve (or reuse) the base run: inflation and vertical load with the rigid road."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    inp = workdir / "base.inp"
+    nodes = rd.write_base_deck(inp, mesh, rim_travel, (0.0, 0.0))
+    t = _solve_once(exe, inp, "")
+    contact, u = _nodal(mesh, inp.with_suffix(".frd"), 2)
+    recs = [r for r in read_dat_blocks(inp.with_suffix(".dat")) if r[0] == "forces" and r[1] == "REFN"]
+    load = next(arr[-1, -3:] for _, _, t_, arr in recs if abs(t_ - SLIDE_START) < 1e-9)
+    return Base(
+        nodes=nodes,
+        restart=inp.with_suffix(".rout"),
+        static_load=load,
+        static_cpress=np.clip(contact["CPRESS"], 0.0, None),
+        static_u=u,
+        runtime_s=t,
+        deck_sha256=hashlib.sha256(inp.read_bytes()).hexdigest(),
+    )
+
+
+def _history(dat: Path) -> History:
+    blocks = read_dat_blocks(dat)
+    rows: dict[tuple[str, str], dict[float, np.ndarray]] = {}
+    for kind, name, t, arr in blocks:
+        if t > SLIDE_START + 1e-9 or (kind, name) == ("total force", "BEAD"):
+            rows.setdefault((kind, name), {})[t] = arr[-1, -3:]
+    key_u, key_f = "displacements", "forces"
+    times = sorted(t for t in rows.get((key_f, "REFN"), {}) if t > SLIDE_START + 1e-9)
+    if not times:
+        raise ModelError(f"no reactions of the slide step in {dat.name}")
+
+    def stack(kind, name):
+        d = rows[(kind, name)]
+        return np.array([d[t] for t in times])
+
+    return History(
+        time=np.array(times) - SLIDE_START,
+        ref_u=stack(key_u, "REFN"),
+        ref_rf=stack(key_f, "REFN"),
+        rot_u=stack(key_u, "ROTN"),
+        rot_rf=stack(key_f, "ROTN"),
+        bead_rf=stack("total force", "BEAD"),
+    )
+
+
+def _excerpt(dat: Path) -> str:
+    """The last increment's records of the .dat file (REFN, ROTN, BEAD), verbatim."""
+    lines = dat.read_text(encoding="latin-1").splitlines()
+    starts = [i for i, ln in enumerate(lines) if "for set REFN" in ln and "displacements" in ln]
+    return "\n".join(lines[starts[-1] :]).rstrip() + "\n"
+
+
+def solve_run(
+    mesh: TireMesh,
+    base: Base,
+    name: str,
+    kin: rd.Kinematics,
+    rim_travel: float,
+    workdir: Path,
+    exe: str,
+    inc: float,
+) -> RunResult:
+    """Write the run's deck, solve it from the base's restart file (or reuse it) and read it."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    inp = workdir / f"{name}.inp"
+    rd.write_slide_deck(inp, mesh, kin, rim_travel, base.nodes.ref_xy, inc)
+    shutil.copyfile(base.restart, inp.with_suffix(".rin"))
+    runtime = _solve_once(exe, inp, base.deck_sha256)
+    contact, u = _nodal(mesh, inp.with_suffix(".frd"))
+    return RunResult(
+        name=name,
+        kin=kin,
+        nodes=base.nodes,
+        history=_history(inp.with_suffix(".dat")),
+        static_load=base.static_load,
+        static_cpress=base.static_cpress,
+        static_u=base.static_u,
+        contact=contact,
+        u=u,
+        runtime_s=runtime,
+        base_runtime_s=base.runtime_s,
+        deck_sha256=hashlib.sha256(inp.read_bytes() + base.deck_sha256.encode()).hexdigest(),
+        dat_excerpt=_excerpt(inp.with_suffix(".dat")),
+    )
