@@ -24,6 +24,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .errors import ArgumentError
+from .friction_coefficient import DEFAULT_FRICTION
 
 _PROFILES: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "uniform": lambda rho: np.ones_like(rho),
@@ -97,7 +98,7 @@ def load(name: str, radius: float, peak: float = 1.0) -> float:
     return 2.0 * np.pi * radius**2 * moments(name, peak)[1]
 
 
-def coefficients(name: str, radius: float, peak: float = 1.0, friction: float = 0.3) -> dict:
+def coefficients(name: str, radius: float, peak: float = 1.0, friction: float = DEFAULT_FRICTION) -> dict:
     """F0, M0, a, m, b, b1 (SI) of a circular profile (docs/theory.md, "Integrals of the pressure")."""
     A = moments(name, peak)
     F0 = 2.0 * np.pi * friction * radius**2 * A[1]

@@ -16,6 +16,7 @@ import numpy as np
 
 from ._arrays import frozen
 from .errors import ArgumentError
+from .friction_coefficient import DEFAULT_FRICTION, check_friction
 from .moments import Moments
 
 
@@ -75,11 +76,10 @@ class Coefficients:
 
 
 def coefficients_from_moments(
-    static: Moments, rolling: Moments | None = None, friction: float = 0.3
+    static: Moments, rolling: Moments | None = None, friction: float = DEFAULT_FRICTION
 ) -> Coefficients:
     """Coefficients from the static map's moments (and the rolling map's, for k_x)."""
-    if not (np.isfinite(friction) and friction > 0):
-        raise ArgumentError(f"friction must be a positive number, got {friction!r}")
+    friction = check_friction(friction)
     R = static.radius
     A = static.A
     if not (A[0] > 0 and A[3] > 0):

@@ -8,12 +8,11 @@ frozen, made of plain values, so it pickles and hashes into a row's identity),
 the report passes it to its sections.
 
 The friction coefficient has one default, `DEFAULT_FRICTION`, and one rule,
-`check_friction`: a finite number in `FRICTION_RANGE`, [0.001, 10]. Below
-0.001 there is no friction to speak of (ice is about 0.05) and Table 1's curves
-underflow; above 10 they overflow, and no tire reaches it (dry asphalt about
-1.2; the command line warns above 1.5).
+`check_friction` (a finite number in `FRICTION_RANGE`, [0.001, 10]), defined in
+`fepost.friction_coefficient` and re-exported here.
 
-This module is light at import (the standard library and `fepost.errors`):
+This module is light at import (the standard library, `fepost.errors` and
+`fepost.friction_coefficient`):
 the command line's option types use it before numpy is imported. The library
 defaults that live in heavy modules (grid size, threshold) are read when an
 `AnalysisOptions` is made.
@@ -26,37 +25,13 @@ from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
 from .errors import ArgumentError
+from .friction_coefficient import DEFAULT_FRICTION as DEFAULT_FRICTION
+from .friction_coefficient import FRICTION_RANGE as FRICTION_RANGE
+from .friction_coefficient import check_friction as check_friction
+from .friction_coefficient import is_real as _real
 
-#: The friction coefficient f when none is given (the paper's).
-DEFAULT_FRICTION = 0.3
-#: Accepted friction coefficients, inclusive (see the module docstring).
-FRICTION_RANGE = (0.001, 10.0)
 #: Largest accepted inflation pressure, Pa (1 GPa: no tire; a unit slip above it).
 PRESSURE_MAX = 1e9
-
-
-def _real(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
-
-
-def check_friction(f: object, *, name: str = "friction") -> float:
-    """``f`` as a float when it is a friction coefficient in `FRICTION_RANGE`.
-
-    Raises
-    ------
-    ArgumentError
-        Not a real number, not finite, or outside the range (naming ``name``).
-    """
-    lo, hi = FRICTION_RANGE
-    if not _real(f) and type(f).__module__ != "numpy":
-        raise ArgumentError(f"{name} must be a friction coefficient in [{lo:g}, {hi:g}], got {f!r}")
-    try:
-        value = float(f)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ArgumentError(f"{name} must be a friction coefficient in [{lo:g}, {hi:g}], got {f!r}") from None
-    if not (math.isfinite(value) and lo <= value <= hi):
-        raise ArgumentError(f"{name} must be a friction coefficient in [{lo:g}, {hi:g}], got {f!r}")
-    return value
 
 
 def check_pressure(p: object, *, name: str = "inflation_pressure") -> float:

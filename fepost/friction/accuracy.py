@@ -21,6 +21,7 @@ from scipy.optimize import least_squares
 
 from .._arrays import frozen
 from ..errors import ArgumentError, FitError
+from ..friction_coefficient import DEFAULT_FRICTION
 from .closed_form import (
     asymptotic_coefficients,
     f_parallel_ratio,
@@ -132,7 +133,7 @@ def _fit(model, start: float, data: np.ndarray, name: str) -> float:
 
 def approximation_error(
     quad: PressureQuadrature,
-    f: float = 0.3,
+    f: float = DEFAULT_FRICTION,
     *,
     F0: float | None = None,
     M0: float | None = None,

@@ -142,8 +142,6 @@ def build_model(
         raise ArgumentError(f"grid must be two integers (n_theta, n_t), got {grid!r}") from None
     if n_theta < 2 * K + 2 or n_t < L + 1:
         raise ArgumentError(f"grid {grid!r} is too coarse for order {(K, L)!r} (need > 2K+1 by > L nodes)")
-    if law.f <= 0:
-        raise ArgumentError(f"law.f must be positive to build a model, got {law.f!r}")
     tensors = map_tensors(eq, radius)
     coef = base_coefficients(tensors, law.f)
     R = coef["R"]

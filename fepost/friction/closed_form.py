@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ArgumentError
+from ..friction_coefficient import DEFAULT_FRICTION, check_friction
 from .quadrature import PressureQuadrature
 
 
@@ -115,7 +116,11 @@ class AsymptoticCoefficients:
 
 
 def asymptotic_coefficients(
-    quad: PressureQuadrature, f: float = 0.3, *, radius: float | None = None, direction: float = 0.0
+    quad: PressureQuadrature,
+    f: float = DEFAULT_FRICTION,
+    *,
+    radius: float | None = None,
+    direction: float = 0.0,
 ) -> AsymptoticCoefficients:
     """a and m matched to the asymptotes of the exact integrals.
 
@@ -137,8 +142,7 @@ def asymptotic_coefficients(
     """
     if not isinstance(quad, PressureQuadrature):
         raise ArgumentError(f"quad must be a PressureQuadrature, got {type(quad).__name__}")
-    if not (np.isfinite(f) and f > 0):
-        raise ArgumentError(f"f must be a positive finite friction coefficient, got {f!r}")
+    f = check_friction(f, name="f")
     R = quad.radius if radius is None else radius
     if not (np.isfinite(R) and R > 0):
         raise ArgumentError(f"radius must be a positive finite length in m, got {radius!r}")

@@ -40,7 +40,29 @@ from . import compiled
 AVAILABLE = compiled.AVAILABLE
 
 #: Order of the scalars in `KernelCoefficients.scalars`.
-SCALARS = tuple("R F0 U0 U0^5 U0^6 Q00 Q01 Q11 S00 S01 S11 gx gy xcx xcy alpha g0 g1x g1y".split())
+SCALARS = tuple(
+    [
+        "R",
+        "F0",
+        "U0",
+        "U0^5",
+        "U0^6",
+        "Q00",
+        "Q01",
+        "Q11",
+        "S00",
+        "S01",
+        "S11",
+        "gx",
+        "gy",
+        "xcx",
+        "xcy",
+        "alpha",
+        "g0",
+        "g1x",
+        "g1y",
+    ]
+)
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ from ..friction.closed_form import f_parallel_ratio, f_perpendicular_ratio, torq
 from ..friction.exact import friction_resultants
 from ..friction.law import FrictionLaw
 from ..friction.quadrature import PressureQuadrature
+from ..friction_coefficient import DEFAULT_FRICTION
 
 #: Fitted parameters, in this order.
 PARAMETERS = ("F0", "M0", "a", "m", "k_x")
@@ -224,7 +225,7 @@ def exact_curves(
     R: float,
     *,
     rolling_quad: PressureQuadrature | None = None,
-    friction: float = 0.3,
+    friction: float = DEFAULT_FRICTION,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """F∥(ψ), M_C(υ), F⊥(υ) (N, N·m, N) from the exact Coulomb integrals.
 
