@@ -139,8 +139,13 @@ def test_verdict_words_and_holm_family():
     clean = lack_of_fit(data, np.arange(n), rng.normal(size=(n, 3)) * sigma, pred, sigma, J)
     assert not clean["detected"]
     assert clean["message"].startswith("no structure left beyond the noise")
-    assert clean["correction"] == "Holm over 5 tests"
-    assert set(clean["tests"]) == {"pure_error", "trend_file", "serial_file", "trend_time", "serial_time"}
+    assert clean["correction"] == "Holm over 10 tests"
+    assert set(clean["tests"]) == {
+        "pure_error_Fx", "pure_error_Fy", "pure_error_Mz", "structure_Fx", "structure_Fy", "structure_Mz",
+        "trend_file", "serial_file", "trend_time", "serial_time",
+    }  # fmt: skip
+    assert set(clean["channels"]) == {"Fx", "Fy", "Mz"}
+    assert not any(v["detected"] for v in clean["channels"].values())
     drift = pred * (0.1 * np.arange(n) / n)[:, None]  # the level creeps up along the run
     res = rng.normal(size=(n, 3)) * sigma + drift
     got = lack_of_fit(data, np.arange(n), res, pred, sigma, J)

@@ -22,12 +22,24 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from .measured import CHANNELS
 from .residuals import binned_means
 from .result import Diagnosis
 
 UNITS = {"Fx": "N", "Fy": "N", "Mz": "N·m"}
+#: Forces (moments) whose largest magnitude reaches this are drawn in kN (kN·m), so
+#: that aircraft-sized tick labels (−60000, 40000) do not run into each other.
+KILO_FROM = 5000.0
+
+
+def display_units(values: np.ndarray, unit: str) -> tuple[float, str]:
+    """(divisor, unit label) for drawing ``values`` in ``unit``: k-prefixed at or above `KILO_FROM`."""
+    top = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    return (1e3, "k" + unit) if top >= KILO_FROM else (1.0, unit)
+
+
 BEFORE = "0.55"
 AFTER = "tab:blue"
 
@@ -44,13 +56,16 @@ def plot_predicted_vs_measured(diag: Diagnosis, axes=None):
     after = diag.predictions["after_heldout"]
     for c, ax in enumerate(axes):
         ch = CHANNELS[c]
+        div, unit = display_units(np.concatenate([meas[:, c], before[:, c]]), UNITS[ch])
         rb = np.sqrt(np.mean(((meas[keep, c] - before[keep, c]) / diag.scales[c]) ** 2))
         ra = np.sqrt(np.mean(((meas[keep, c] - after[keep, c]) / diag.scales[c]) ** 2))
-        ax.scatter(meas[keep, c], before[keep, c], s=9, c=BEFORE, label=f"simulation (rmse {rb:.3g})")
+        ax.scatter(
+            meas[keep, c] / div, before[keep, c] / div, s=9, c=BEFORE, label=f"simulation (rmse {rb:.3g})"
+        )
         if diag.cause != "none":
             ax.scatter(
-                meas[keep, c],
-                after[keep, c],
+                meas[keep, c] / div,
+                after[keep, c] / div,
                 s=9,
                 c=AFTER,
                 alpha=0.7,
@@ -58,14 +73,15 @@ def plot_predicted_vs_measured(diag: Diagnosis, axes=None):
             )
         if not keep.all():
             ax.scatter(
-                meas[~keep, c], before[~keep, c], s=22, c=OUTLIER, marker="x", zorder=5,
+                meas[~keep, c] / div, before[~keep, c] / div, s=22, c=OUTLIER, marker="x", zorder=5,
                 label="outlier (left out)", gid="outliers",
             )  # fmt: skip
         lo = min(meas[:, c].min(), before[:, c].min())
         hi = max(meas[:, c].max(), before[:, c].max())
-        ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
-        ax.set_xlabel(f"measured {ch} ({UNITS[ch]})")
-        ax.set_ylabel(f"predicted {ch} ({UNITS[ch]})")
+        ax.plot([lo / div, hi / div], [lo / div, hi / div], "k-", lw=0.8)
+        ax.set_xlabel(f"measured {ch} ({unit})")
+        ax.set_ylabel(f"predicted {ch} ({unit})")
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
         ax.set_title(ch)
         ax.legend(fontsize=7, loc="upper left")
     axes[0].figure.suptitle(
@@ -136,8 +152,6 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
     ANOVA test on the standardised residuals; the run-order column shows the
     lack-of-fit run-order test. The legend sits below the panels.
     """
-    from matplotlib.ticker import MaxNLocator
-
     cols = _columns(diag)
     order_label, order_x = run_order(diag)
     ncol = len(cols) + 1
@@ -199,7 +213,7 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
                 if p is not None:
                     text = f"ANOVA p = {p:.2g}"
             elif c == 0 and name == order_label and trend_key in lof:
-                text = f"drift test p = {lof[trend_key]['p']:.2g}\n(chosen model)"
+                text = f"drift test p = {lof[trend_key]['p_holm']:.2g}\n(chosen model, Holm)"
             if text:
                 ax.text(0.03, 0.97, text, transform=ax.transAxes, fontsize=7, va="top", gid="p-value",
                         bbox={"fc": "white", "ec": "none", "alpha": 0.7, "pad": 1.0})  # fmt: skip
