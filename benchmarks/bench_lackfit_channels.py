@@ -118,9 +118,8 @@ def main(argv: list[str] | None = None) -> None:
         _SIMS.append(load_simulation(pmap, None, friction=0.3))
     t0 = time.perf_counter()
     for model in args.noise_models:
-        print(
-            f"\nnoise model {model} {NOISE_MODELS[model]} x {args.noise_factor:g}, {args.points} points, level {LOF_LEVEL} (Holm)"
-        )
+        what = f"{model} {NOISE_MODELS[model]} x {args.noise_factor:g}"
+        print(f"\nnoise model {what}, {args.points} points, level {LOF_LEVEL} (Holm)")
         for size in [0.0, *args.sizes]:
             jobs = [
                 (model, args.first_seed + i, i, args.points, size, args.noise_factor)
