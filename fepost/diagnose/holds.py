@@ -11,7 +11,9 @@ channel c of vx, vy, wz spans at most its tolerance,
 
     max − min ≤ abs_c + rel · max |c|   (abs: 1 mm/s for vx, vy, 0.001 rad/s for wz; rel 1 %),
 
-so the first window − 1 samples of a hold are left out as settling. A **hold**
+so the first window − 1 samples of a hold are left out as settling; so are its
+last window − 1 (a ramp that starts slowly stays within the tolerance for up to
+that many samples). A **hold**
 is a run of steady samples lasting at least ``min_seconds`` and ``min_samples``.
 With a ``point`` column (the rig's own test-point number, ``--point-column``)
 the holds are instead the runs of one finite point number, as long as above.
@@ -95,8 +97,9 @@ class Holds:
     """The holds of one recording: ``data`` (one row per hold, SI), their SEs and what was left out.
 
     ``se`` (m, 3): standard errors of the hold means of Fx, Fy, Mz (N, N, N·m);
-    ``dof`` (m,): their degrees of freedom; ``spans`` (m, 2): first and last
-    time of each hold (s); ``row_spans`` (m, 2): first and last row (0-based);
+    ``dof`` (m,): their degrees of freedom (the least of the three channels');
+    ``spans`` (m, 2): first and last time of each hold (s);
+    ``row_spans`` (m, 2): first and last row (0-based);
     ``left_out``: (first time, last time, rows) of each transition;
     ``trace``: a decimated copy of the recording for the figure.
     """
@@ -185,10 +188,11 @@ class _Builder:
         self.t_first = self.t_last = self.t_end = np.nan  # recording's first, last; last hold's end
         self.tail: dict[str, np.ndarray] = {}
         self.prev_point = np.nan
-        self.stride, self.trace = 1, {}
+        self.stride = 1
+        self.trace: dict[str, list[np.ndarray]] = {}
         self.total = 0
 
-    def steady(self, chunk: Chunk) -> np.ndarray:
+    def steady(self, chunk: Chunk) -> tuple[np.ndarray, np.ndarray]:
         """Per row of ``chunk``: steady by the rule, or the start of a new point (point mode: run ids)."""
         rule = self.rule
         if rule.use_point:
@@ -243,15 +247,20 @@ class _Builder:
             return
         block = {k: np.concatenate([o[k] for o in self.open]) for k in self.open[0]}
         self.open = []
+        trim = 0 if self.rule.use_point else self.rule.window - 1
+        if trim:  # a ramp stays within the tolerance for up to window - 1 samples: leave them out too
+            block = {k: v[:-trim] for k, v in block.items()}
         t = block["time"]
         n = t.size
         start = self.open_start
         if n < self.rule.min_samples or t[-1] - t[0] < self.rule.min_seconds:
             return
-        row = {k: float(np.mean(v)) for k, v in block.items() if k != "point"}
+        row: dict = {k: float(np.mean(v)) for k, v in block.items() if k != "point"}
+        dofs = []
         for c in FORCES:
-            _, se, dof = batch_means(block[c])
-            row[f"se_{c}"], row["dof"] = se, dof
+            _, row[f"se_{c}"], dof = batch_means(block[c])
+            dofs.append(dof)
+        row["dof"] = min(dofs)
         row["span"] = (float(t[0]), float(t[-1]))
         row["rows"] = (start, start + n - 1)
         if start > self.last_end + 1:

@@ -43,6 +43,7 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -176,7 +177,7 @@ def _leading_comments(path: Path) -> int:
     return n
 
 
-def _csv_batches(path: Path, wanted) -> Iterator[tuple[list[str], object]]:
+def _csv_batches(path: Path, wanted) -> Iterator[tuple[dict, Any]]:
     import pyarrow as pa
     from pyarrow import csv
 
@@ -196,7 +197,7 @@ def _csv_batches(path: Path, wanted) -> Iterator[tuple[list[str], object]]:
         raise DataError(f"{path}: not a numeric CSV recording ({msg})") from None
 
 
-def _parquet_batches(path: Path, wanted) -> Iterator[tuple[dict, object]]:
+def _parquet_batches(path: Path, wanted) -> Iterator[tuple[dict, Any]]:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -237,7 +238,7 @@ def _tdx_layout(path: Path) -> tuple[list[str], dict[str, tuple[str, float, floa
     raise DataError(f"{path}: no **MEASURDATA section: not a TYDEX file")
 
 
-def _tdx_batches(path: Path, wanted) -> Iterator[tuple[dict, object]]:
+def _tdx_batches(path: Path, wanted) -> Iterator[tuple[dict, Any]]:
     import pyarrow as pa
     from pyarrow import csv
 
