@@ -14,6 +14,10 @@
   load or pressure shows as a trend of the means even when the signed Fx, Fy
   residuals only fan out. Outliers are drawn in red.
 * :func:`plot_candidates` — ΔBIC of every candidate against the simulation.
+* :func:`plot_recording` — for a rig recording: the kinematics and forces
+  against time (a decimated copy, `fepost.diagnose.holds.TRACE_POINTS` samples
+  at most), the steady holds shaded and each hold's mean drawn on it, the rows
+  left out (transitions) in red.
 
 Each function takes an optional figure or axes and returns it; none calls show().
 """
@@ -261,6 +265,45 @@ def plot_candidates(diag: Diagnosis, ax=None):
     return ax
 
 
+def plot_recording(diag: Diagnosis, fig: Figure | None = None) -> Figure:
+    """The recording with its holds shaded and the left-out rows in red; returns the figure."""
+    holds = diag.holds
+    if holds is None:
+        raise ValueError("plot_recording needs a diagnosis of a recording (diag.holds is None)")
+    tr = holds.trace
+    if fig is None:
+        fig = Figure(figsize=(12, 9), layout="constrained")
+    axes = fig.subplots(4, 1, sharex=True)
+    t = tr["time"]
+    inside = np.zeros(t.size, bool)
+    for a, b in holds.spans:
+        inside[np.searchsorted(t, a) : np.searchsorted(t, b, side="right")] = True
+    panels = [(("vx", "vy"), "m/s"), (("wz",), "rad/s"), (("Fx", "Fy"), "N"), (("Mz",), "N·m")]
+    for ax, (names, unit) in zip(axes, panels, strict=True):
+        values = np.concatenate([tr[n] for n in names])
+        div, shown = display_units(values, unit) if unit in ("N", "N·m") else (1.0, unit)
+        for k, name in enumerate(names):
+            y = tr[name] / div
+            ax.plot(t, np.where(inside, y, np.nan), lw=0.6, color=f"C{k}", label=f"{name} (in holds)")
+            ax.plot(t, np.where(inside, np.nan, y), lw=0.6, color=OUTLIER, alpha=0.7,
+                    label="left out (transitions)" if k == 0 else None)  # fmt: skip
+            mean = np.asarray(getattr(diag.data, name)) / div
+            ax.hlines(mean, holds.spans[:, 0], holds.spans[:, 1], color="k", lw=1.2,
+                      label="hold mean" if k == 0 else None)  # fmt: skip
+        ax.fill_between(t, 0, 1, where=inside, transform=ax.get_xaxis_transform(), color="tab:green",
+                        alpha=0.12, lw=0, label="steady hold")  # fmt: skip
+        ax.set_ylabel(f"{', '.join(names)} ({shown})", fontsize=9)
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
+        ax.legend(fontsize=7, loc="upper right", ncol=4)
+    axes[-1].set_xlabel("time (s)")
+    d = holds.to_dict()
+    fig.suptitle(
+        f"recording: {d['count']} steady holds, {d['rows_used']} of {d['rows']} rows used, "
+        f"{d['rows_left_out']} left out as transitions"
+    )
+    return fig
+
+
 def save_figures(diag: Diagnosis, folder) -> list[str]:
     """Write the three figures as PNG into ``folder``; returns the file names."""
     from pathlib import Path
@@ -274,4 +317,7 @@ def save_figures(diag: Diagnosis, folder) -> list[str]:
     out.append("residuals.png")
     plot_candidates(diag).figure.savefig(folder / "candidates.png", dpi=110)
     out.append("candidates.png")
+    if diag.holds is not None:
+        plot_recording(diag).savefig(folder / "recording.png", dpi=100)
+        out.append("recording.png")
     return out
