@@ -59,7 +59,7 @@ def add_parser(sub) -> None:
         help="recording channel names, e.g. Fx=FX_N,Mz=MZ_Nm,time=RUNTIME (default: own names, aliases)",
     )
     p.add_argument(
-        "--units",
+        "--channel-units",
         metavar="MAP",
         help="recording units per channel, e.g. Fx=kN,Fy=kN,Mz=kNm,wz=deg/s,vx=km/h (default SI)",
     )
@@ -164,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
     from ..diagnose.recording import Columns
     from ..diagnose.writer import write_diagnosis
 
-    columns = Columns.parse(args.columns, args.units)
+    columns = Columns.parse(args.columns, args.channel_units)
     if args.point_column:
         columns = Columns({**columns.names, "point": args.point_column}, columns.units)
     result = diagnose(

@@ -116,8 +116,10 @@ class Holds:
     trace: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
-        for name in ("se", "dof", "spans", "row_spans"):
+        for name in ("se", "spans"):
             object.__setattr__(self, name, frozen(getattr(self, name)))
+        for name in ("dof", "row_spans"):
+            object.__setattr__(self, name, frozen(getattr(self, name), dtype=int))
 
     @property
     def count(self) -> int:

@@ -27,7 +27,7 @@ source column of a channel; without it each channel is found under its own name
 or a common alias (:data:`ALIASES`, matched without regard to case, e.g.
 ``FX``, ``Force_X``, ``RUNTIME``; ``Fz``/``FZ`` for ``N``, whose sign is dropped:
 rigs record the load as a compressive, often negative, Fz). **Units**: each
-channel is converted to SI with a factor from :data:`UNITS` (``--units
+channel is converted to SI with a factor from :data:`UNITS` (``--channel-units
 Fx=kN,wz=deg/s``); TYDEX files state their units, which are used when no unit
 is given. Unknown units, missing channels and non-finite values are one-line
 :class:`~fepost.errors.DataError` naming the file and the column.
@@ -113,14 +113,16 @@ class Columns:
     def __post_init__(self) -> None:
         for ch, unit in self.units.items():
             if ch not in UNITS:
-                raise ArgumentError(f"--units: unknown channel {ch!r} (one of {', '.join(UNITS)})")
+                raise ArgumentError(f"--channel-units: unknown channel {ch!r} (one of {', '.join(UNITS)})")
             if unit not in UNITS[ch]:
-                raise ArgumentError(f"--units: unit {unit!r} of {ch} is not one of {', '.join(UNITS[ch])}")
+                raise ArgumentError(
+                    f"--channel-units: unit {unit!r} of {ch} is not one of {', '.join(UNITS[ch])}"
+                )
 
     @classmethod
     def parse(cls, columns: str | None = None, units: str | None = None) -> Columns:
-        """From the command line's ``--columns Fx=FX_N,...`` and ``--units Fx=kN,...``."""
-        return cls(_parse_pairs(columns, "--columns"), _parse_pairs(units, "--units"))
+        """From the command line's ``--columns Fx=FX_N,...`` and ``--channel-units Fx=kN,...``."""
+        return cls(_parse_pairs(columns, "--columns"), _parse_pairs(units, "--channel-units"))
 
     def resolve(self, available: list[str], source: str) -> dict[str, str]:
         """channel -> source column for the ``available`` names; a needed channel missing is an error."""
