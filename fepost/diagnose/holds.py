@@ -1,11 +1,11 @@
 """Steady holds of a rig recording, each reduced to one test point with its standard error.
 
 A rig holds each kinematic point for a few seconds and ramps between points.
-:func:`find_holds` reads the recording chunk by chunk
-(:func:`fepost.diagnose.recording.read_chunks`) and keeps one chunk and the
+`find_holds` reads the recording chunk by chunk
+(`fepost.diagnose.recording.read_chunks`) and keeps one chunk and the
 current hold in memory.
 
-**The rule** (:class:`HoldRule`). Sample i is *steady* when over the trailing
+**The rule** (`HoldRule`). Sample i is *steady* when over the trailing
 window of ``window`` samples (i − window + 1 … i) each commanded kinematic
 channel c of vx, vy, wz spans at most its tolerance,
 
@@ -24,15 +24,15 @@ many and the time spans.
 hold's mid time), and per force channel the standard error of the mean by
 **batch means**: with τ = (1 + ρ₁)/(1 − ρ₁) the correlation time (in samples)
 from the lag-1 autocorrelation ρ₁ of the hold's samples, the hold is cut into b
-consecutive batches of at least :data:`TAU_BATCHES` × τ samples (and at least
-:data:`MIN_BATCH`; at most :data:`BATCHES` batches, at least 2), and
+consecutive batches of at least `TAU_BATCHES` × τ samples (and at least
+`MIN_BATCH`; at most `BATCHES` batches, at least 2), and
 SE² = var(batch means)/b with b − 1 degrees of freedom. Batches ten correlation
 times long are nearly independent (for AR(1) noise the batch-means variance is
 then a few % low), so the SE accounts for autocorrelated samples, where σ/√n
 would be too small by √τ.
 
-The lack-of-fit test (:mod:`fepost.diagnose.lackfit`) uses them pooled per
-channel (:meth:`Holds.pure_error`): κ_c = Σ ν_i n_i SE_ic² / Σ ν_i is the
+The lack-of-fit test (`fepost.diagnose.lackfit`) uses them pooled per
+channel (`Holds.pure_error`): κ_c = Σ ν_i n_i SE_ic² / Σ ν_i is the
 long-run variance of one sample, the same in every hold when the rig's noise
 is, and a hold of n_i samples has SE_ic = √(κ_c/n_i) on Σ ν_i degrees of
 freedom (a per-hold SE on a few degrees of freedom would make Σ (r/SE)²

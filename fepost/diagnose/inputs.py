@@ -1,12 +1,12 @@
 """Measured data in: a table of test points, or a rig recording reduced to its steady holds.
 
-:func:`load_measured` decides. ``layout="points"``: the measured-data CSV of
-test points (:mod:`fepost.diagnose.measured`), exactly as always.
-``layout="recording"``: a time series (:mod:`fepost.diagnose.recording`,
-:mod:`fepost.diagnose.holds`). ``layout="auto"`` (the default): a recording
+`load_measured` decides. ``layout="points"``: the measured-data CSV of
+test points (`fepost.diagnose.measured`), exactly as always.
+``layout="recording"``: a time series (`fepost.diagnose.recording`,
+`fepost.diagnose.holds`). ``layout="auto"`` (the default): a recording
 when the file is Parquet, MATLAB or TYDEX, when a column mapping, a unit or a
 point column is given, or when a CSV has more than
-:data:`~fepost.diagnose.measured.MAX_ROWS` data rows (counted without parsing,
+`fepost.diagnose.measured.MAX_ROWS` data rows (counted without parsing,
 and only up to that limit); otherwise a table of test points.
 """
 

@@ -3,8 +3,8 @@
 All tests use the standardised residuals z_ic = r_ic/σ_ic of the chosen model on
 the rows kept (outliers left out), stacked over the three channels (N = 3n
 observations), and its whitened Jacobian J (p mean parameters). Observations
-whose noise SD is below :data:`FLOOR_FACTOR` × the noise floor
-(:data:`~fepost.diagnose.noise.NOISE_FLOOR`, the model's numerical accuracy)
+whose noise SD is below `FLOOR_FACTOR` × the noise floor
+(`fepost.diagnose.noise.NOISE_FLOOR`, the model's numerical accuracy)
 are left out of the tests (their z are set to zero and their rows and columns
 dropped): there the floor, not the data, sets σ, so their scatter measures
 neither noise nor misfit (a force that is zero by symmetry, measured with noise
@@ -23,10 +23,10 @@ proportional to the reading, has no scatter at all).
    measures the misfit against the pure-error scatter of that channel alone: the
    noise model's σ cancels (replicates share it), so a misfit that inflates one
    channel's fitted noise cannot hide itself, and two clean channels cannot
-   dilute it (a pooled three-channel test, :func:`pure_error_test`, is diluted
-   by both). Needs at least :data:`MIN_PURE_ERROR_DF` replicate degrees of
+   dilute it (a pooled three-channel test, `pure_error_test`, is diluted
+   by both). Needs at least `MIN_PURE_ERROR_DF` replicate degrees of
    freedom per channel. For the hold means of a time series
-   (:mod:`fepost.diagnose.holds`) every row has its own standard error s_ic
+   (`fepost.diagnose.holds`) every row has its own standard error s_ic
    from the scatter within its hold (autocorrelation accounted for) on ν_i
    degrees of freedom; then F_c = Σ_i (r_ic/s_ic)²/(m − p_c) ~ F(m − p_c, Σ ν_i),
    with p_c from the Jacobian whitened by s.
@@ -43,7 +43,7 @@ proportional to the reading, has no scatter at all).
 
 Tests 2 and 3 run in file order and, when the data carry ``time``, in time
 order. The family of tests (the three pure-error tests, one per channel, and the
-run-order tests) is corrected by Holm's step-down method at :data:`LOF_LEVEL`:
+run-order tests) is corrected by Holm's step-down method at `LOF_LEVEL`:
 lack of fit is **detected** when the smallest p-value times the number of tests
 is below it. ``p_value`` is that Holm-adjusted p-value of the strongest test and
 ``test`` its name; ``channels`` gives each channel's pure-error test
@@ -107,7 +107,7 @@ def pure_error_test(z: np.ndarray, labels: np.ndarray, p: int, used: np.ndarray 
 
     ``used`` (n, 3) marks the observations tested (default all); replicates share
     a prediction and a σ, so a channel is used in all rows of a group or in none.
-    The verdict uses the per-channel tests (:func:`channel_pure_error_test`); this
+    The verdict uses the per-channel tests (`channel_pure_error_test`); this
     pooled form is kept for comparison.
     """
     used = np.ones(z.shape, bool) if used is None else used

@@ -3,7 +3,7 @@
 A recording has one row per sample: ``time`` (s), the kinematics ``vx``, ``vy``
 (m/s), ``wz`` (rad/s), the channels ``Fx``, ``Fy`` (N), ``Mz`` (N·m), and
 optionally ``N`` (N), ``roll`` and ``point`` (a test-point number given by the
-rig: :mod:`fepost.diagnose.holds` then takes the holds from it). Formats, by
+rig: `fepost.diagnose.holds` then takes the holds from it). Formats, by
 suffix:
 
 ========================= ==========================================================
@@ -22,18 +22,18 @@ suffix:
                           rows up to ``**END``; ``!`` lines are comments
 ========================= ==========================================================
 
-**Column mapping** (:class:`Columns`): ``--columns Fx=FX_N,Mz=MZ_Nm`` names the
+**Column mapping** (`Columns`): ``--columns Fx=FX_N,Mz=MZ_Nm`` names the
 source column of a channel; without it each channel is found under its own name
-or a common alias (:data:`ALIASES`, matched without regard to case, e.g.
+or a common alias (`ALIASES`, matched without regard to case, e.g.
 ``FX``, ``Force_X``, ``RUNTIME``; ``Fz``/``FZ`` for ``N``, whose sign is dropped:
 rigs record the load as a compressive, often negative, Fz). **Units**: each
-channel is converted to SI with a factor from :data:`UNITS` (``--channel-units
+channel is converted to SI with a factor from `UNITS` (``--channel-units
 Fx=kN,wz=deg/s``); TYDEX files state their units, which are used when no unit
 is given. Unknown units, missing channels and non-finite values are one-line
-:class:`~fepost.errors.DataError` naming the file and the column.
+`fepost.errors.DataError` naming the file and the column.
 
-Reading streams :data:`CHUNK_ROWS` rows at a time (Parquet batches, CSV blocks,
-HDF5 slices), so the caller (:func:`fepost.diagnose.holds.find_holds`) holds one
+Reading streams `CHUNK_ROWS` rows at a time (Parquet batches, CSV blocks,
+HDF5 slices), so the caller (`fepost.diagnose.holds.find_holds`) holds one
 chunk and one hold in memory, not the recording.
 """
 

@@ -1,11 +1,11 @@
 """Synthetic rig recordings: test points held for seconds, ramps between them, autocorrelated noise.
 
-:func:`synthetic_recording` turns the noise-free test points of a
-:class:`~fepost.diagnose.synthetic.SyntheticData` (a hidden effect already in
+`synthetic_recording` turns the noise-free test points of a
+`fepost.diagnose.synthetic.SyntheticData` (a hidden effect already in
 them) into what a rig writes: each point held for ``hold`` s at ``rate`` Hz,
 joined by linear ramps of ``ramp`` s (kinematics and forces both ramp), with
 AR(1) noise (lag-1 correlation ``rho``, stationary SD ``sd`` per force channel)
-added to every sample. :func:`write_recording` writes it as CSV, Parquet,
+added to every sample. `write_recording` writes it as CSV, Parquet,
 MATLAB v5 or v7.3, or TYDEX, with the rig's own channel names and units when
 asked (so the reading side's mapping is exercised).
 """

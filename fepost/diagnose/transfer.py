@@ -14,14 +14,14 @@ origin), with the torque about the patch origin gaining d × F
 `PressureQuadrature.shifted`, and the tests compare the two). So one exact
 evaluation gives every row its own shift at once.
 
-Fitting follows ``pressure_shift`` (:mod:`fepost.diagnose.models`): ``expand(values)``
+Fitting follows ``pressure_shift`` (`fepost.diagnose.models`): ``expand(values)``
 evaluates the exact resultants at the rows' converged shifts d⁰ and at d⁰ ± δ
-along x and y (δ = :data:`SHIFT_STEP` × R, plus one mixed point), builds each
+along x and y (δ = `SHIFT_STEP` × R, plus one mixed point), builds each
 row's second-order Taylor model of the resultants in its own shift, and solves
 the fixed point in that local model (exact at d⁰). ``predict(values)`` (the exact
 model) starts from the local model about zero shift and corrects the shifts by
 Newton steps on exact evaluations until they move by less than
-:data:`SHIFT_TOL` × R (:data:`MAX_EXACT` evaluations at most; the map
+`SHIFT_TOL` × R (`MAX_EXACT` evaluations at most; the map
 d ↦ h F(d)/N contracts for |h| f ≲ the patch radius, the parameter bounds).
 
 h_x, h_y are the effective heights; h = 0 is no effect (``friction_level``). The
