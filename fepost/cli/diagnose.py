@@ -27,11 +27,14 @@ def add_parser(sub) -> None:
         help="what the simulation gets wrong against measured friction data, and why",
         description=(
             "Fit every candidate cause (friction level, pressure- or speed-dependent friction, "
-            "elliptic patch, anisotropic friction, pressure shift, sensor offsets) through the exact "
+            "elliptic patch, anisotropic friction, pressure shift, sensor offsets, sensor crosstalk, "
+            "load transfer) through the exact "
             "friction integrals, robustly (gross outliers are flagged and left out) and under a noise "
             "model chosen per channel (constant, proportional to |F|, or both); choose by BIC with "
             "nesting tests and a held-out check, try a second cause on top, test for lack of fit "
-            "(replicates, drift along the run order or a time column) and report the gain. "
+            "(per channel against replicates or the scatter within holds, drift along the run order or "
+            "a time column) and report the gain. Rig recordings (CSV, Parquet, MATLAB, TYDEX) are "
+            "reduced to their steady holds first. "
             "With --make-example CSV, write example measured data over SIM instead. "
             "Formats and every output key: docs/diagnose.md."
         ),
