@@ -60,7 +60,7 @@ BATCHES = 20
 MIN_BATCH = 5
 TAU_BATCHES = 10.0
 #: Most samples kept for the recording figure (decimated evenly).
-TRACE_POINTS = 20_000
+TRACE_POINTS = 5_000
 #: Left-out spans listed in the report (the count is always complete).
 MAX_SPANS = 200
 KINEMATICS = ("vx", "vy", "wz")

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ArgumentError, DataError
+from ..errors import ArgumentError
 from .holds import HoldRule, Holds, find_holds
 from .measured import MAX_ROWS, MeasuredData, read_measured
-from .recording import Columns
+from .recording import ALIASES, Columns
 
 LAYOUTS = ("auto", "points", "recording")
 
@@ -44,7 +44,20 @@ def is_recording(path, columns: Columns | None, rule: HoldRule | None) -> bool:
         return True
     if rule is not None and rule.use_point:
         return True
-    return path.is_file() and _more_rows_than(path, MAX_ROWS)
+    return _more_rows_than(path, MAX_ROWS) and _has_time(path, columns)
+
+
+def _has_time(path: Path, columns: Columns | None) -> bool:
+    """Whether the CSV's header names a time column (a table of points without one is refused as before)."""
+    if columns is not None and "time" in columns.names:
+        return True
+    with path.open("r", encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            s = line.strip()
+            if s and not s.startswith("#"):
+                names = {c.strip().lower() for c in s.split(",")}
+                return bool(names & {"time", *ALIASES["time"]})
+    return False
 
 
 def load_measured(
@@ -64,7 +77,7 @@ def load_measured(
         raise ArgumentError(f"measured must be a path, MeasuredData or Holds, got {type(measured).__name__}")
     path = Path(measured)
     if not path.is_file():
-        raise DataError(f"{path}: no such file")
+        return read_measured(path), None  # the table reader's own message (no such file, a folder, ...)
     recording = layout == "recording" or (layout == "auto" and is_recording(path, columns, hold_rule))
     if not recording:
         return read_measured(path), None

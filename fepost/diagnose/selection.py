@@ -46,7 +46,7 @@ from .models import Candidate
 #: Folds of the held-out check.
 FOLDS = 5
 #: Level of each nesting likelihood-ratio test (Bonferroni: 5 % over the 9 extensions).
-ALPHA = 0.05 / (len(CAUSES) - 2)
+ALPHA = 0.05 / (len(CAUSES) - 1)
 #: BIC difference below which two admissible, non-nested candidates are indistinguishable.
 INDISTINGUISHABLE_DBIC = 10.0
 
