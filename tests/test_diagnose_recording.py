@@ -95,6 +95,14 @@ def test_point_column_gives_the_rig_holds(recording, tmp_path):
     h = find_holds(path, Columns({"point": "point"}), HoldRule(use_point=True))
     assert h.count == len(syn.data)
     assert h.rows_used == np.count_nonzero(rec["hold_id"] >= 0)
+    # without transitions between them, consecutive points are still told apart
+    keep = rec["hold_id"] >= 0
+    packed = {k: v[keep] for k, v in rec.items()}
+    packed["time"] = np.arange(packed["time"].size) / 200.0
+    h2 = find_holds(write_recording(packed, tmp_path / "q.parquet"), Columns({"point": "point"}),
+                    HoldRule(use_point=True))  # fmt: skip
+    assert h2.count == len(syn.data) and h2.rows_used == packed["time"].size
+    np.testing.assert_allclose(h2.data.forces, h.data.forces, rtol=1e-12)
 
 
 @pytest.mark.parametrize("suffix", FORMATS)

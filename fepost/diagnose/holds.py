@@ -234,10 +234,10 @@ class _Builder:
         # runs of equal flag (and in point mode, breaks where the point changes)
         edges = np.flatnonzero((np.diff(flags.astype(np.int8)) != 0) | starts[1:]) + 1
         bounds = np.concatenate([[0], edges, [n]])
-        if starts[0]:
-            self._close()
         for a, b in zip(bounds[:-1], bounds[1:], strict=True):
             if flags[a]:
+                if starts[a]:  # point mode: a new test point begins here
+                    self._close()
                 if not self.open:
                     self.open_start = chunk.start + a
                 self.open.append({k: v[a:b] for k, v in chunk.values.items()})
