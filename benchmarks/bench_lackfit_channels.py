@@ -17,7 +17,14 @@ measures with the whole pipeline) and is ~10× faster.
   detected and names Fy, and for comparison the rate of the pooled
   three-channel test of earlier versions (``pure_error_test``) at the same level.
 
-Run: ``python benchmarks/bench_lackfit_channels.py [--seeds 100] [--points 150]
+``--recording``: instead of test points, each data set is a rig recording of
+the points (`fepost.diagnose.synthetic_recording`: 3 s holds at 200 Hz, 1 s
+ramps, AR(1) noise with ρ = 0.9 and a per-sample SD of 3 % of f·N in Fx, Fy
+and of f·N·R in Mz), read back and reduced to its holds
+(`fepost.diagnose.holds.find_holds`); the test then takes its pure error from
+the scatter within the holds.
+
+Run: ``python benchmarks/bench_lackfit_channels.py [--recording] [--seeds 100] [--points 150]
 [--sizes 0.01 0.02 0.03 0.06] [--noise-factor 1] [--jobs 2]``
 """
 
@@ -57,7 +64,22 @@ def wilson(k: int, n: int) -> str:
     return f"{k}/{n} = {k / n:.1%} (Wilson 95 % CI {ci.low:.1%} .. {ci.high:.1%})"
 
 
-def _verdict(data, sim):
+def _holds(syn, size, seed):
+    """The data set as a recording's hold means (module docstring, ``--recording``)."""
+    import tempfile
+
+    from fepost.diagnose.holds import find_holds
+    from fepost.diagnose.synthetic_recording import synthetic_recording, write_recording
+
+    scale = np.array([1.0, 1.0, syn.meta["R"]]) * syn.friction * syn.meta["N"]
+    rec = synthetic_recording(syn, sd=0.03 * scale, rho=0.9, seed=seed)
+    if size:
+        rec["Fy"] = rec["Fy"] + size * rec["Fx"]
+    with tempfile.TemporaryDirectory() as tmp:
+        return find_holds(write_recording(rec, f"{tmp}/rec.parquet"))
+
+
+def _verdict(data, sim, pure=None):
     pred = Predictor(sim, data)
     cands = build_candidates(pred)
     cands = {k: cands[k] for k in ("none", "friction_level")}
@@ -68,7 +90,8 @@ def _verdict(data, sim):
     prediction = cand.predict(f.values)
     sigma = f.noise.sigma()[rows]
     res = (Y - prediction)[rows]
-    lof = lack_of_fit(data, rows, res, prediction[rows], sigma, f.jacobian)
+    pe = None if pure is None else (pure[0][rows] / pred.scale, pure[1][rows])
+    lof = lack_of_fit(data, rows, res, prediction[rows], sigma, f.jacobian, pure_error=pe)
     used = sigma >= 2.0 * NOISE_FLOOR
     pooled = pure_error_test(np.where(used, res / sigma, 0.0), point_keys(data)[rows], 1, used)
     return lof, pooled
@@ -77,13 +100,18 @@ def _verdict(data, sim):
 def _one(job):
     model, seed, i, points, size, factor = job
     pmap, sim = _MAPS[i % len(_MAPS)], _SIMS[i % len(_SIMS)]
-    noise = {k: factor * v for k, v in NOISE_MODELS[model].items()}
-    syn = synthesize(pmap, "none", {}, friction=0.3, n=points, seed=seed, **noise)
-    data = syn.data
-    if size:
-        data = dataclasses.replace(data, Fy=data.Fy + size * data.Fx)
     t = time.perf_counter()
-    lof, pooled = _verdict(data, sim)
+    if model == "recording":
+        syn = synthesize(pmap, "none", {}, friction=0.3, n=points, seed=seed, noise=0.0)
+        holds = _holds(syn, size, seed)
+        lof, pooled = _verdict(holds.data, sim, holds.pure_error())
+    else:
+        noise = {k: factor * v for k, v in NOISE_MODELS[model].items()}
+        syn = synthesize(pmap, "none", {}, friction=0.3, n=points, seed=seed, **noise)
+        data = syn.data
+        if size:
+            data = dataclasses.replace(data, Fy=data.Fy + size * data.Fx)
+        lof, pooled = _verdict(data, sim)
     return {
         "detected": lof["detected"],
         "channels": {ch: v["detected"] for ch, v in lof["channels"].items()},
@@ -109,7 +137,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--noise-models", nargs="+", default=list(NOISE_MODELS), choices=list(NOISE_MODELS))
     parser.add_argument("--noise-factor", type=float, default=1.0, help="multiplies every noise SD")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--recording", action="store_true", help="hold means of recordings (docstring)")
     args = parser.parse_args(argv)
+    if args.recording:
+        args.noise_models = ["recording"]
+        NOISE_MODELS["recording"] = {"per-sample SD": 0.03, "AR(1) rho": 0.9}
     for name, radius, peak in MAPS:
         pmap = PolarMap.from_function(
             pressure_function(name, radius, peak=peak), radius, PolarGrid.make(), source=name
