@@ -85,7 +85,7 @@ def test_residual_figure_draws_the_tested_group_means(which, request):
     # the figure shows the Holm-adjusted p-value, as the summary and the JSON do
     key = "trend_time" if d.data.time is not None else "trend_file"
     shown = float(drift[0].split("=")[1].split()[0])
-    assert shown == pytest.approx(d.lack_of_fit["tests"][key]["p_holm"], rel=0.05, abs=1e-300)
+    assert shown == pytest.approx(d.lack_of_fit["tests"][key]["p_holm"], rel=0.06)  # shown with 2 digits
 
 
 def test_large_forces_are_drawn_in_kilonewtons():
