@@ -11,8 +11,9 @@ Then, ``--repeat`` times each, in fresh processes:
 * a plain read of the same file into memory: ``pyarrow.parquet.read_table`` or
   ``pyarrow.csv.read_csv`` (the floor any reader of the whole file pays).
 
-Wall time and peak resident memory (``os.wait4``'s ru_maxrss of that child)
-are reported as medians. The machine is shared: run under ``nice`` and read
+Wall time, CPU time (user + system) and peak resident memory (``os.wait4``'s
+rusage of that child) are reported as medians; on a loaded machine the CPU
+time is the steadier figure. The machine is shared: run under ``nice`` and read
 the load average printed with the results.
 
 Run: ``python benchmarks/bench_diagnose_recording.py [--rows 1e6 3e6] [--formats parquet csv]
@@ -60,8 +61,8 @@ def _make(folder: Path, rows: int, suffix: str, args) -> tuple[Path, Path]:
     return sim, path
 
 
-def _run(cmd: list[str]) -> tuple[float, float, int]:
-    """(seconds, peak RSS in MB, exit status) of one child process."""
+def _run(cmd: list[str]) -> tuple[float, float, int, float]:
+    """(wall seconds, peak RSS in MB, exit status, CPU seconds) of one child process."""
     t = time.perf_counter()
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     _, status, usage = os.wait4(proc.pid, 0)
@@ -70,7 +71,7 @@ def _run(cmd: list[str]) -> tuple[float, float, int]:
     code = os.waitstatus_to_exitcode(status)
     if code:
         print(f"    failed ({code}): {err.strip().splitlines()[-1] if err.strip() else ''}")
-    return seconds, usage.ru_maxrss / 1024.0, code
+    return seconds, usage.ru_maxrss / 1024.0, code, usage.ru_utime + usage.ru_stime
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -104,9 +105,10 @@ def main(argv: list[str] | None = None) -> None:
             for name, runs in res.items():
                 secs = np.median([r[0] for r in runs])
                 mem = np.median([r[1] for r in runs])
+                cpu = np.median([r[3] for r in runs])
                 ok = all(r[2] == 0 for r in runs)
                 note = f"{len(runs)} runs" + ("" if ok else ", FAILED")
-                print(f"    {name:<11} median {secs:7.1f} s  peak RSS {mem:7.0f} MB  ({note})")
+                print(f"    {name:<11} median {secs:7.1f} s wall, {cpu:7.1f} s CPU, peak RSS {mem:7.0f} MB ({note})")
     print(f"load average after {os.getloadavg()}")
 
 

@@ -55,7 +55,7 @@ def _has_time(path: Path, columns: Columns | None) -> bool:
         for line in fh:
             s = line.strip()
             if s and not s.startswith("#"):
-                names = {c.strip().lower() for c in s.split(",")}
+                names = {c.strip().strip('"').strip().lower() for c in s.split(",")}
                 return bool(names & {"time", *ALIASES["time"]})
     return False
 
