@@ -108,7 +108,8 @@ def main(argv: list[str] | None = None) -> None:
                 cpu = np.median([r[3] for r in runs])
                 ok = all(r[2] == 0 for r in runs)
                 note = f"{len(runs)} runs" + ("" if ok else ", FAILED")
-                print(f"    {name:<11} median {secs:7.1f} s wall, {cpu:7.1f} s CPU, peak RSS {mem:7.0f} MB ({note})")
+                what = f"median {secs:7.1f} s wall, {cpu:7.1f} s CPU, peak RSS {mem:7.0f} MB"
+                print(f"    {name:<11} {what} ({note})")
     print(f"load average after {os.getloadavg()}")
 
 
