@@ -17,7 +17,9 @@ points, noise 1.5 %; ``B`` paraboloid R = 0.09 m with a rolling map (k_x = 0.1),
 roll −1/0/+1, 300 points, noise 2 %; ``rig`` the set-A map and effects as in
 tests/test_diagnose_rig.py: 300 points, noise 3 % of |reading| (no floor) and four
 gross errors per data set (the same rows in every replicate); ``rig-combined``
-the same with noise SD² = (0.75 % of range)² + (2 % of |reading|)²; ``pairs`` the two
+the same with noise SD² = (0.75 % of range)² + (2 % of |reading|)²; ``new`` the
+causes ``sensor_crosstalk`` and ``load_transfer`` on a Hertzian map R = 0.1 m, 300
+points, noise 1.5 %; ``pairs`` the two
 two-cause cases of that file (friction level with sensor offsets, anisotropy
 with a pressure shift; 400 points, noise 1.5 %), their joint model fitted.
 
@@ -80,10 +82,22 @@ def set_up(name: str):
     if name == "pairs":
         pmap = _map("tire", 0.12, 2.5e5)
         return PAIRS, 1204, {"n": 400, "noise": 0.015, "loads": (0.7, 1.0, 1.3)}, pmap, None
+    if name == "new":
+        return NEW, 300, {"n": 300, "noise": 0.015}, _map("hertz", 0.1, 3.0e5), None
     if name == "B":
         static, rolling = _map("paraboloid", 0.09, 4e5), _map("paraboloid", 0.09, 4e5, k_x=0.1)
         return SET_B, 200, {"n": 300, "noise": 0.02}, static, rolling
     raise SystemExit(f"unknown set {name!r}")
+
+
+#: The causes added with rig recordings (set ``new``): a load-cell crosstalk and a load transfer.
+NEW = (
+    (
+        "sensor_crosstalk",
+        {"c_xy": 0.0, "c_xz": 0.0, "c_yx": 0.06, "c_yz": 0.0, "c_zx": 0.002, "c_zy": -0.0015},
+    ),
+    ("load_transfer", {"h_x": 0.03, "h_y": 0.02}),
+)
 
 
 # Fork-shared state of one (set, cause) study: the workers inherit it.

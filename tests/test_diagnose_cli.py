@@ -15,7 +15,8 @@ from fepost.diagnose.synthetic import synthesize
 
 CAUSES = {
     "none", "friction_level", "pressure_dependent_friction", "speed_dependent_friction",
-    "elliptic_patch", "anisotropic_friction", "pressure_shift", "sensor_offset",
+    "elliptic_patch", "anisotropic_friction", "pressure_shift", "sensor_offset", "sensor_crosstalk",
+    "load_transfer",
 }  # fmt: skip
 
 

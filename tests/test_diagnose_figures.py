@@ -80,7 +80,19 @@ def test_residual_figure_draws_the_tested_group_means(which, request):
     assert got == want
     texts = [t.get_text() for ax in fig.axes for t in ax.texts]
     assert any(t.startswith("ANOVA p = ") for t in texts)
-    assert any(t.startswith("drift test p = ") for t in texts)
+    drift = [t for t in texts if t.startswith("drift test p = ")]
+    assert drift
+    # the figure shows the Holm-adjusted p-value, as the summary and the JSON do
+    key = "trend_time" if d.data.time is not None else "trend_file"
+    shown = float(drift[0].split("=")[1].split()[0])
+    assert shown == pytest.approx(d.lack_of_fit["tests"][key]["p_holm"], rel=0.06)  # shown with 2 digits
+
+
+def test_large_forces_are_drawn_in_kilonewtons():
+    from fepost.diagnose.figures import display_units
+
+    assert display_units(np.array([-60000.0, 40000.0]), "N") == (1e3, "kN")
+    assert display_units(np.array([-4999.0, 30.0]), "N·m") == (1.0, "N·m")
 
 
 def test_outliers_are_drawn_in_every_panel(diag_outliers):

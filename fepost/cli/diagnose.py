@@ -27,11 +27,14 @@ def add_parser(sub) -> None:
         help="what the simulation gets wrong against measured friction data, and why",
         description=(
             "Fit every candidate cause (friction level, pressure- or speed-dependent friction, "
-            "elliptic patch, anisotropic friction, pressure shift, sensor offsets) through the exact "
+            "elliptic patch, anisotropic friction, pressure shift, sensor offsets, sensor crosstalk, "
+            "load transfer) through the exact "
             "friction integrals, robustly (gross outliers are flagged and left out) and under a noise "
             "model chosen per channel (constant, proportional to |F|, or both); choose by BIC with "
             "nesting tests and a held-out check, try a second cause on top, test for lack of fit "
-            "(replicates, drift along the run order or a time column) and report the gain. "
+            "(per channel against replicates or the scatter within holds, drift along the run order or "
+            "a time column) and report the gain. Rig recordings (CSV, Parquet, MATLAB, TYDEX) are "
+            "reduced to their steady holds first. "
             "With --make-example CSV, write example measured data over SIM instead. "
             "Formats and every output key: docs/diagnose.md."
         ),
@@ -50,7 +53,29 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--measured",
         metavar="CSV",
-        help="measured friction data (CSV: vx, vy, wz, Fx, Fy, Mz [, N, roll, time]; docs/diagnose.md)",
+        help="measured friction data: a CSV of test points (vx, vy, wz, Fx, Fy, Mz [, N, roll, time]) or "
+        "a rig recording (.csv, .parquet, .mat, .tdx) whose steady holds are found; docs/diagnose.md",
+    )
+    p.add_argument(
+        "--columns",
+        metavar="MAP",
+        help="recording channel names, e.g. Fx=FX_N,Mz=MZ_Nm,time=RUNTIME (default: own names, aliases)",
+    )
+    p.add_argument(
+        "--channel-units",
+        metavar="MAP",
+        help="recording units per channel, e.g. Fx=kN,Fy=kN,Mz=kNm,wz=deg/s,vx=km/h (default SI)",
+    )
+    p.add_argument(
+        "--point-column",
+        metavar="NAME",
+        help="recording column numbering the test points: holds are its runs (default: steady kinematics)",
+    )
+    p.add_argument(
+        "--layout",
+        choices=("auto", "points", "recording"),
+        default="auto",
+        help="read --measured as a table of test points or as a recording (default auto: docs/diagnose.md)",
     )
     add_friction_option(p, "nominal friction coefficient")
     p.add_argument("--out", metavar="DIR", help="output folder")
@@ -136,8 +161,13 @@ def run(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: exists and is not a folder")
     from ..diagnose import diagnose
+    from ..diagnose.holds import HoldRule
+    from ..diagnose.recording import Columns
     from ..diagnose.writer import write_diagnosis
 
+    columns = Columns.parse(args.columns, args.channel_units)
+    if args.point_column:
+        columns = Columns({**columns.names, "point": args.point_column}, columns.units)
     result = diagnose(
         args.simulation,
         args.measured,
@@ -146,6 +176,9 @@ def run(args: argparse.Namespace) -> int:
         seed=0 if args.seed is None else args.seed,
         n_folds=args.folds,
         analyse_kwargs={"options": analysis_options(args)},
+        columns=columns,
+        hold_rule=HoldRule(use_point=bool(args.point_column)),
+        layout=args.layout,
     )
     out = write_diagnosis(result, args.out, force=args.force)
     print(result.summary(), end="")

@@ -14,4 +14,6 @@ CAUSES = (
     "anisotropic_friction",
     "pressure_shift",
     "sensor_offset",
+    "sensor_crosstalk",
+    "load_transfer",
 )

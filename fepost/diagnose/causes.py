@@ -41,6 +41,7 @@ import numpy as np
 
 from .causenames import CAUSES
 from .models import Candidate, Parameter, Predictor, extension_model, with_fixed
+from .transfer import load_transfer_model
 
 __all__ = [
     "CAUSES",
@@ -66,7 +67,12 @@ MEANING = {
     "anisotropic_friction": "friction differs along x and along y",
     "pressure_shift": "the real centre of pressure lies elsewhere",
     "sensor_offset": "constant offsets in the measured channels",
+    "sensor_crosstalk": "the load cell's calibration matrix has off-diagonal terms",
+    "load_transfer": "the centre of pressure moves with the friction force",
 }
+
+#: Causes the load-transfer model combines with (applied after the force, on the sensor).
+SENSOR_CAUSES = ("sensor_offset", "sensor_crosstalk")
 
 
 def extension_parameters(pred: Predictor) -> dict[str, tuple[Parameter, ...]]:
@@ -96,6 +102,21 @@ def extension_parameters(pred: Predictor) -> dict[str, tuple[Parameter, ...]]:
             Parameter(f"offset_{ch}", unit, 0.0, -np.inf, np.inf, 0.01 * s, 0.0, f"constant added to {ch}")
             for ch, unit, s in zip(("Fx", "Fy", "Mz"), ("N", "N", "N·m"), scale, strict=True)
         ),
+        "sensor_crosstalk": tuple(
+            Parameter(name, unit, 0.0, -0.5 * s, 0.5 * s, 0.01 * s, 0.0, what)
+            for name, unit, s, what in (
+                ("c_xy", "1", 1.0, "measured Fx gains c_xy Fy"),
+                ("c_xz", "1/m", 1.0 / R, "measured Fx gains c_xz Mz"),
+                ("c_yx", "1", 1.0, "measured Fy gains c_yx Fx"),
+                ("c_yz", "1/m", 1.0 / R, "measured Fy gains c_yz Mz"),
+                ("c_zx", "m", R, "measured Mz gains c_zx Fx"),
+                ("c_zy", "m", R, "measured Mz gains c_zy Fy"),
+            )
+        ),
+        "load_transfer": tuple(
+            Parameter(name, "m", 0.0, -R, R, 0.05 * R, 0.0, f"centre of pressure moves by {name}·{F}/N")
+            for name, F in (("h_x", "Fx"), ("h_y", "Fy"))
+        ),
     }
 
 
@@ -111,7 +132,17 @@ _DESCRIPTION = {
     "anisotropic_friction": "friction differs along x and along y",
     "pressure_shift": "the real centre of pressure lies elsewhere than the simulated one",
     "sensor_offset": "constant offsets in the measured Fx, Fy, Mz",
+    "sensor_crosstalk": "the load cell's calibration matrix has off-diagonal terms (measured = C·true)",
+    "load_transfer": "the centre of pressure moves with the friction force (dx = h_x Fx/N, dy = h_y Fy/N)",
 }
+
+
+def combinable(extensions) -> bool:
+    """Whether one model can hold all of ``extensions``: ``load_transfer`` only with the sensor causes."""
+    extensions = tuple(extensions)
+    if "load_transfer" not in extensions:
+        return True
+    return all(e in SENSOR_CAUSES for e in extensions if e != "load_transfer")
 
 
 def pair_name(extensions) -> str:
@@ -129,11 +160,14 @@ def joint_candidate(pred: Predictor, extensions, params: dict | None = None) -> 
     unknown = [e for e in extensions if e not in EXTENSIONS]
     if unknown or len(set(extensions)) != len(extensions) or not extensions:
         raise ValueError(f"extensions must be distinct names of {EXTENSIONS}, got {extensions!r}")
+    if not combinable(extensions):
+        raise ValueError(f"load_transfer combines only with {', '.join(SENSOR_CAUSES)}, got {extensions!r}")
     table = params or extension_parameters(pred)
     parameters = (friction_parameter(pred),) + tuple(p for e in extensions for p in table[e])
     nested = ("none", "friction_level") + (extensions if len(extensions) > 1 else ())
     description = "; ".join(_DESCRIPTION[e] for e in extensions)
-    return extension_model(pred, pair_name(extensions), parameters, nested, description, extensions)
+    build = load_transfer_model if "load_transfer" in extensions else extension_model
+    return build(pred, pair_name(extensions), parameters, nested, description, extensions)
 
 
 def build_candidates(pred: Predictor) -> dict[str, Candidate]:

@@ -54,6 +54,15 @@ def example_parameters(cause: str, friction: float, load: float, radius: float) 
         "anisotropic_friction": {"alpha": 1.15},
         "pressure_shift": {"dx": 0.04 * radius, "dy": -0.03 * radius},
         "sensor_offset": {"offset_Fx": 0.08 * fn, "offset_Fy": -0.06 * fn, "offset_Mz": 0.05 * fn * radius},
+        "sensor_crosstalk": {
+            "c_xy": 0.0,
+            "c_xz": 0.0,
+            "c_yx": 0.06,
+            "c_yz": 0.0,
+            "c_zx": 0.02 * radius,
+            "c_zy": 0.0,
+        },  # fmt: skip
+        "load_transfer": {"h_x": 0.3 * radius, "h_y": 0.2 * radius},
     }
     if cause not in table:
         raise ArgumentError(f"--cause must be one of {', '.join(CAUSES)}, got {cause!r}")

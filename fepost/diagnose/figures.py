@@ -14,6 +14,10 @@
   load or pressure shows as a trend of the means even when the signed Fx, Fy
   residuals only fan out. Outliers are drawn in red.
 * :func:`plot_candidates` — ΔBIC of every candidate against the simulation.
+* :func:`plot_recording` — for a rig recording: the kinematics and forces
+  against time (a decimated copy, `fepost.diagnose.holds.TRACE_POINTS` samples
+  at most), the steady holds shaded and each hold's mean drawn on it, the rows
+  left out (transitions) in red.
 
 Each function takes an optional figure or axes and returns it; none calls show().
 """
@@ -22,12 +26,24 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from .measured import CHANNELS
 from .residuals import binned_means
 from .result import Diagnosis
 
 UNITS = {"Fx": "N", "Fy": "N", "Mz": "N·m"}
+#: Forces (moments) whose largest magnitude reaches this are drawn in kN (kN·m), so
+#: that aircraft-sized tick labels (−60000, 40000) do not run into each other.
+KILO_FROM = 5000.0
+
+
+def display_units(values: np.ndarray, unit: str) -> tuple[float, str]:
+    """(divisor, unit label) for drawing ``values`` in ``unit``: k-prefixed at or above `KILO_FROM`."""
+    top = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    return (1e3, "k" + unit) if top >= KILO_FROM else (1.0, unit)
+
+
 BEFORE = "0.55"
 AFTER = "tab:blue"
 
@@ -44,13 +60,16 @@ def plot_predicted_vs_measured(diag: Diagnosis, axes=None):
     after = diag.predictions["after_heldout"]
     for c, ax in enumerate(axes):
         ch = CHANNELS[c]
+        div, unit = display_units(np.concatenate([meas[:, c], before[:, c]]), UNITS[ch])
         rb = np.sqrt(np.mean(((meas[keep, c] - before[keep, c]) / diag.scales[c]) ** 2))
         ra = np.sqrt(np.mean(((meas[keep, c] - after[keep, c]) / diag.scales[c]) ** 2))
-        ax.scatter(meas[keep, c], before[keep, c], s=9, c=BEFORE, label=f"simulation (rmse {rb:.3g})")
+        ax.scatter(
+            meas[keep, c] / div, before[keep, c] / div, s=9, c=BEFORE, label=f"simulation (rmse {rb:.3g})"
+        )
         if diag.cause != "none":
             ax.scatter(
-                meas[keep, c],
-                after[keep, c],
+                meas[keep, c] / div,
+                after[keep, c] / div,
                 s=9,
                 c=AFTER,
                 alpha=0.7,
@@ -58,14 +77,15 @@ def plot_predicted_vs_measured(diag: Diagnosis, axes=None):
             )
         if not keep.all():
             ax.scatter(
-                meas[~keep, c], before[~keep, c], s=22, c=OUTLIER, marker="x", zorder=5,
+                meas[~keep, c] / div, before[~keep, c] / div, s=22, c=OUTLIER, marker="x", zorder=5,
                 label="outlier (left out)", gid="outliers",
             )  # fmt: skip
         lo = min(meas[:, c].min(), before[:, c].min())
         hi = max(meas[:, c].max(), before[:, c].max())
-        ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
-        ax.set_xlabel(f"measured {ch} ({UNITS[ch]})")
-        ax.set_ylabel(f"predicted {ch} ({UNITS[ch]})")
+        ax.plot([lo / div, hi / div], [lo / div, hi / div], "k-", lw=0.8)
+        ax.set_xlabel(f"measured {ch} ({unit})")
+        ax.set_ylabel(f"predicted {ch} ({unit})")
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
         ax.set_title(ch)
         ax.legend(fontsize=7, loc="upper left")
     axes[0].figure.suptitle(
@@ -136,8 +156,6 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
     ANOVA test on the standardised residuals; the run-order column shows the
     lack-of-fit run-order test. The legend sits below the panels.
     """
-    from matplotlib.ticker import MaxNLocator
-
     cols = _columns(diag)
     order_label, order_x = run_order(diag)
     ncol = len(cols) + 1
@@ -199,7 +217,7 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
                 if p is not None:
                     text = f"ANOVA p = {p:.2g}"
             elif c == 0 and name == order_label and trend_key in lof:
-                text = f"drift test p = {lof[trend_key]['p']:.2g}\n(chosen model)"
+                text = f"drift test p = {lof[trend_key]['p_holm']:.2g}\n(chosen model, Holm)"
             if text:
                 ax.text(0.03, 0.97, text, transform=ax.transAxes, fontsize=7, va="top", gid="p-value",
                         bbox={"fc": "white", "ec": "none", "alpha": 0.7, "pad": 1.0})  # fmt: skip
@@ -247,6 +265,45 @@ def plot_candidates(diag: Diagnosis, ax=None):
     return ax
 
 
+def plot_recording(diag: Diagnosis, fig: Figure | None = None) -> Figure:
+    """The recording with its holds shaded and the left-out rows in red; returns the figure."""
+    holds = diag.holds
+    if holds is None:
+        raise ValueError("plot_recording needs a diagnosis of a recording (diag.holds is None)")
+    tr = holds.trace
+    if fig is None:
+        fig = Figure(figsize=(12, 9), layout="constrained")
+    axes = fig.subplots(4, 1, sharex=True)
+    t = tr["time"]
+    inside = np.zeros(t.size, bool)
+    for a, b in holds.spans:
+        inside[np.searchsorted(t, a) : np.searchsorted(t, b, side="right")] = True
+    panels = [(("vx", "vy"), "m/s"), (("wz",), "rad/s"), (("Fx", "Fy"), "N"), (("Mz",), "N·m")]
+    for ax, (names, unit) in zip(axes, panels, strict=True):
+        values = np.concatenate([tr[n] for n in names])
+        div, shown = display_units(values, unit) if unit in ("N", "N·m") else (1.0, unit)
+        for k, name in enumerate(names):
+            y = tr[name] / div
+            ax.plot(t, np.where(inside, y, np.nan), lw=0.6, color=f"C{k}", label=f"{name} (in holds)")
+            ax.plot(t, np.where(inside, np.nan, y), lw=0.6, color=OUTLIER, alpha=0.7,
+                    label="left out (transitions)" if k == 0 else None)  # fmt: skip
+            mean = np.asarray(getattr(diag.data, name)) / div
+            ax.hlines(mean, holds.spans[:, 0], holds.spans[:, 1], color="k", lw=1.2,
+                      label="hold mean" if k == 0 else None)  # fmt: skip
+        ax.fill_between(t, 0, 1, where=inside, transform=ax.get_xaxis_transform(), color="tab:green",
+                        alpha=0.12, lw=0, label="steady hold")  # fmt: skip
+        ax.set_ylabel(f"{', '.join(names)} ({shown})", fontsize=9)
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
+        ax.legend(fontsize=7, loc="upper right", ncol=4)
+    axes[-1].set_xlabel("time (s)")
+    d = holds.to_dict()
+    fig.suptitle(
+        f"recording: {d['count']} steady holds, {d['rows_used']} of {d['rows']} rows used, "
+        f"{d['rows_left_out']} left out as transitions"
+    )
+    return fig
+
+
 def save_figures(diag: Diagnosis, folder) -> list[str]:
     """Write the three figures as PNG into ``folder``; returns the file names."""
     from pathlib import Path
@@ -260,4 +317,7 @@ def save_figures(diag: Diagnosis, folder) -> list[str]:
     out.append("residuals.png")
     plot_candidates(diag).figure.savefig(folder / "candidates.png", dpi=110)
     out.append("candidates.png")
+    if diag.holds is not None:
+        plot_recording(diag).savefig(folder / "recording.png", dpi=100)
+        out.append("recording.png")
     return out

@@ -22,8 +22,10 @@ Limits: at most :data:`MAX_ROWS` test points (a rig programme has hundreds;
 diagnose takes 1–4 ms per point on a 2-core machine, 7 s for 5000 points, see
 ``benchmarks/bench_diagnose.py``) and
 files of at most :data:`MAX_BYTES`; both are refused before the rows are parsed,
-so a file of a million rows is turned away in a second rather than diagnosed for
-an hour. A cell longer than :data:`fepost.csvtable.MAX_CELL` characters is an error.
+so a table of a million rows is turned away in a second rather than diagnosed for
+an hour. Long data with a ``time`` column are rig recordings, read in chunks and
+reduced to their steady holds instead (`fepost.diagnose.inputs`). A cell longer
+than :data:`fepost.csvtable.MAX_CELL` characters is an error.
 
 :func:`check_plausible` compares the data with the simulation (units, dead
 channels, a test programme in which nothing varies, rolling rows without a

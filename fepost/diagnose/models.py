@@ -56,6 +56,25 @@ GEOMETRY_STEP = 0.2
 GEOMETRY = (("s", 1.0), ("dx", 0.0), ("dy", 0.0))
 IDENTITY = tuple(v for _, v in GEOMETRY)
 OFFSETS = ("offset_Fx", "offset_Fy", "offset_Mz")
+#: Crosstalk terms of the load cell, c_ab: measured channel a gains c_ab × true channel b
+#: (channels x = Fx, y = Fy, z = Mz), with (a, b) their positions.
+CROSSTALK = {"c_xy": (0, 1), "c_xz": (0, 2), "c_yx": (1, 0), "c_yz": (1, 2), "c_zx": (2, 0), "c_zy": (2, 1)}
+
+
+def apply_sensor(index: dict, p, out: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """The load cell's view of the true channels ``out`` (n, 3, scaled): C·out, then offsets.
+
+    C = I + the crosstalk terms present in ``index`` (SI: c_xy, c_yx in 1; c_xz,
+    c_yz in 1/m; c_zx, c_zy in m); in scaled channels C'_ab = C_ab s_b/s_a.
+    """
+    if "c_xy" in index:
+        C = np.eye(3)
+        for name, (a, b) in CROSSTALK.items():
+            C[a, b] = p[index[name]] * scale[b] / scale[a]
+        out = out @ C.T
+    if OFFSETS[0] in index:
+        out = out + np.array([p[index[o]] for o in OFFSETS]) / scale
+    return out
 
 
 @dataclass(frozen=True)
@@ -118,6 +137,7 @@ class Predictor:
         self.groups = {r: i for r, i in self.groups.items() if i.size}
         self.scale = sim.scales()
         loads = data.loads(sim.load)
+        self.loads = loads
         lam = np.ones(self.n)
         if data.N is not None:
             for r, idx in self.groups.items():
@@ -136,6 +156,24 @@ class Predictor:
             res = friction_resultants(quad, self.vx[idx], self.vy[idx], self.wz[idx], law)
             out[idx] = np.column_stack([res.Fx, res.Fy, res.Mz]) * self.lam[idx, None] ** power
         self.evaluations += 1
+        return out / self.scale
+
+    def coulomb_moved(self, dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+        """Coulomb resultants (f = 1, scaled) with each row's map moved by its own (dx_i, dy_i) (m).
+
+        Exact: the map moved by d gives the force of the unmoved map at the
+        velocity v + ω×d of the moved origin, and the torque about the patch
+        origin gains d × F (docs/diagnose.md, ``load_transfer``).
+        """
+        vx = self.vx - self.wz * dy
+        vy = self.vy + self.wz * dx
+        law = FrictionLaw(f=1.0, pressure_ref=self.sigma_ref)
+        out = np.empty((self.n, 3))
+        for r, idx in self.groups.items():
+            res = friction_resultants(self.sim.quads[r], vx[idx], vy[idx], self.wz[idx], law)
+            out[idx] = np.column_stack([res.Fx, res.Fy, res.Mz]) * self.lam[idx, None]
+        self.evaluations += 1
+        out[:, 2] += dx * out[:, 1] - dy * out[:, 0]
         return out / self.scale
 
     def raw(self, term: tuple[int, int], alpha: float, geometry: tuple[float, float, float]) -> np.ndarray:
@@ -234,10 +272,7 @@ def _combine(layout: _Layout, p, raw: dict, scale: np.ndarray) -> np.ndarray:
     if "c_p" in idx:
         cp = p[idx["c_p"]]
         m = (1.0 - cp) * m + cp * speed_law((1, 0), (1, 1))
-    out = p[idx["f"]] * m
-    if OFFSETS[0] in idx:
-        out = out + np.array([p[idx[o]] for o in OFFSETS]) / scale
-    return out
+    return apply_sensor(idx, p, p[idx["f"]] * m, scale)
 
 
 def extension_model(

@@ -2,7 +2,10 @@
 
 The steps (each a module of this package):
 
-1. :mod:`~fepost.diagnose.measured` reads and checks the CSV;
+1. :mod:`~fepost.diagnose.measured` reads and checks the CSV of test points, or
+   :mod:`~fepost.diagnose.recording` and :mod:`~fepost.diagnose.holds` read a
+   rig recording and reduce its steady holds to test points
+   (:func:`~fepost.diagnose.inputs.load_measured` decides which);
    :mod:`~fepost.diagnose.simulation` puts the FE maps on the fit grid.
 2. :mod:`~fepost.diagnose.causes` builds every candidate cause as a model over
    the exact integrals (:mod:`~fepost.diagnose.models`).
@@ -17,7 +20,8 @@ The steps (each a module of this package):
 5. :mod:`~fepost.diagnose.pairs` tries a second cause on top of it by the same
    rules, and a friction level other than nominal.
 6. :mod:`~fepost.diagnose.lackfit` asks whether the chosen model leaves
-   structure (pure error, run-order drift); :mod:`~fepost.diagnose.residuals`
+   structure (pure error per channel, from replicates or from the scatter
+   within holds; residual structure per channel; run-order drift); :mod:`~fepost.diagnose.residuals`
    tests the residuals against the kinematics; the paper's closed forms are
    compared with the data and with the exact integrals.
 """
@@ -32,10 +36,13 @@ from ..errors import ArgumentError
 from ..friction.closed_form import components
 from .causes import EXTENSIONS, Predictor, build_candidates, extension_parameters, joint_candidate
 from .fitting import fit
+from .holds import HoldRule
+from .inputs import load_measured
 from .lackfit import lack_of_fit
-from .measured import MeasuredData, check_plausible, read_measured
+from .measured import CHANNELS, MeasuredData, check_plausible
 from .noise import Noise, select_structure
 from .pairs import correlated_parameters, friction_test, search_pairs
+from .recording import Columns
 from .residuals import kinematic_variables, residual_structure
 from .result import Diagnosis, ParameterEstimate
 from .robust import robust_pass
@@ -100,8 +107,6 @@ def _noise_model(rob, cands, Y, rows) -> tuple[Noise, dict]:
     g = np.abs(ref.model.predict(ref.values))
     res = (Y - ref.model.predict(ref.values))[rows]
     structure, tables = [], {}
-    from .measured import CHANNELS
-
     for c, ch in enumerate(CHANNELS):
         best, table = select_structure(res[:, c], g[rows, c])
         structure.append(best)
@@ -109,87 +114,45 @@ def _noise_model(rob, cands, Y, rows) -> tuple[Noise, dict]:
     return Noise.start(tuple(structure), g), tables
 
 
-def diagnose(
-    simulation,
-    measured,
-    *,
-    rolling=None,
-    friction: float = 0.3,
-    seed: int = 0,
-    n_folds: int = FOLDS,
-    nr: int = FIT_NR,
-    nphi: int = FIT_NPHI,
-    pairs: bool = True,
-    analyse_kwargs: dict | None = None,
-) -> Diagnosis:
-    """Compare measured friction data with the simulation and name the cause(s) of the misfit.
-
-    ``simulation``/``rolling``: FE exports (paths or ContactFields, through
-    :func:`fepost.analysis.analyse`), polar maps in the patch frame, or a ready
-    :class:`~fepost.diagnose.simulation.Simulation`. ``measured``: a CSV path or
-    :class:`~fepost.diagnose.measured.MeasuredData`. ``friction``: nominal f.
-    ``seed`` shuffles the cross-validation folds. ``nr``/``nphi``: the fit grid.
-    ``pairs``: look for a second cause (module docstring, step 5).
-    Raises :class:`~fepost.errors.DataError` on unusable data.
-    """
-    t0 = time.perf_counter()
+def _check_arguments(seed, n_folds) -> None:
     if isinstance(seed, bool) or int(seed) != seed or seed < 0:
         raise ArgumentError(f"seed must be a non-negative integer, got {seed!r}")
     if isinstance(n_folds, bool) or int(n_folds) != n_folds or n_folds < 2:
         raise ArgumentError(f"n_folds must be an integer of at least 2, got {n_folds!r}")
-    sim = load_simulation(simulation, rolling, friction=friction, nr=nr, nphi=nphi, **(analyse_kwargs or {}))
-    data = measured if isinstance(measured, MeasuredData) else read_measured(measured)
-    check_plausible(
-        data,
-        friction=sim.friction,
-        load=sim.load,
-        radius=sim.radius,
-        has_rolling=sim.rolling is not None,
-    )
 
-    pred = Predictor(sim, data)
-    cands = build_candidates(pred)
-    table = extension_parameters(pred)
-    scale = pred.scale
-    Y = data.forces / scale
 
-    # 3. robust fits, outliers, noise model
-    rob, rows, noise, noise_tables = screen(cands, Y)
-    t_robust = time.perf_counter() - t0
-
-    # 4. Gaussian fits on the kept rows, held-out check, the primary cause
+def _single_causes(cands, Y, rob, rows, noise, n_folds, seed):
+    """Step 4: Gaussian fits on the kept rows, held-out check, scores (primary first)."""
     fits = {
         name: fit(c, Y, rows, start=rob.fits[name].values if c.n_params else None, noise=noise)
         for name, c in cands.items()
     }
     parts = folds(rows, n_folds, seed)
     cvs = {name: crossvalidate(c, Y, parts, fits[name]) for name, c in cands.items()}
-    scores = score_candidates(cands, fits, cvs)
-    primary = scores[0].name
-    t_single = time.perf_counter() - t0
+    return fits, cvs, parts, score_candidates(cands, fits, cvs)
 
-    # 5. a second cause
+
+def _second_cause(pred, cands, fits, cvs, primary, Y, parts, table, friction, pairs):
+    """Step 5: a second cause and a friction level on top of the primary; the final model."""
     search = None
-    final_cand, final_fit, final_cv = cands[primary], fits[primary], cvs[primary]
+    final = (cands[primary], fits[primary], cvs[primary])
     causes = [primary]
     if pairs and primary in EXTENSIONS:
         search = search_pairs(pred, cands, fits, cvs, primary, Y, parts, table)
         chosen = search.chosen
         if chosen is not None and chosen.fit is not None and chosen.cv is not None:
-            final_cand = joint_candidate(pred, (primary, chosen.second), table)
-            final_fit, final_cv = chosen.fit, chosen.cv
+            final = (joint_candidate(pred, (primary, chosen.second), table), chosen.fit, chosen.cv)
             causes.append(chosen.second)
-        ft = friction_test(final_cand, final_fit, final_cv, Y, parts, sim.friction)
+        ft = friction_test(*final, Y, parts, friction)
         search = type(search)(search.primary, search.trials, search.chosen, ft, search.indistinguishable)
         if ft.get("admissible"):
             causes.append("friction_level")
-    t_pairs = time.perf_counter() - t0
+    return final, causes, search
 
-    model = final_fit.model if final_fit.model is not None else final_cand
-    owner = {}
-    for ext in final_cand.extensions:
-        for p in table[ext]:
-            owner[p.name] = ext
+
+def _parameters(final_cand, final_fit, table) -> tuple[dict, dict]:
+    """The chosen model's parameter estimates and which cause owns each parameter."""
+    owner = {p.name: ext for ext in final_cand.extensions for p in table[ext]}
     params = {
         p.name: ParameterEstimate(
             p.name,
@@ -201,28 +164,10 @@ def diagnose(
         )  # fmt: skip
         for p, v, (lo, hi) in zip(final_cand.parameters, final_fit.values, final_fit.ci95, strict=True)
     }
+    return params, owner
 
-    before = cands["none"].predict(np.empty(0)) * scale
-    after = model.predict(final_fit.values) * scale
-    heldout = after.copy()
-    heldout[final_cv.rows] = data.forces[final_cv.rows] - final_cv.residuals * scale
-    closed = closed_form_prediction(sim, data)
-    meas = data.forces
-    none_cv = cvs["none"]
-    sigma = final_fit.noise.sigma()
 
-    gain = {
-        "rmse_before": none_cv.rmse,
-        "rmse_after": final_cv.rmse,
-        "delta_bic": final_fit.bic - fits["none"].bic,
-        "delta_aicc": final_fit.aicc - fits["none"].aicc,
-        "rmse_before_channels": none_cv.rmse_channels.tolist(),
-        "rmse_after_channels": final_cv.rmse_channels.tolist(),
-        "rmse_units": "scaled: Fx, Fy by f0 N; Mz by f0 N R",
-        "heldout": f"{n_folds}-fold cross-validation (folds shuffled with seed {seed}), outliers left out",
-        "delta": "score(chosen model) - score(none); negative favours the model",
-        "model": final_cand.name,
-    }
+def _residual_evidence(data, sim, rows, meas, before, heldout, scale, sigma) -> dict:
     variables = kinematic_variables(data.vx, data.vy, data.wz, sim.radius, data.loads(sim.load), data.roll)
     kept_vars = {k: np.asarray(v)[rows] for k, v in variables.items()}
     residuals: dict = {
@@ -231,19 +176,15 @@ def diagnose(
         "units": "standardised: residual / noise SD of the chosen model (outliers left out)",
     }
     for key in ("before", "after"):
-        for c, ch in enumerate(("Fx", "Fy", "Mz")):
+        for c, ch in enumerate(CHANNELS):
             r = ((meas - (before if key == "before" else heldout)) / scale)[rows, c]
             residuals[key][ch]["rmse"] = _rmse(r)
             residuals[key][ch]["mean"] = float(np.mean(r))
-    lof = lack_of_fit(
-        data,
-        rows,
-        (Y - model.predict(final_fit.values))[rows],
-        model.predict(final_fit.values)[rows],
-        sigma[rows],
-        final_fit.jacobian,
-    )
-    closed_form = {
+    return {"variables": variables, "residuals": residuals}
+
+
+def _closed_form_evidence(sim, meas, closed, before, scale, rows) -> dict:
+    return {
         "rmse_vs_data": _rmse(((meas - closed) / scale)[rows]),
         "rmse_vs_exact": _rmse((closed - before) / scale),
         "exact_rmse_vs_data": _rmse(((meas - before) / scale)[rows]),
@@ -252,7 +193,9 @@ def diagnose(
         | {"k_x": sim.coefficients.k_x},
         "note": "F0, M0, a, m from the static map's moments; scaled RMSEs",
     }
-    notes = design_notes(data.vx, data.vy, data.wz, sim.radius, data.N)
+
+
+def _separation_notes(final_cand, final_fit, table, causes, owner) -> list[str]:
     separation = []
     if len(final_cand.extensions) > 1:
         first, second = (tuple(q.name for q in table[e]) for e in final_cand.extensions[:2])
@@ -267,52 +210,132 @@ def diagnose(
                 f"f and {b} ({owner[b]}) are correlated (r = {r:+.2f}): the friction level is "
                 "partly confounded with it on this programme"
             )
+    return separation
+
+
+def _noise_summary(final_fit, noise_tables, reference) -> dict:
     noise_info = final_fit.noise.to_dict()
     for ch, table_c in noise_tables.items():
         noise_info[ch]["bic"] = {k: v["bic"] for k, v in table_c.items()}
     noise_info["criterion"] = (
         "per channel, lowest BIC among constant, proportional and combined on the residuals of the "
-        f"reference fit ({rob.reference}); |F_ref| = its predicted magnitude"
+        f"reference fit ({reference}); |F_ref| = its predicted magnitude"
     )
-    elapsed = time.perf_counter() - t0
+    return noise_info
+
+
+def _gain(final_fit, fits, final_cv, none_cv, final_name, n_folds, seed) -> dict:
+    return {
+        "rmse_before": none_cv.rmse,
+        "rmse_after": final_cv.rmse,
+        "delta_bic": final_fit.bic - fits["none"].bic,
+        "delta_aicc": final_fit.aicc - fits["none"].aicc,
+        "rmse_before_channels": none_cv.rmse_channels.tolist(),
+        "rmse_after_channels": final_cv.rmse_channels.tolist(),
+        "rmse_units": "scaled: Fx, Fy by f0 N; Mz by f0 N R",
+        "heldout": f"{n_folds}-fold cross-validation (folds shuffled with seed {seed}), outliers left out",
+        "delta": "score(chosen model) - score(none); negative favours the model",
+        "model": final_name,
+    }
+
+
+def diagnose(
+    simulation,
+    measured,
+    *,
+    rolling=None,
+    friction: float = 0.3,
+    seed: int = 0,
+    n_folds: int = FOLDS,
+    nr: int = FIT_NR,
+    nphi: int = FIT_NPHI,
+    pairs: bool = True,
+    analyse_kwargs: dict | None = None,
+    columns: Columns | None = None,
+    hold_rule: HoldRule | None = None,
+    layout: str = "auto",
+) -> Diagnosis:
+    """Compare measured friction data with the simulation and name the cause(s) of the misfit.
+
+    ``simulation``/``rolling``: FE exports (paths or ContactFields, through
+    `fepost.analysis.analyse`), polar maps in the patch frame, or a ready
+    `Simulation`. ``measured``: a CSV of test points, a rig recording (CSV,
+    Parquet, MATLAB, TYDEX; ``columns`` maps its channels and units,
+    ``hold_rule`` finds its holds, ``layout`` is ``"auto"``, ``"points"`` or
+    ``"recording"``: `fepost.diagnose.inputs.load_measured`), `MeasuredData` or
+    `Holds`. ``friction``: nominal f. ``seed`` shuffles the cross-validation
+    folds. ``nr``/``nphi``: the fit grid. ``pairs``: look for a second cause
+    (module docstring, step 5). Raises `DataError` on unusable data.
+    """
+    t0 = time.perf_counter()
+    _check_arguments(seed, n_folds)
+    sim = load_simulation(simulation, rolling, friction=friction, nr=nr, nphi=nphi, **(analyse_kwargs or {}))
+    data, holds = load_measured(measured, columns=columns, hold_rule=hold_rule, layout=layout)
+    check_plausible(
+        data, friction=sim.friction, load=sim.load, radius=sim.radius, has_rolling=sim.rolling is not None
+    )
+    pred = Predictor(sim, data)
+    cands = build_candidates(pred)
+    table = extension_parameters(pred)
+    scale = pred.scale
+    Y = data.forces / scale
+
+    rob, rows, noise, noise_tables = screen(cands, Y)  # 3.
+    t_robust = time.perf_counter() - t0
+    fits, cvs, parts, scores = _single_causes(cands, Y, rob, rows, noise, n_folds, seed)  # 4.
+    primary = scores[0].name
+    t_single = time.perf_counter() - t0
+    (final_cand, final_fit, final_cv), causes, search = _second_cause(
+        pred, cands, fits, cvs, primary, Y, parts, table, sim.friction, pairs
+    )  # 5.
+    t_pairs = time.perf_counter() - t0
+
+    model = final_fit.model if final_fit.model is not None else final_cand
+    params, owner = _parameters(final_cand, final_fit, table)
+    before = cands["none"].predict(np.empty(0)) * scale
+    after = model.predict(final_fit.values) * scale
+    heldout = after.copy()
+    heldout[final_cv.rows] = data.forces[final_cv.rows] - final_cv.residuals * scale
+    closed = closed_form_prediction(sim, data)
+    sigma = final_fit.noise.sigma()
+    evidence = _residual_evidence(data, sim, rows, data.forces, before, heldout, scale, sigma)
+    pure = None if holds is None else tuple(np.asarray(x)[rows] for x in holds.pure_error())
+    lof = lack_of_fit(
+        data, rows, (Y - model.predict(final_fit.values))[rows], model.predict(final_fit.values)[rows],
+        sigma[rows], final_fit.jacobian,
+        pure_error=None if pure is None else (pure[0] / scale, pure[1]),
+    )  # fmt: skip
     indist = (
         tuple(indistinguishable(scores, cands)) if search is None or search.chosen is None
         else search.indistinguishable
     )  # fmt: skip
+    info = {
+        "folds": n_folds, "seed": seed, "seconds": time.perf_counter() - t0, "seconds_robust": t_robust,
+        "seconds_single": t_single, "seconds_pairs": t_pairs - t_single,
+        "exact_evaluations": pred.evaluations,
+    }  # fmt: skip
     return Diagnosis(
         cause=primary,
         causes=tuple(causes),
         parameters=params,
-        gain=gain,
+        gain=_gain(final_fit, fits, final_cv, cvs["none"], final_cand.name, n_folds, seed),
         candidates=tuple(scores),
         indistinguishable=indist,
-        design_notes=tuple(notes),
-        separation=tuple(separation),
-        residuals=residuals,
-        closed_form=closed_form,
+        design_notes=tuple(design_notes(data.vx, data.vy, data.wz, sim.radius, data.N)),
+        separation=tuple(_separation_notes(final_cand, final_fit, table, causes, owner)),
+        residuals=evidence["residuals"],
+        closed_form=_closed_form_evidence(sim, data.forces, closed, before, scale, rows),
         simulation=sim.to_dict(),
         data=data,
-        predictions={
-            "before": before,
-            "after": after,
-            "after_heldout": heldout,
-            "closed_form": closed,
-        },
+        predictions={"before": before, "after": after, "after_heldout": heldout, "closed_form": closed},
         scales=scale,
-        variables=variables,
+        variables=evidence["variables"],
         outliers=tuple(int(i) for i in rob.outliers),
         lack_of_fit=lof,
-        noise=noise_info,
+        noise=_noise_summary(final_fit, noise_tables, rob.reference),
         sigma=sigma,
         robust=rob.to_dict(),
         pairs=None if search is None else search.to_dict(),
-        info={
-            "folds": n_folds,
-            "seed": seed,
-            "seconds": elapsed,
-            "seconds_robust": t_robust,
-            "seconds_single": t_single,
-            "seconds_pairs": t_pairs - t_single,
-            "exact_evaluations": pred.evaluations,
-        },
+        info=info,
+        holds=holds,
     )

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._arrays import frozen
+from .holds import Holds
 from .measured import MeasuredData
 from .selection import Score
 
@@ -50,7 +51,8 @@ class Diagnosis:
     ``outliers`` are 0-based data rows left out of every fit; ``sigma`` (n, 3)
     the noise SD of every row under the chosen noise model (scaled units);
     ``lack_of_fit`` the verdict of :func:`~fepost.diagnose.lackfit.lack_of_fit`;
-    ``separation`` what the test programme cannot separate within the chosen model.
+    ``separation`` what the test programme cannot separate within the chosen model;
+    ``holds`` the steady holds the data came from when they were a recording.
     """
 
     cause: str
@@ -75,6 +77,7 @@ class Diagnosis:
     robust: dict = field(default_factory=dict)
     pairs: dict | None = None
     info: dict = field(default_factory=dict)
+    holds: Holds | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "predictions", {k: frozen(v) for k, v in self.predictions.items()})
@@ -129,6 +132,7 @@ class Diagnosis:
             },
             "n_points": len(self.data),
             "measured_source": self.data.source,
+            **({"holds": self.holds.to_dict()} if self.holds is not None else {}),
             **self.info,
         }
 

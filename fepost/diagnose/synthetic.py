@@ -16,7 +16,10 @@ exponential fall of friction with sliding speed).
 The effects are applied here independently of the diagnosis's own models:
 through :class:`~fepost.friction.law.FrictionLaw` for the friction laws,
 :meth:`~fepost.friction.quadrature.PressureQuadrature.stretched`/``shifted`` for
-the geometry, offsets added in N and N·m; loads by scaling the map's pressure;
+the geometry, offsets added in N and N·m, crosstalk as the matrix C applied to
+the forces in SI, load transfer as a fixed point per distinct test point on the
+map moved by its own shift (``shifted``, one row at a time, where the diagnosis
+moves the kinematics instead); loads by scaling the map's pressure;
 the reversed rolling map (roll = −1) by mirroring the kinematics and the
 resultants (vx, ω_z, Fx, Mz change sign) rather than the map.
 """
@@ -57,7 +60,15 @@ EFFECT_PARAMETERS: dict[str, dict[str, float | None]] = {
     "anisotropic_friction": {"alpha": 1.0},
     "pressure_shift": {"dx": 0.0, "dy": 0.0},
     "sensor_offset": {"offset_Fx": 0.0, "offset_Fy": 0.0, "offset_Mz": 0.0},
+    "sensor_crosstalk": {k: 0.0 for k in ("c_xy", "c_xz", "c_yx", "c_yz", "c_zx", "c_zy")},
+    "load_transfer": {"h_x": 0.0, "h_y": 0.0},
 }
+#: Crosstalk terms: (measured channel, true channel) in (Fx, Fy, Mz).
+CROSSTALK_TERMS = {
+    "c_xy": (0, 1), "c_xz": (0, 2), "c_yx": (1, 0), "c_yz": (1, 2), "c_zx": (2, 0), "c_zy": (2, 1),
+}  # fmt: skip
+#: The load transfer's fixed point (per distinct test point) stops when the shift moves by less (m).
+TRANSFER_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -320,46 +331,16 @@ def synthesize(
     if rolling is not None:
         quads[1] = _fine_quad(rolling)
     N_sim = quads[0].load
-    R = static.radius
-    kin = kinematics or rig_programme(R, n, seed=seed, rolls=rolls, loads=loads)
+    kin = kinematics or rig_programme(static.radius, n, seed=seed, rolls=rolls, loads=loads)
     if not 0 <= int(outliers) <= kin.vx.size:
         raise ArgumentError(f"outliers must be between 0 and the number of rows, got {outliers!r}")
     f = float(params.get("f", friction))
-    common = {
-        "f": f,
-        "pressure_coef": float(params.get("c_p", 0.0)),
-        "anisotropy": float(params.get("alpha", 1.0)),
-        "pressure_ref": quads[0].mean_pressure,
-    }
-    if "stribeck_ratio" in params:
-        law: FrictionLaw = StribeckLaw(
-            **common, ratio=float(params["stribeck_ratio"]), speed_scale=float(params["stribeck_speed"])
-        )
-    else:
-        law = FrictionLaw(**common, speed_coef=float(params.get("c_v", 0.0)))
-    s = float(params.get("s", 1.0))
-    dx, dy = float(params.get("dx", 0.0)), float(params.get("dy", 0.0))
-    clean = np.empty((kin.vx.size, 3))
-    for r in np.unique(kin.roll):
-        mirror = r < 0
-        base = quads[1 if r else 0]
-        base_load = base.load
-        sx = -1.0 if mirror else 1.0
-        for lam in np.unique(kin.load_factor):
-            idx = np.flatnonzero((kin.roll == r) & (kin.load_factor == lam))
-            # Rows without a load column carry each map as given (λ = 1).
-            quad = base if loads is None else _scaled(base, lam * N_sim / base_load)
-            if s != 1.0:
-                quad = quad.stretched(s)
-            if dx or dy:
-                quad = quad.shifted(sx * dx, dy)  # mirrored kinematics: the shift mirrors too
-            res = friction_resultants(quad, sx * kin.vx[idx], kin.vy[idx], sx * kin.wz[idx], law)
-            clean[idx] = np.column_stack([sx * res.Fx, res.Fy, sx * res.Mz])
+    law = _law(params, f, quads[0].mean_pressure)
+    clean = _clean_resultants(quads, kin, law, params, scaled_loads=loads is not None, N_sim=N_sim)
     m = kin.vx.size
     if drift:
         clean *= 1.0 + drift * (np.arange(m) / max(m - 1, 1))[:, None]
-    if "sensor_offset" in effects:
-        clean = clean + np.array([params["offset_Fx"], params["offset_Fy"], params["offset_Mz"]])
+    clean = _sensor(clean, effects, params)
     sd = noise * (clean.max(axis=0) - clean.min(axis=0))
     if noise_proportional:
         sd = np.sqrt(sd[None, :] ** 2 + (noise_proportional * clean) ** 2)
@@ -369,13 +350,7 @@ def synthesize(
     bad = np.sort(rng.choice(m, size=int(outliers), replace=False)) if outliers else np.zeros(0, int)
     glitch[bad] = np.resize(GLITCHES, bad.size)
     meas = meas * glitch[:, None]
-    time = None
-    order = np.arange(m)
-    if time_column:
-        time = SECONDS_PER_POINT * np.arange(m) + rng.uniform(0.0, 5.0, m)
-        direction = np.round(np.degrees(np.arctan2(kin.vy, kin.vx)), 6)
-        speed = np.round(np.hypot(kin.vx, kin.vy), 9)
-        order = np.lexsort((speed, direction, kin.wz, kin.roll))  # the file sorted by test condition
+    time, order = _run_order(kin, rng, time_column)
     loads_col = None if loads is None else kin.load_factor * N_sim
     data = MeasuredData(
         vx=kin.vx[order], vy=kin.vy[order], wz=kin.wz[order],
@@ -385,7 +360,7 @@ def synthesize(
     )  # fmt: skip
     truth = {"f": f, **{k: float(v) for k, v in params.items() if k != "f"}}
     meta = {
-        "N": N_sim, "R": R, "n": int(m), "seed": seed, "noise": noise,
+        "N": N_sim, "R": static.radius, "n": int(m), "seed": seed, "noise": noise,
         "noise_proportional": noise_proportional, "drift": drift, "time_column": bool(time_column),
     }  # fmt: skip
     where = np.empty(m, int)
@@ -395,6 +370,98 @@ def synthesize(
         data, "+".join(effects), truth, clean[order], sd_rows, friction, meta,
         tuple(sorted(int(where[i]) for i in bad)), glitch[order],
     )  # fmt: skip
+
+
+def _law(params: dict, f: float, pressure_ref: float) -> FrictionLaw:
+    """The local friction law of the hidden effects (``c_p``, ``alpha``, ``c_v`` or Stribeck)."""
+    common = {
+        "f": f,
+        "pressure_coef": float(params.get("c_p", 0.0)),
+        "anisotropy": float(params.get("alpha", 1.0)),
+        "pressure_ref": pressure_ref,
+    }
+    if "stribeck_ratio" in params:
+        return StribeckLaw(
+            **common, ratio=float(params["stribeck_ratio"]), speed_scale=float(params["stribeck_speed"])
+        )
+    return FrictionLaw(**common, speed_coef=float(params.get("c_v", 0.0)))
+
+
+def _clean_resultants(quads, kin: Kinematics, law, params: dict, *, scaled_loads: bool, N_sim: float):
+    """Noise-free Fx, Fy, Mz (N, N, N·m) of every row, with the geometric effects and load transfer."""
+    s = float(params.get("s", 1.0))
+    dx, dy = float(params.get("dx", 0.0)), float(params.get("dy", 0.0))
+    heights = (float(params.get("h_x", 0.0)), float(params.get("h_y", 0.0)))
+    clean = np.empty((kin.vx.size, 3))
+    for r in np.unique(kin.roll):
+        mirror = r < 0
+        base = quads[1 if r else 0]
+        sx = -1.0 if mirror else 1.0
+        for lam in np.unique(kin.load_factor):
+            idx = np.flatnonzero((kin.roll == r) & (kin.load_factor == lam))
+            # Rows without a load column carry each map as given (λ = 1).
+            quad = base if not scaled_loads else _scaled(base, lam * N_sim / base.load)
+            if s != 1.0:
+                quad = quad.stretched(s)
+            kv = (sx * kin.vx[idx], kin.vy[idx], sx * kin.wz[idx])
+            if heights != (0.0, 0.0):
+                load = lam * N_sim if scaled_loads else N_sim
+                res = _transferred(quad, kv, law, (sx * dx, dy), (sx, heights), load)
+            else:
+                if dx or dy:
+                    quad = quad.shifted(sx * dx, dy)  # mirrored kinematics: the shift mirrors too
+                got = friction_resultants(quad, *kv, law)
+                res = np.column_stack([got.Fx, got.Fy, got.Mz])
+            clean[idx] = res * np.array([sx, 1.0, sx])
+    return clean
+
+
+def _transferred(quad, kv, law, shift, mirror_heights, load: float) -> np.ndarray:
+    """Resultants (n, 3) in the map's frame with the centre of pressure moved by h·F/N (fixed point).
+
+    Each distinct test point is iterated on its own map, moved by the constant
+    ``shift`` plus (h_x Fx/N, h_y Fy/N) with Fx, Fy the tire's force in the real
+    frame (``sx`` = −1 for the mirrored map, whose x shift mirrors).
+    """
+    sx, (hx, hy) = mirror_heights
+    pts = np.column_stack(kv)
+    uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
+    out = np.empty((uniq.shape[0], 3))
+    for k, (vx, vy, wz) in enumerate(uniq):
+        d = np.zeros(2)  # (dx, dy) of the load transfer in the real frame
+        for _ in range(200):
+            moved = quad.shifted(shift[0] + sx * d[0], shift[1] + d[1])
+            got = friction_resultants(moved, vx, vy, wz, law, threads=1)
+            res = np.array([float(got.Fx), float(got.Fy), float(got.Mz)])
+            new = np.array([hx * sx * res[0] / load, hy * res[1] / load])
+            if np.max(np.abs(new - d)) < TRANSFER_TOL:
+                break
+            d = new
+        out[k] = res
+    return out[np.ravel(inverse)]
+
+
+def _sensor(clean: np.ndarray, effects: tuple[str, ...], params: dict) -> np.ndarray:
+    """What the load cell reports: crosstalk C·F (SI), then offsets."""
+    if "sensor_crosstalk" in effects:
+        C = np.eye(3)
+        for name, (a, b) in CROSSTALK_TERMS.items():
+            C[a, b] = float(params[name])
+        clean = clean @ C.T
+    if "sensor_offset" in effects:
+        clean = clean + np.array([params["offset_Fx"], params["offset_Fy"], params["offset_Mz"]])
+    return clean
+
+
+def _run_order(kin: Kinematics, rng, time_column: bool):
+    """(time column or None, file order): with a time column the file is sorted by test condition."""
+    m = kin.vx.size
+    if not time_column:
+        return None, np.arange(m)
+    time = SECONDS_PER_POINT * np.arange(m) + rng.uniform(0.0, 5.0, m)
+    direction = np.round(np.degrees(np.arctan2(kin.vy, kin.vx)), 6)
+    speed = np.round(np.hypot(kin.vx, kin.vy), 9)
+    return time, np.lexsort((speed, direction, kin.wz, kin.roll))  # the file sorted by test condition
 
 
 #: Validation cases (hidden effect, true parameters) shared by the detection
