@@ -25,6 +25,7 @@ from pathlib import Path
 
 from ..analysis import analyse
 from ..errors import ArgumentError
+from ..friction_coefficient import DEFAULT_FRICTION
 from ..polar import PolarMap
 from .causes import CAUSES
 from .measured import write_csv
@@ -75,7 +76,7 @@ def make_example(
     *,
     cause: str = EXAMPLE_CAUSE,
     seed: int = EXAMPLE_SEED,
-    friction: float = 0.3,
+    friction: float = DEFAULT_FRICTION,
     rolling=None,
     analyse_kwargs: dict | None = None,
 ) -> SyntheticData:

@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import ArgumentError
 from ..friction.closed_form import components
+from ..friction_coefficient import DEFAULT_FRICTION
 from .causes import EXTENSIONS, Predictor, build_candidates, extension_parameters, joint_candidate
 from .fitting import fit
 from .holds import HoldRule
@@ -244,7 +245,7 @@ def diagnose(
     measured,
     *,
     rolling=None,
-    friction: float = 0.3,
+    friction: float = DEFAULT_FRICTION,
     seed: int = 0,
     n_folds: int = FOLDS,
     nr: int = FIT_NR,

@@ -337,7 +337,7 @@ def _mat73_columns(path: Path, wanted) -> Iterator[tuple[dict, dict]]:
         raise DataError(f"{path}: MATLAB v7.3 files need h5py (pip install h5py)") from None
     with h5py.File(path, "r") as f:
         group = f
-        top = [k for k in f.keys() if not k.startswith("#")]
+        top = [k for k in f if not k.startswith("#")]
         if len(top) == 1 and isinstance(f[top[0]], h5py.Group):
             group = f[top[0]]
             top = list(group.keys())

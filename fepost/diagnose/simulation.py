@@ -32,6 +32,7 @@ from ..analysis import analyse
 from ..coefficients import Coefficients, coefficients_from_moments
 from ..errors import ArgumentError
 from ..friction.quadrature import PressureQuadrature, edge_grid
+from ..friction_coefficient import DEFAULT_FRICTION, check_friction
 from ..moments import moments
 from ..polar import PolarGrid, PolarMap
 
@@ -71,8 +72,7 @@ class Simulation:
     quads: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.friction) and self.friction > 0):
-            raise ArgumentError(f"friction must be a positive number, got {self.friction!r}")
+        check_friction(self.friction)
         quads = {0: PressureQuadrature.from_polar(self.static)}
         if self.rolling is not None:
             quads[1] = PressureQuadrature.from_polar(self.rolling)
@@ -123,7 +123,7 @@ def simulation_from_maps(
     static: PolarMap,
     rolling: PolarMap | None = None,
     *,
-    friction: float = 0.3,
+    friction: float = DEFAULT_FRICTION,
     nr: int = FIT_NR,
     nphi: int = FIT_NPHI,
     source: str = "",
@@ -154,7 +154,7 @@ def load_simulation(
     simulation,
     rolling=None,
     *,
-    friction: float = 0.3,
+    friction: float = DEFAULT_FRICTION,
     nr: int = FIT_NR,
     nphi: int = FIT_NPHI,
     **analyse_kwargs,

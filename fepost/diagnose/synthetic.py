@@ -36,6 +36,7 @@ from ..errors import ArgumentError
 from ..friction.exact import friction_resultants
 from ..friction.law import FrictionLaw
 from ..friction.quadrature import PressureQuadrature, edge_grid
+from ..friction_coefficient import DEFAULT_FRICTION
 from ..polar import PolarGrid, PolarMap
 from .causes import CAUSES
 from .measured import MeasuredData
@@ -279,7 +280,7 @@ def synthesize(
     params: dict | None = None,
     *,
     rolling: PolarMap | None = None,
-    friction: float = 0.3,
+    friction: float = DEFAULT_FRICTION,
     n: int = 400,
     noise: float = 0.015,
     noise_proportional: float = 0.0,
