@@ -2,11 +2,11 @@
 
 Python API (the CLI is a thin shell over it):
 
-* :func:`fepost.reader.read_contact` – FE export → :class:`~fepost.field.ContactField`
-* :func:`fepost.patch.build_patch` – loaded region, plane, frame, circularity
-* :func:`fepost.resample.resample` – FE interpolation onto a :class:`~fepost.polar.PolarGrid`
-* :func:`fepost.moments.moments`, :func:`fepost.coefficients.coefficients_from_moments`
-* :func:`fepost.analysis.analyse` – all of the above in one call
+* `fepost.reader.read_contact` – FE export → `ContactField`
+* `fepost.patch.build_patch` – loaded region, plane, frame, circularity
+* `fepost.resample.resample` – FE interpolation onto a `PolarGrid`
+* `fepost.moments.moments`, `fepost.coefficients.coefficients_from_moments`
+* `fepost.analysis.analyse` – all of the above in one call
 
 ``import fepost`` is light: ``fepost.analyse`` and ``fepost.Analysis`` import the
 pipeline (numpy, scipy, VTK) on first use, so the command line starts quickly.

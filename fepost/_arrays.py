@@ -6,7 +6,7 @@ import weakref
 
 import numpy as np
 
-#: Read-only views whose writable bases no one else holds, by id (see :func:`adopted`).
+#: Read-only views whose writable bases no one else holds, by id (see `adopted`).
 _ADOPTED: weakref.WeakValueDictionary = weakref.WeakValueDictionary()
 
 
@@ -38,7 +38,7 @@ def frozen(a, dtype=float) -> np.ndarray:
 def sealed(a: np.ndarray) -> np.ndarray:
     """Mark an array the library has just created as read-only, without copying.
 
-    Only for arrays no caller holds: it lets :func:`frozen` share them. The
+    Only for arrays no caller holds: it lets `frozen` share them. The
     arrays it views (numpy's fancy indexing may return a view of a transposed
     temporary) are sealed too.
     """
@@ -50,7 +50,7 @@ def sealed(a: np.ndarray) -> np.ndarray:
 
 
 def adopted(a: np.ndarray) -> np.ndarray:
-    """A read-only view of ``a`` that :func:`frozen` shares instead of copying.
+    """A read-only view of ``a`` that `frozen` shares instead of copying.
 
     For arrays whose memory belongs to an object that the library itself has
     just created and drops (a VTK data set a reader built from a file):

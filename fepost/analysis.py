@@ -1,6 +1,6 @@
 """The main pipeline: FE export(s) → patch → polar map → moments → coefficients.
 
-:func:`analyse` is the documented entry point of the Python API::
+`analyse` is the documented entry point of the Python API::
 
     from fepost import analyse
     result = analyse("meshes/static.vtu", "meshes/rolling.vtu", friction=0.3)
@@ -85,7 +85,7 @@ class Analysis:
 
     @cached_property
     def model_summary(self):
-        """The generalised friction model of these maps (:mod:`fepost.friction.summary`)."""
+        """The generalised friction model of these maps (`fepost.friction.summary`)."""
         from .friction.law import FrictionLaw
         from .friction.summary import summarise
 
@@ -197,12 +197,12 @@ def _check_reaction(fld: ContactField, patch: Patch) -> None:
 
 
 def check_load_pair(static: Patch, rolling: Patch, *, allow: bool = False) -> float:
-    """The ratio N_fe(rolling) / N_fe(static); refuse a pair further apart than :data:`LOAD_TOL`.
+    """The ratio N_fe(rolling) / N_fe(static); refuse a pair further apart than `LOAD_TOL`.
 
     Raises
     ------
     ArgumentError
-        The loads differ by more than :data:`LOAD_TOL` and ``allow`` is false
+        The loads differ by more than `LOAD_TOL` and ``allow`` is false
         (one line naming both maps and both loads).
     """
     ratio = rolling.N_fe / static.N_fe
@@ -229,7 +229,7 @@ def _check_resampling(patch: Patch, mom: Moments) -> None:
 
 def _warm_up() -> None:
     """Import, while the files are read, what the results need later: the generalised model
-    (:attr:`Analysis.model_summary`, in :meth:`Analysis.to_dict` by default)."""
+    (`Analysis.model_summary`, in `Analysis.to_dict` by default)."""
     from .friction import summary  # noqa: F401
 
 

@@ -1,18 +1,18 @@
 """Numeric CSV tables with named columns: the one reader of fepost's CSV inputs.
 
-The measured rig data of ``fepost diagnose`` (:mod:`fepost.diagnose.measured`)
-and the kinematics of ``fepost predict`` (:mod:`fepost.friction.predict`) are
+The measured rig data of ``fepost diagnose`` (`fepost.diagnose.measured`)
+and the kinematics of ``fepost predict`` (`fepost.friction.predict`) are
 the same kind of file: a header row naming the columns, then one row of numbers
 per point; blank lines and lines whose first non-blank character is ``#`` are
 skipped (before and after the header), columns the format does not read are
-ignored, and a UTF-8 byte-order mark is dropped. A :class:`CsvFormat` says
-which columns a format needs and how its messages name it; :func:`parse_table`
-and :func:`read_table` read every such format alike.
+ignored, and a UTF-8 byte-order mark is dropped. A `CsvFormat` says
+which columns a format needs and how its messages name it; `parse_table`
+and `read_table` read every such format alike.
 
-Every problem is one :class:`~fepost.errors.DataError` of one line naming the
+Every problem is one `DataError` of one line naming the
 file and, where there is one, the line and the column: an unreadable, binary
 or over-large file, a line the csv module cannot split or a cell longer than
-:data:`MAX_CELL` characters, a header without a required column or with a
+`MAX_CELL` characters, a header without a required column or with a
 column read twice, a row too short for a column read, a cell that is not a
 finite number, no data rows.
 
@@ -194,7 +194,7 @@ def read_table(path, fmt: CsvFormat) -> CsvTable:
     ------
     DataError
         One line naming the file: missing, a folder, unreadable, larger than
-        ``fmt.max_bytes``, not text (NUL bytes), or any problem of :func:`parse_table`.
+        ``fmt.max_bytes``, not text (NUL bytes), or any problem of `parse_table`.
     """
     path = Path(path)
     try:

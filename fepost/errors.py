@@ -1,6 +1,6 @@
 """The exceptions and warnings fepost raises.
 
-Every exception subclasses both :class:`FepostError` and the matching built-in,
+Every exception subclasses both `FepostError` and the matching built-in,
 so callers may catch either. Messages are one line and name the file or the
 argument at fault. The library raises and warns; only the CLI prints and exits.
 """

@@ -1,11 +1,11 @@
 """The loaded element faces of a contact field, grouped by face type, on their way to triangles.
 
-The patch step works on linear triangles (:mod:`fepost.facesums`,
-:mod:`fepost.locate`); element faces of other types are cut into triangles by
-:func:`refine`, with their exact load kept aside (:func:`exact_load`) to check
+The patch step works on linear triangles (`fepost.facesums`,
+`fepost.locate`); element faces of other types are cut into triangles by
+`refine`, with their exact load kept aside (`exact_load`) to check
 the cut. Faces whose normal is steep to the patch plane and which touch the
 contact only where flat loaded faces do are the sides of the loaded body, not
-contact surface: :func:`drop_edge_faces` removes them (a side face of a block
+contact surface: `drop_edge_faces` removes them (a side face of a block
 whose bottom edge is in contact would otherwise carry half the edge pressure
 up its height).
 """
@@ -150,7 +150,7 @@ def drop_edge_faces(
     return out, dropped
 
 
-#: First refinement level per face type (see :func:`fepost.reader.quadratic.refine`).
+#: First refinement level per face type (see `fepost.reader.quadratic.refine`).
 START_LEVEL = {"tri3": 0, "quad4": 1, "tri6": 4, "tri7": 4, "quad8": 4, "quad9": 4}
 
 
@@ -161,7 +161,7 @@ def refine(
 
     Linear triangles keep their nodes; a ``quad4`` at ``level`` 1 is split
     along its diagonal (0, 2) on its own nodes; other faces are cut at
-    ``level`` × their :data:`START_LEVEL` into triangles whose new nodes
+    ``level`` × their `START_LEVEL` into triangles whose new nodes
     follow ``points`` (nodal values interpolated with the shape functions;
     face values repeated per triangle). The linear flag marks triangles whose
     field cannot dip below its nodal values (linear and bilinear faces).

@@ -30,8 +30,8 @@ class ContactField:
         Linear triangular faces.
     values : float array, Pa
         Contact pressure, per node (``location == "point"``, shape (n,)) or per
-        face (``"cell"``: the triangles' values, then those of :attr:`faces` in
-        the order of :data:`OTHER_FACE_TYPES`).
+        face (``"cell"``: the triangles' values, then those of `faces` in
+        the order of `OTHER_FACE_TYPES`).
     field : str
         Name of the array the pressure came from (``NAME:COMPONENT`` for a component).
     step, time : int | None, float | None
@@ -44,7 +44,7 @@ class ContactField:
         The validated sidecar.
     faces : mapping face type → (m, k) int array
         Faces of other types: ``quad4`` (bilinear), ``tri6``, ``tri7``, ``quad8``,
-        ``quad9`` (quadratic), nodes in the order of :mod:`fepost.reader.cells`.
+        ``quad9`` (quadratic), nodes in the order of `fepost.reader.cells`.
     reactions : mapping name → float, N
         The solver's reaction and contact-force values stored in the file at this
         step (Exodus global variables whose names say reaction or force).
@@ -114,7 +114,7 @@ class ContactField:
         return int(self.triangles.shape[0]) + sum(len(f) for f in self.faces.values())
 
     def face_groups(self) -> Iterator[tuple[str, np.ndarray, slice]]:
-        """(face type, connectivity, slice of :attr:`values` for face data) of every non-empty group."""
+        """(face type, connectivity, slice of `values` for face data) of every non-empty group."""
         start = 0
         groups = [("tri3", self.triangles)] + [
             (t, self.faces[t]) for t in OTHER_FACE_TYPES if t in self.faces

@@ -1,9 +1,9 @@
 """Point location and FE interpolation in a planar triangle mesh.
 
-:func:`interpolate` evaluates a field at query points the way the FE
+`interpolate` evaluates a field at query points the way the FE
 element does: linear on the triangle holding the point for nodal data,
 constant per face for face data, with a mask of the points that fall on no
-triangle. It is the fast path of :func:`fepost.resample.resample` and is
+triangle. It is the fast path of `fepost.resample.resample` and is
 checked against VTK's probe filter (the other path) in the tests. (The
 library locators cost more than the whole pipeline on million-node patches:
 VTK's cell locator takes ~0.4 s to build on 2.3 M faces, matplotlib's
@@ -66,7 +66,7 @@ def _raster(points: np.ndarray, size: float) -> tuple[np.ndarray, float, tuple[i
     """Origin, cell size and shape of a raster over the query points' bounding box.
 
     The cells are about ``size`` (the mesh's typical edge) so a cell holds a few
-    triangles, but never more than :data:`RASTER_MAX` a side.
+    triangles, but never more than `RASTER_MAX` a side.
     """
     lo = points.min(axis=0)
     ext = points.max(axis=0) - lo
@@ -114,7 +114,7 @@ def _candidates(X, Y, tri, origin, h, shape, sat) -> tuple[np.ndarray, np.ndarra
 def _register(cand: np.ndarray, boxes: np.ndarray, occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The (cell key, candidate) pairs of the candidates' boxes in cells holding a query, sorted by key.
 
-    Boxes are expanded to their cells in batches of at most :data:`EXPAND_MAX`
+    Boxes are expanded to their cells in batches of at most `EXPAND_MAX`
     cells, so a few very large faces cannot exhaust memory.
     """
     ny = occupied.shape[1]

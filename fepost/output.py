@@ -1,22 +1,22 @@
 """Atomic output: files and folders appear whole or not at all.
 
 A file is written to a hidden temporary file beside it and renamed over the
-target (:func:`write_text_atomic`); a folder is built in a hidden temporary folder
-beside it and swapped into place when complete (:func:`staged_folder`). On any
+target (`write_text_atomic`); a folder is built in a hidden temporary folder
+beside it and swapped into place when complete (`staged_folder`). On any
 error, Ctrl-C or SIGTERM (which the CLI turns into an exception) the temporary
 is removed and the target is left as it was. Files and folders are created
 with the usual modes masked by the umask (``0o666`` and ``0o777``), like any
-other program's output, not the private modes of :mod:`tempfile`.
+other program's output, not the private modes of `tempfile`.
 
 Temporary names carry the writer's host and process id,
 ``.<name>.fepost-<host>-<pid>-<token>.tmp`` (``.old`` for a folder being
 replaced), so a run killed outright (SIGKILL, power loss) leaves litter that the
 next write into the same folder recognises and removes
-(:func:`remove_stale_temporaries`): only entries of this naming pattern, from
+(`remove_stale_temporaries`): only entries of this naming pattern, from
 this host, whose process is gone or started after the entry was last touched
 (its pid was reused).
 
-:func:`check_replaceable` refuses to replace a folder that holds the run's own
+`check_replaceable` refuses to replace a folder that holds the run's own
 inputs, the current folder, the home folder or the file-system root.
 """
 
@@ -226,7 +226,7 @@ def umask_mode(path: str | Path) -> None:
 
 
 def write_json_atomic(path: str | Path, data) -> Path:
-    """:func:`to_json` of ``data`` written with :func:`write_text_atomic`."""
+    """`to_json` of ``data`` written with `write_text_atomic`."""
     return write_text_atomic(path, to_json(data) + "\n")
 
 
@@ -250,7 +250,7 @@ def check_replaceable(out: str | Path, inputs: Iterable[str | Path | None] = ())
 
     ``out`` (a file or a folder) must not be, or contain, any of ``inputs``, the
     current folder, the home folder or the file-system root. Raises
-    :class:`~fepost.errors.OutputError` with one line naming what it holds.
+    `OutputError` with one line naming what it holds.
     """
     target = _resolve(out)
     guarded = [(_resolve(p), f"the input {p}") for p in inputs if p is not None]
@@ -291,7 +291,7 @@ def staged_folder(
 
     An existing non-empty ``out`` is refused unless ``force``; an existing
     ``out`` that holds any of ``protect`` (the run's inputs), the current or the
-    home folder is always refused (:func:`check_replaceable`). On any error or
+    home folder is always refused (`check_replaceable`). On any error or
     interruption the temporary folder is removed and ``out`` is left as it was.
     """
     out = Path(os.path.realpath(out)) if Path(out).is_symlink() else Path(out)

@@ -5,14 +5,14 @@ Definitions (docs/theory.md, "The contact patch and its frame")
 * **Loaded**: an element face is loaded when the FE pressure exceeds the
   threshold somewhere on it: for nodal data when one of its nodes does, for
   face data when its value does. The threshold is ``threshold`` × the peak
-  pressure (default :data:`DEFAULT_THRESHOLD` = 1e-6, i.e. essentially
+  pressure (default `DEFAULT_THRESHOLD` = 1e-6, i.e. essentially
   "non-zero"). Steep faces that touch the contact only where flat loaded faces
   do (the sides of the loaded body) are not part of the patch
-  (:func:`fepost.facegroups.drop_edge_faces`).
+  (`fepost.facegroups.drop_edge_faces`).
 * **Faces**: linear triangles as they are; bilinear and quadratic faces are cut
   into triangles with their own shape functions, finer until the triangles
-  carry the element load to :data:`REFINE_TOL` (``N_fe`` is always the exact
-  integral over the element faces, :mod:`fepost.reader.quadratic`).
+  carry the element load to `REFINE_TOL` (``N_fe`` is always the exact
+  integral over the element faces, `fepost.reader.quadratic`).
 * **Plane**: least-squares plane through the nodes with pressure above the
   threshold (SVD). Its normal is the road normal z, oriented to have a
   positive component along the global axis it is closest to (z-up and y-up
@@ -26,16 +26,16 @@ Definitions (docs/theory.md, "The contact patch and its frame")
   area of the loaded faces.
 * **Circularity**: best-fit ellipse from the second area moments of the
   loaded faces (a uniform ellipse of semi-axes a ≥ b has moments a²/4, b²/4).
-  ``circular`` is true when ``aspect`` = a/b ≤ 1 + :data:`ASPECT_TOL` and
-  r_max/r_equiv ≤ :data:`RMAX_TOL` (a square, aspect 1, has 1.25).
+  ``circular`` is true when ``aspect`` = a/b ≤ 1 + `ASPECT_TOL` and
+  r_max/r_equiv ≤ `RMAX_TOL` (a square, aspect 1, has 1.25).
 
-Rejected (:class:`~fepost.errors.PatchError` / :class:`~fepost.errors.PressureError`
-/ :class:`~fepost.errors.DimensionError` / :class:`~fepost.errors.ScaleError`):
+Rejected (`PatchError` / `PressureError`
+/ `DimensionError` / `ScaleError`):
 all-zero pressure, NaN inside the patch, negative nodal pressures below −1 % of
 the peak, several patches each carrying more than 1 % of the load (side by side,
 or on parallel surfaces), a patch whose RMS distance from its plane exceeds
-:data:`PLANARITY_TOL` × R (R = r_max, as documented), loaded nodes on one line (a line contact), and
-implausible scales (:func:`fepost.reader.units.check_scale`).
+`PLANARITY_TOL` × R (R = r_max, as documented), loaded nodes on one line (a line contact), and
+implausible scales (`fepost.reader.units.check_scale`).
 Repaired with a warning: NaN away from the patch and small negative values
 (set to zero), fragments under 1 % of the load (dropped).
 """

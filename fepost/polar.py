@@ -1,6 +1,6 @@
 """Polar quadrature grids on the unit disc and pressure maps sampled on them.
 
-A :class:`PolarGrid` holds nodes ρ ∈ [0, 1] and φ ∈ [0, 2π) with weights such
+A `PolarGrid` holds nodes ρ ∈ [0, 1] and φ ∈ [0, 2π) with weights such
 that, for a patch of radius R,
 
     ∬ g dA ≈ R² Σ_ij g(ρ_i, φ_j) ρ_i w_i v_j     (``dA`` weights)
@@ -15,8 +15,8 @@ Two rules are offered:
     The paper's rule: equally spaced ρ including 0 and 1, trapezoid weights,
     periodic trapezoid in φ. Second order.
 
-A :class:`PolarMap` is a pressure field (Pa) on such a grid, about a centre, with
-radius R (m). Its integrals are in :mod:`fepost.moments`.
+A `PolarMap` is a pressure field (Pa) on such a grid, about a centre, with
+radius R (m). Its integrals are in `fepost.moments`.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ DEFAULT_NR = 64
 DEFAULT_NPHI = 128
 #: Memory a grid node costs in one run, bytes: measured (peak of ``analyse`` and of the Table 1
 #: exact-data fit at 2-8 million nodes: 140-220 bytes per node), doubled for the report's extra
-#: maps (the command line's check, :func:`fepost.cli._validate.check_grid`, uses the same figure).
+#: maps (the command line's check, `fepost.cli._validate.check_grid`, uses the same figure).
 BYTES_PER_NODE = 400
 
 
@@ -112,7 +112,7 @@ class PolarGrid:
 
 @dataclass(frozen=True)
 class PolarMap:
-    """A pressure field sampled on a :class:`PolarGrid` about ``centre``.
+    """A pressure field sampled on a `PolarGrid` about ``centre``.
 
     ``sigma`` has shape (nr, nphi) in Pa, ``radius`` is R in m, ``centre`` the
     (x, y) of the grid centre in the patch frame (m; (0, 0) = static centre of

@@ -1,7 +1,7 @@
 """How many contact patches the loaded faces make: side by side in the plane, or on different surfaces.
 
 The regions side by side are counted on a small raster (`loaded_regions`),
-dilated and labelled here with numpy (:func:`dilate`, :func:`label`) rather
+dilated and labelled here with numpy (`dilate`, `label`) rather
 than with ``scipy.ndimage``, whose import alone (~0.3-0.6 s) would be a quarter
 of a million-node ``fepost coefficients`` run; the two agree cell for cell
 (tests/test_regions.py).
@@ -110,7 +110,7 @@ def loaded_regions(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums
 
     Notes
     -----
-    Regions closer than a gap of about :data:`GAP_FRACTION` × √area (tread
+    Regions closer than a gap of about `GAP_FRACTION` × √area (tread
     grooves, sparse contact at the edge) belong to one patch; regions farther
     apart (dual wheels) are separate. The nodes are binned on a raster of cell
     h = max(GAP_FRACTION·√area, longest loaded edge), so faces that share a node

@@ -3,11 +3,11 @@
 The FE field is interpolated with its own elements: linear on each triangle
 for nodal data, constant per face for face data. Two implementations give the
 same numbers (the tests hold them to round-off): ``method="bins"`` (default,
-:mod:`fepost.locate`, a few times faster on million-node patches) and
+`fepost.locate`, a few times faster on million-node patches) and
 ``method="vtk"`` (VTK's probe filter through pyvista's ``sample``). Grid nodes
 that fall on no loaded face (outside the patch, in a groove, in a hole of the
 mesh) get zero pressure; the valid-point mask is kept on the map. Whether the
-resampled map still carries the FE load is checked by :func:`fepost.analysis.analyse` (N against N_fe).
+resampled map still carries the FE load is checked by `fepost.analysis.analyse` (N against N_fe).
 """
 
 from __future__ import annotations

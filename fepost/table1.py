@@ -1,11 +1,11 @@
 """The paper's Table 1 on our FE maps: theory, fitted values and 95 % bounds.
 
-:func:`table1` takes an :class:`~fepost.analysis.Analysis`, makes the test curves
-(:func:`fepost.identify.make_test_curves`; closed forms with the paper's 20 %
-uniform noise by default), fits them (:func:`fepost.identify.fit_table1`) and
+`table1` takes an `Analysis`, makes the test curves
+(`fepost.identify.make_test_curves`; closed forms with the paper's 20 %
+uniform noise by default), fits them (`fepost.identify.fit_table1`) and
 lays the result beside the paper's printed table, with the inconsistencies
 docs/theory.md lists. It also fits the closed forms to curves made by the exact
-integrals (:func:`fepost.identify.approximation_bias`) and reports the bias the
+integrals (`fepost.identify.approximation_bias`) and reports the bias the
 approximation itself causes.
 
 k_x without a rolling map
@@ -13,7 +13,7 @@ k_x without a rolling map
 The table1 JSON contract has a k_x row. With a rolling map, k_x is the moment form
 R·x_c/⟨x²⟩ and the exact F⊥ curve is integrated over the real
 rolling map. Without one, the theoretical k_x is *assumed* to be the paper's
-0.130 (:data:`PAPER_K_X`, or the ``k_x`` argument), the F⊥ curve is made with it
+0.130 (`PAPER_K_X`, or the ``k_x`` argument), the F⊥ curve is made with it
 (closed form, or the exact integrals over σ0(1 + k_x x/R)), and the table says so:
 the k_x row then checks the identification procedure only, not our FE model.
 """
@@ -133,7 +133,7 @@ class GeneralisedTable:
     ``rows``: f, F0, M0, a, m, k_x with ``theory`` from the FE maps (a, m along x,
     β = 0: the direction of the test curves); ``identification``: the fit;
     ``curves``: the noisy exact-integral data; ``form``: the fitted
-    :class:`~fepost.identify.GeneralisedCurves` (its two models).
+    `GeneralisedCurves` (its two models).
     """
 
     rows: tuple[Row, ...]
@@ -142,7 +142,7 @@ class GeneralisedTable:
     form: GeneralisedCurves
 
     def row(self, name: str) -> Row:
-        """The row of ``name`` (one of :data:`ROW_NAMES`)."""
+        """The row of ``name`` (one of `ROW_NAMES`)."""
         return _named_row(self.rows, name)
 
     def to_dict(self) -> dict:
@@ -190,7 +190,7 @@ class Table1:
     generalised: GeneralisedTable | None = None
 
     def row(self, name: str) -> Row:
-        """The row of ``name`` (one of :data:`ROW_NAMES`)."""
+        """The row of ``name`` (one of `ROW_NAMES`)."""
         return _named_row(self.rows, name)
 
     def to_dict(self) -> dict:
@@ -337,12 +337,12 @@ def table1(
 
     ``source``: ``"closed_form"`` (the paper's) or ``"exact"`` (curves from the exact
     integrals). ``noise``, ``amplitude``, ``n_points``, ``span``, ``seed``: as in
-    :func:`fepost.identify.make_test_curves`. ``k_x``: the assumed k_x when the
-    analysis has no rolling map (default :data:`PAPER_K_X`); an error when it has one.
-    ``bias``: also run :func:`fepost.identify.approximation_bias` (exact integrals).
+    `fepost.identify.make_test_curves`. ``k_x``: the assumed k_x when the
+    analysis has no rolling map (default `PAPER_K_X`); an error when it has one.
+    ``bias``: also run `fepost.identify.approximation_bias` (exact integrals).
     ``profile``: profile-likelihood bounds for a and m.
     ``generalised``: also fit the generalised model to exact-integral curves made
-    with the same points, noise and seed (:class:`GeneralisedTable`).
+    with the same points, noise and seed (`GeneralisedTable`).
     """
     if not isinstance(analysis, Analysis):
         raise ArgumentError(f"analysis must be an Analysis, got {type(analysis).__name__}")
@@ -443,7 +443,7 @@ def _generalised_table(
     analysis, quad, rolling_quad, kx, *, n_points, span, noise, amplitude, seed
 ) -> GeneralisedTable:
     """Take the analysis's generalised models (built once, shared with
-    :attr:`~fepost.analysis.Analysis.model_summary`; without a rolling map the
+    `model_summary`; without a rolling map the
     rolling model is built on σ0(1 + k_x x/R)), make the exact curves, fit (no
     profile bounds)."""
     c = analysis.coefficients

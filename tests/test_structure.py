@@ -206,11 +206,6 @@ def test_functions_are_short():
     assert not long, "\n".join(long)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="raw Sphinx roles remain in docstrings until the lead's conversion script runs after "
-    "the merges; remove this mark then",
-)
 def test_no_sphinx_roles_in_docstrings():
     raw = sorted(name for name, path in MODULES.items() if ROLE.search(path.read_text(encoding="utf-8")))
     assert not raw, f"raw Sphinx roles (rendered raw by MkDocs) in: {raw}"

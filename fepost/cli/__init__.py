@@ -1,14 +1,14 @@
 """Command-line interface: a thin shell over the Python API.
 
-Each subcommand is a module of this package named in :data:`COMMANDS`, exposing
+Each subcommand is a module of this package named in `COMMANDS`, exposing
 ``add_parser(subparsers)`` and ``run(args) -> int``. A subcommand module is light
-at import (argparse, this package's helpers, :mod:`fepost.errors`): the whole
+at import (argparse, this package's helpers, `fepost.errors`): the whole
 parser is built from them on every run, so ``fepost --help`` and usage errors
 never import numpy, scipy, VTK or matplotlib; ``run`` imports what it needs.
-Option types and ranges are in :mod:`fepost.cli._validate`.
+Option types and ranges are in `fepost.cli._validate`.
 
-:func:`main` is the edge where exceptions become exit statuses
-(:data:`EXIT_STATUSES`, also in ``docs/cli-exit-codes.md``): every failure is
+`main` is the edge where exceptions become exit statuses
+(`EXIT_STATUSES`, also in ``docs/cli-exit-codes.md``): every failure is
 one line on stderr, a traceback only with ``--debug``; fepost's warnings are
 printed as one line each, other libraries' warnings (numpy's RuntimeWarnings
 among them) are not shown to users (``--debug`` shows them; the test suite
@@ -89,7 +89,7 @@ def _epilog() -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``fepost`` parser with every subcommand in :data:`COMMANDS` (light imports only)."""
+    """The ``fepost`` parser with every subcommand in `COMMANDS` (light imports only)."""
     parser = _Parser(
         prog="fepost",
         description="FE tire-road contact results -> coupled dry-friction model coefficients.",
@@ -143,7 +143,7 @@ class _Run:
 
         An exception raised while VTK's extension modules initialise crashes the
         process (SIGSEGV, seen in testing); inside an import the raise waits for
-        a SIGALRM 50 ms later that checks again (:meth:`on_alarm`).
+        a SIGALRM 50 ms later that checks again (`on_alarm`).
         """
         self.signum = self.signum or signum
         if not self.debug:
@@ -315,7 +315,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI with ``argv`` (default: ``sys.argv[1:]``); return the exit status.
 
     Never raises (except with ``--debug``) and never exits: the status follows
-    :data:`EXIT_STATUSES`.
+    `EXIT_STATUSES`.
     """
     argv = list(sys.argv[1:] if argv is None else argv)
     run = _Run()

@@ -1,25 +1,25 @@
 """Types, ranges and lazily read defaults for the subcommands' options.
 
 Every ``type=`` callable here takes the option's text and returns the value, or
-raises :class:`argparse.ArgumentTypeError` saying what is wrong with what was
+raises `argparse.ArgumentTypeError` saying what is wrong with what was
 given; the parser prefixes the option's name (``argument --seed: ...``) and the
 CLI prints that one line and exits with status 2. Values that are valid but
-implausible are accepted with an :class:`~fepost.errors.OptionWarning`.
+implausible are accepted with an `OptionWarning`.
 
 The ranges (documented in ``docs/cli-exit-codes.md`` and each option's help):
 
 ================  ======================================================
 ``--friction``    a number in [0.001, 10] (`fepost.options.FRICTION_RANGE`); above
-                  :data:`FRICTION_PLAUSIBLE` (1.5) accepted with a warning:
+                  `FRICTION_PLAUSIBLE` (1.5) accepted with a warning:
                   tire rubber on a road reaches about 1.2 (dry asphalt)
 ``--threshold``   a number strictly between 0 and 1 (fraction of the peak)
 ``--seed``        an integer >= 0 (numpy's generators take no negative seed)
 ``--inflation-pressure``  a pressure with an optional unit (``1.38e6``,
                   ``1380kPa``, ``1.38 MPa``, ``13.8bar``, ``200psi``; no
                   unit: Pa) in (0, 1 GPa]; outside [10 kPa, 10 MPa]
-                  accepted with a warning (:func:`pressure`)
+                  accepted with a warning (`pressure`)
 ``--nr``          an integer in [2, 4096]; ``--nphi`` in [4, 16384]; and
-                  the grid must fit in memory (:func:`check_grid`)
+                  the grid must fit in memory (`check_grid`)
 table1            ``--span`` in (0, 100], ``--k-x`` in [-10, 10],
                   ``--amplitude`` in [0, 2], ``--n-points`` in [2, 10^6]
 ================  ======================================================
@@ -31,7 +31,7 @@ f = 1e-300), far outside any physical case.
 This module is light on purpose (argparse and the standard library only): the
 parser is built from it on every run, including ``fepost --help``, which must not
 import numpy, scipy or VTK. Library defaults that live in heavy modules are given
-as :class:`LibraryDefault` and read only when the help shows them or the
+as `LibraryDefault` and read only when the help shows them or the
 command runs.
 """
 
@@ -79,7 +79,7 @@ def _integer(text: str) -> int:
 
 def friction(text: str) -> float:
     """Friction coefficient f by the one rule, `fepost.options.check_friction`; a warning
-    above :data:`FRICTION_PLAUSIBLE`."""
+    above `FRICTION_PLAUSIBLE`."""
     from ..errors import ArgumentError
     from ..options import FRICTION_RANGE, check_friction
 
@@ -108,7 +108,7 @@ PRESSURE_PLAUSIBLE = (1e4, 1e7)
 
 
 def pressure(text: str) -> float:
-    """An inflation pressure in Pa, from a number and an optional unit of :data:`PRESSURE_UNITS`."""
+    """An inflation pressure in Pa, from a number and an optional unit of `PRESSURE_UNITS`."""
     raw = str(text).strip()
     number = raw.rstrip("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ").strip()
     unit = raw[len(raw.rstrip("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ")) :].lower()
@@ -191,7 +191,7 @@ def check_strings(parser: argparse.ArgumentParser, args: argparse.Namespace) -> 
     """Refuse an empty string (``--json ''``) or one holding a NUL character (no file
     name can) given to any option or input, naming it.
 
-    Raises :class:`~fepost.errors.ArgumentError`.
+    Raises `ArgumentError`.
     """
     actions = list(parser._actions)
     command = getattr(args, "command", None)
@@ -218,8 +218,8 @@ def check_outputs(args: argparse.Namespace) -> None:
     inputs, or whose folder does not exist, before any work is done.
 
     The inputs are every other path given on the command line that exists; the
-    current and home folders are guarded too (:func:`fepost.output.check_replaceable`).
-    Raises :class:`~fepost.errors.OutputError`.
+    current and home folders are guarded too (`fepost.output.check_replaceable`).
+    Raises `OutputError`.
     """
     values = []
     for key, value in vars(args).items():
@@ -249,7 +249,7 @@ class LibraryDefault:
     """A default kept in a (heavy) library module, read only when it is needed.
 
     ``default=LibraryDefault("fepost.table1", "DEFAULT_SEED")`` with a help text
-    containing ``%(default)s`` shows the value in ``--help``; :func:`resolve_defaults`
+    containing ``%(default)s`` shows the value in ``--help``; `resolve_defaults`
     replaces it by the module's attribute after parsing (the command imports that
     module anyway). For the help text the constant is read from the module's
     source, where it is a literal assignment, without importing it (importing
@@ -311,7 +311,7 @@ def _source_file(module: str) -> str | None:
 
 
 def resolve_defaults(args: argparse.Namespace) -> None:
-    """Replace every :class:`LibraryDefault` left in ``args`` by its value."""
+    """Replace every `LibraryDefault` left in ``args`` by its value."""
     for key, value in vars(args).items():
         if isinstance(value, LibraryDefault):
             setattr(args, key, value.value)
@@ -327,7 +327,7 @@ def _physical_memory() -> int | None:
 def check_grid(args: argparse.Namespace) -> None:
     """Refuse ``--nr`` x ``--nphi`` grids that cannot fit in this machine's memory.
 
-    Raises :class:`~fepost.errors.ArgumentError` with the estimate.
+    Raises `ArgumentError` with the estimate.
     """
     nr, nphi = getattr(args, "nr", None), getattr(args, "nphi", None)
     if not (isinstance(nr, int) and isinstance(nphi, int)):

@@ -7,7 +7,7 @@ non-empty DIR). The summary is also printed.
 
 ``fepost diagnose --make-example CSV --simulation SIM [--cause NAME] [--seed S]``
 writes example measured data instead: the project's generator over SIM with one
-documented cause hidden in it (:mod:`fepost.diagnose.example`).
+documented cause hidden in it (`fepost.diagnose.example`).
 """
 
 from __future__ import annotations

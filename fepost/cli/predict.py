@@ -2,10 +2,10 @@
 
 For each row (vx, vy, wz) of the kinematics CSV, writes the friction force and
 torque of the exact Coulomb integrals over the FE map, of the paper's closed
-forms and of the generalised model (columns in :mod:`fepost.friction.predict`),
+forms and of the generalised model (columns in `fepost.friction.predict`),
 same rows in the same order, atomically. ``--model-json`` also writes the
 generalised model's coefficients (the export documented in ``docs/model.md``).
-Module-level imports stay light: the work is imported inside :func:`run`.
+Module-level imports stay light: the work is imported inside `run`.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 ``--force`` replaces a non-empty DIR, but never one that holds the inputs, the
 sample meshes, the current folder, the home folder or the root
-(:func:`fepost.output.check_replaceable`).
+(`fepost.output.check_replaceable`).
 """
 
 from __future__ import annotations

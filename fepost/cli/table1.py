@@ -16,7 +16,7 @@ import argparse
 from . import _validate as v
 from ._common import add_friction_option, add_input_options, analysis_options
 
-#: The committed seed of ``fepost table1`` (:data:`fepost.table1.DEFAULT_SEED`).
+#: The committed seed of ``fepost table1`` (`fepost.table1.DEFAULT_SEED`).
 SEED = v.LibraryDefault("fepost.table1", "DEFAULT_SEED")
 
 

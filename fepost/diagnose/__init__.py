@@ -1,16 +1,16 @@
 """``fepost diagnose``: what the simulation gets wrong against rig data, and why.
 
-:func:`diagnose` compares measured Fx, Fy, Mz (the measured-data CSV of
+`diagnose` compares measured Fx, Fy, Mz (the measured-data CSV of
 docs/diagnose.md) with the exact friction integrals over the FE contact
-pressure. It fits every candidate cause (:data:`~fepost.diagnose.causenames.CAUSES`)
+pressure. It fits every candidate cause (`CAUSES`)
 as a physical extension of the model, robustly first to flag gross outliers
-(:mod:`~fepost.diagnose.robust`) and under a noise model chosen per channel
-(:mod:`~fepost.diagnose.noise`); names the cause the data support (BIC with
-nesting tests and a held-out check, :mod:`~fepost.diagnose.selection`) and a
-second one on top when the same rules admit it (:mod:`~fepost.diagnose.pairs`);
-tests what is left for lack of fit (:mod:`~fepost.diagnose.lackfit`) and
-measures the gain. :mod:`.synthetic` makes test data with effects, noise, gross
-errors and drift hidden in them; :mod:`.example` writes an example CSV.
+(`robust`) and under a noise model chosen per channel
+(`noise`); names the cause the data support (BIC with
+nesting tests and a held-out check, `selection`) and a
+second one on top when the same rules admit it (`pairs`);
+tests what is left for lack of fit (`lackfit`) and
+measures the gain. `.synthetic` makes test data with effects, noise, gross
+errors and drift hidden in them; `.example` writes an example CSV.
 """
 
 from __future__ import annotations

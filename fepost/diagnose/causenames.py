@@ -2,7 +2,7 @@
 
 A module of its own, without numpy, so that the command line builds its
 ``--cause`` choices and help without importing the diagnosis
-(:mod:`fepost.diagnose.causes` defines what each cause does).
+(`fepost.diagnose.causes` defines what each cause does).
 """
 
 CAUSES = (

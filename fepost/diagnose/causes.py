@@ -1,8 +1,8 @@
 """The candidate causes: physical extensions of the simulation, as parametrised models.
 
 Every model predicts the three channels of every test point through the exact
-integrals (docs/theory.md, :func:`~fepost.friction.exact.friction_resultants`),
-in the dimensionless units of :meth:`Simulation.scales <fepost.diagnose.simulation.Simulation.scales>`:
+integrals (docs/theory.md, `friction_resultants`),
+in the dimensionless units of `Simulation.scales <fepost.diagnose.simulation.Simulation.scales>`:
 Fx/(f₀N), Fy/(f₀N), Mz/(f₀NR) with the nominal f₀ and the static map's N and R.
 
 All extensions share the friction level f; each adds its own 1–3 parameters,
@@ -21,8 +21,8 @@ cause                          parameters            no-effect value
 ``sensor_offset``              f, oFx, oFy (N), oMz  offsets = 0
 ============================== ===================== ===============================
 
-Two extensions at once (:func:`joint_candidate`) share f and keep both
-parameter sets; the effects combine exactly (:mod:`fepost.diagnose.models`).
+Two extensions at once (`joint_candidate`) share f and keep both
+parameter sets; the effects combine exactly (`fepost.diagnose.models`).
 
 Linear structure (the speed of the fits). The exact resultants are linear in f,
 and — while no local coefficient is clipped at zero — in c_p, in c_v and in α.
@@ -154,7 +154,7 @@ def joint_candidate(pred: Predictor, extensions, params: dict | None = None) -> 
     """One model with every extension in ``extensions`` (order kept: primary first) and a shared f.
 
     It nests ``none``, ``friction_level`` and each extension alone. ``params``
-    (from :func:`extension_parameters`) saves rebuilding the parameter table.
+    (from `extension_parameters`) saves rebuilding the parameter table.
     """
     extensions = tuple(extensions)
     unknown = [e for e in extensions if e not in EXTENSIONS]
@@ -171,7 +171,7 @@ def joint_candidate(pred: Predictor, extensions, params: dict | None = None) -> 
 
 
 def build_candidates(pred: Predictor) -> dict[str, Candidate]:
-    """Every cause of :data:`CAUSES` as a :class:`Candidate` over the predictor's points."""
+    """Every cause of `CAUSES` as a `Candidate` over the predictor's points."""
     f_par = friction_parameter(pred)
     table = extension_parameters(pred)
     level = extension_model(

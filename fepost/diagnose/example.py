@@ -1,22 +1,22 @@
 """Example measured data: a rig programme over a simulation with one documented cause hidden in it.
 
-:func:`make_example` runs the generator of :mod:`~fepost.diagnose.synthetic` on
+`make_example` runs the generator of `synthetic` on
 an FE export and writes the measured-data CSV, with a header of ``#`` comment
 lines that say what is hidden in it (cause, parameters, noise, outlier rows,
 seed) and the command that made it. ``fepost diagnose --make-example CSV
 --simulation SIM [--cause NAME] [--seed S]`` is its command line.
 
-Effect sizes (:func:`example_parameters`) are set relative to the simulation, so
+Effect sizes (`example_parameters`) are set relative to the simulation, so
 that every cause is plain on any map: a 15 % lower friction level; c_p = 0.25;
 c_v = −0.1 s/m; a patch stretched by 12 %; f_y/f_x = 1.15; the centre of
 pressure moved by (4 %, −3 %) of R; offsets of (8 %, −6 %) of f·N and 5 % of
 f·N·R. The programme has loads 0.8, 1.0 and 1.2 × N (pressure dependence then
 shows through the load), 300 points, noise 1.5 % of each channel's range and
-:data:`EXAMPLE_OUTLIERS` gross errors (a sign flip, a 2.5× spike).
+`EXAMPLE_OUTLIERS` gross errors (a sign flip, a 2.5× spike).
 
 The example shipped as ``examples/measured_example.csv`` was made from
 ``meshes/static.vtu`` with the defaults: ``pressure_dependent_friction``,
-c_p = 0.25, seed :data:`EXAMPLE_SEED`.
+c_p = 0.25, seed `EXAMPLE_SEED`.
 """
 
 from __future__ import annotations

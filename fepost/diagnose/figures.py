@@ -1,9 +1,9 @@
 """Figures of a diagnosis (matplotlib, no pyplot state; callers save or embed them).
 
-* :func:`plot_predicted_vs_measured` — one panel per channel: the simulation
+* `plot_predicted_vs_measured` — one panel per channel: the simulation
   (grey) and the named extension's held-out predictions (colour) against the
   measurement, with the identity line.
-* :func:`plot_residuals` — residuals in % of the channel scale (f₀N, f₀NR)
+* `plot_residuals` — residuals in % of the channel scale (f₀N, f₀NR)
   against sliding speed, speed ratio, sliding direction, spin sign and (when
   they vary) load and roll, and against the run order (or the ``time``
   column), with the group means the ANOVA test compares (± their 95 %
@@ -13,8 +13,8 @@
   less friction than simulated), where a change of friction level with speed,
   load or pressure shows as a trend of the means even when the signed Fx, Fy
   residuals only fan out. Outliers are drawn in red.
-* :func:`plot_candidates` — ΔBIC of every candidate against the simulation.
-* :func:`plot_recording` — for a rig recording: the kinematics and forces
+* `plot_candidates` — ΔBIC of every candidate against the simulation.
+* `plot_recording` — for a rig recording: the kinematics and forces
   against time (a decimated copy, `fepost.diagnose.holds.TRACE_POINTS` samples
   at most), the steady holds shaded and each hold's mean drawn on it, the rows
   left out (transitions) in red.

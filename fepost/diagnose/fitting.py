@@ -1,8 +1,8 @@
 """Nonlinear least squares under a per-channel noise model, Gaussian or robust.
 
 The data are Fx, Fy, Mz in the dimensionless units of
-:meth:`~fepost.diagnose.simulation.Simulation.scales`. The noise of channel c at
-row i has standard deviation σ_ic from a :class:`~fepost.diagnose.noise.Noise`
+`scales`. The noise of channel c at
+row i has standard deviation σ_ic from a `Noise`
 model (constant, proportional to a fixed reference |F|, or both), whose
 parameters are estimated with the model's.
 
@@ -11,9 +11,9 @@ parameters are estimated with the model's.
     ℓ(θ, a, b) = −½ Σ_ic [ln(2π σ_ic²) + r_ic(θ)²/σ_ic²].
 
 It is maximised by alternating: fix σ, minimise Σ r²/σ² with
-:func:`scipy.optimize.least_squares` (trust-region reflective, bounds,
+`scipy.optimize.least_squares` (trust-region reflective, bounds,
 finite-difference Jacobian); fix θ, maximise over the noise parameters
-(:meth:`Noise.refit <fepost.diagnose.noise.Noise.refit>`); until the σ settle.
+(`Noise.refit <fepost.diagnose.noise.Noise.refit>`); until the σ settle.
 The variances do not depend on θ (the reference magnitudes are fixed), so a
 fixed point is a stationary point of ℓ. With constant noise this is the
 profiled likelihood −(n/2) Σ_c [ln(2π RSS_c/n) + 1].
@@ -21,18 +21,18 @@ profiled likelihood −(n/2) Σ_c [ln(2π RSS_c/n) + 1].
 **Robust fit** (``loss="huber"``). The same alternation with Huber's loss
 ρ_k(z) (k = 1.345: quadratic within k noise SDs, linear beyond; ``loss="huber"``
 with ``f_scale=k`` of least_squares on the whitened residuals) and Huber's scale
-equation for the noise parameters (Huber's Proposal 2, :mod:`~fepost.diagnose.noise`);
+equation for the noise parameters (Huber's Proposal 2, `noise`);
 the first scale is 1.4826 × MAD of the residuals at the start values.
 ``log_likelihood`` is then −Σ [ρ_k(z) + ln σ], the log-likelihood of Huber's
 least-favourable density up to a constant, evaluated at that scale.
 Robust fits serve only to find outliers and the noise model's reference
-(:mod:`~fepost.diagnose.robust`); every score, test and interval comes from a
+(`robust`); every score, test and interval comes from a
 Gaussian fit on the rows that remain.
 
 95 % intervals are Wald intervals from the whitened Jacobian at the optimum
 (covariance (JᵀJ)⁻¹ via its SVD, scaled by n_obs/(n_obs − k), Student t with
 n_obs − k degrees of freedom, k = parameters + noise parameters), as at the end
-of :func:`scipy.optimize.curve_fit`; a rank-deficient Jacobian gives a
+of `scipy.optimize.curve_fit`; a rank-deficient Jacobian gives a
 FitWarning and infinite intervals. Every model here is linear or nearly so in
 its parameters over the ranges that matter, where Wald and profile intervals
 agree.
@@ -58,7 +58,7 @@ SIGMA_RTOL = 1e-4
 MAX_ROUNDS = 12
 #: Relative step of the finite-difference Jacobian, in units of each parameter's scale.
 DIFF_STEP = 1e-6
-#: Geometry fits (see :func:`fit`): at most this many expansions ...
+#: Geometry fits (see `fit`): at most this many expansions ...
 GN_MAX = 12
 #: ... each step halved at most this many times ...
 GN_HALVINGS = 6
@@ -188,11 +188,11 @@ def fit(
     ``start``: initial parameter values (default each parameter's start);
     ``noise``: the noise model and its starting parameters (default: constant
     variance per channel); ``loss``: ``"gaussian"`` or ``"huber"`` (module
-    docstring). Raises :class:`FitError` when the solver fails.
+    docstring). Raises `FitError` when the solver fails.
 
     A candidate with ``expand`` (costly geometry) is fitted through local
     models: fit its second-order expansion about the current values; when that
-    moves the parameters by less than :data:`GN_TOL` standard errors, stop;
+    moves the parameters by less than `GN_TOL` standard errors, stop;
     else move there (halving the step while the exact objective, one set of
     integrals per trial point, drops; stop when no halving improves it, or when
     the step taken is under the tolerance) and expand again. The returned ``model``

@@ -14,20 +14,20 @@ Columns (SI, header row, one row per test point; other columns are ignored):
 =========== ==========================================================
 
 Blank lines and lines whose first non-blank character is ``#`` are skipped
-(before and after the header). The file is read by :mod:`fepost.csvtable`, as
+(before and after the header). The file is read by `fepost.csvtable`, as
 the kinematics of ``fepost predict`` are: every problem is a one-line
-:class:`~fepost.errors.DataError` naming the file, the line and the column.
+`DataError` naming the file, the line and the column.
 
-Limits: at most :data:`MAX_ROWS` test points (a rig programme has hundreds;
+Limits: at most `MAX_ROWS` test points (a rig programme has hundreds;
 diagnose takes 1–4 ms per point on a 2-core machine, 7 s for 5000 points, see
 ``benchmarks/bench_diagnose.py``) and
-files of at most :data:`MAX_BYTES`; both are refused before the rows are parsed,
+files of at most `MAX_BYTES`; both are refused before the rows are parsed,
 so a table of a million rows is turned away in a second rather than diagnosed for
 an hour. Long data with a ``time`` column are rig recordings, read in chunks and
 reduced to their steady holds instead (`fepost.diagnose.inputs`). A cell longer
-than :data:`fepost.csvtable.MAX_CELL` characters is an error.
+than `fepost.csvtable.MAX_CELL` characters is an error.
 
-:func:`check_plausible` compares the data with the simulation (units, dead
+`check_plausible` compares the data with the simulation (units, dead
 channels, a test programme in which nothing varies, rolling rows without a
 rolling map) once f, N and R are known.
 """
@@ -226,14 +226,14 @@ def check_plausible(
     """Reject or flag data that cannot be compared with the simulation.
 
     ``friction`` is the nominal f, ``load`` the simulation's N (N), ``radius``
-    its R (m). Errors (:class:`DataError`), in this order: fewer than
-    :data:`MIN_ROWS` rows; no row that slides or spins; fewer than
-    :data:`MIN_DISTINCT` distinct test points (nothing varies); a channel that is
+    its R (m). Errors (`DataError`), in this order: fewer than
+    `MIN_ROWS` rows; no row that slides or spins; fewer than
+    `MIN_DISTINCT` distinct test points (nothing varies); a channel that is
     zero in every row (dead sensor); roll = ±1 rows when no rolling map was given
     (the static map would silently stand in for it); |Fx|, |Fy| above
     ``UNITS_ERROR_RATIO``·f·N or |Mz| above that times f·N·R in any row (wrong
     units); a channel with one value in every row (dead sensor). Warning
-    (:class:`UnitsWarning`): the largest force of the sliding rows is below
+    (`UnitsWarning`): the largest force of the sliding rows is below
     ``UNITS_SMALL_RATIO``·f·N (kN given as N?).
     """
     src = f"{data.source}: " if data.source else ""

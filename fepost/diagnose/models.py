@@ -1,12 +1,12 @@
 """Models over the exact integrals: one extension or several at once, with their geometry.
 
-A model is a set of extensions of the simulation (:mod:`fepost.diagnose.causes`)
+A model is a set of extensions of the simulation (`fepost.diagnose.causes`)
 sharing the friction level f. Its prediction, in the dimensionless units of
-:meth:`Simulation.scales <fepost.diagnose.simulation.Simulation.scales>`, is
+`Simulation.scales <fepost.diagnose.simulation.Simulation.scales>`, is
 
     f · [(1 − c_p)(B₀₀ + c_v (B₀₁ − B₀₀)) + c_p (B₁₀ + c_v (B₁₁ − B₁₀))] + o / scale,
 
-where B_pv are exact resultants (:func:`~fepost.friction.exact.friction_resultants`)
+where B_pv are exact resultants (`friction_resultants`)
 of four laws with f = 1: Coulomb (B₀₀), pressure-dependent with c_p = 1 (B₁₀, whose
 load scaling is λ² since μσ ∝ σ²), speed-dependent with c_v = 1 (B₀₁) and both
 (B₁₁). The local coefficient μ = f (1 + c_p(σ/σ_ref − 1))(1 + c_v|w|) is bilinear
@@ -20,11 +20,11 @@ single pressure-, speed- or direction-dependent law, up to eight for a pair).
 Geometry (the stretch s of ``elliptic_patch`` and the shift dx, dy of
 ``pressure_shift``; stretch first, then shift) moves the pressure map, so every
 B depends on it and needs new exact integrals per geometry. Those are cached
-(:data:`CACHE_SIZE` per :class:`Predictor`, shared by all models). A geometric
+(`CACHE_SIZE` per `Predictor`, shared by all models). A geometric
 model also offers ``expand(values)``: the same formula with each B replaced by
 its second-order Taylor expansion in the geometry about ``values``, from central
-differences of step :data:`GEOMETRY_STEP` (first and second derivatives, and
-mixed ones). :func:`fepost.diagnose.fitting.fit` iterates these local models.
+differences of step `GEOMETRY_STEP` (first and second derivatives, and
+mixed ones). `fepost.diagnose.fitting.fit` iterates these local models.
 """
 
 from __future__ import annotations
@@ -126,7 +126,7 @@ class Predictor:
     channels for the law, with each row's map scaled by λ = N_row/N_map (``power``
     2 for a pressure-dependent part, see the module docstring) and the
     quadratures optionally transformed (``transform(quad) -> quad``).
-    :meth:`raw` caches them per (law term, anisotropy, geometry).
+    `raw` caches them per (law term, anisotropy, geometry).
     """
 
     def __init__(self, sim: Simulation, data: MeasuredData) -> None:
@@ -283,7 +283,7 @@ def extension_model(
     description: str,
     extensions: tuple[str, ...],
 ) -> Candidate:
-    """A :class:`Candidate` combining the parameters' effects exactly (module docstring)."""
+    """A `Candidate` combining the parameters' effects exactly (module docstring)."""
     layout = _Layout.of(parameters)
     keys = layout.keys()
     scale = pred.scale

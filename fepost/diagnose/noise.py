@@ -6,13 +6,13 @@ variance
     σ_ic² = a_c + b_c g_ic²,
 
 where g_ic is the magnitude of a **reference prediction** of that channel
-(dimensionless units of :meth:`Simulation.scales
+(dimensionless units of `Simulation.scales
 <fepost.diagnose.simulation.Simulation.scales>`). The reference is fixed before
 the candidates are fitted and is the same for all of them (see
-:mod:`~fepost.diagnose.pipeline`), so every candidate is judged under one
+`pipeline`), so every candidate is judged under one
 variance family: their likelihoods stay comparable and nested, and the
 variance does not depend on the mean parameters (the weighted least squares of
-:mod:`~fepost.diagnose.fitting` then maximise the likelihood exactly).
+`fitting` then maximise the likelihood exactly).
 
 Structures (``a``, ``b`` ≥ 0):
 
@@ -24,11 +24,11 @@ structure         variance                            parameters
 ``combined``      a + b g²  (a ≥ FLOOR²)              2
 ================  ==================================  ==========
 
-:data:`NOISE_FLOOR` is a floor on every standard deviation: the model's own
+`NOISE_FLOOR` is a floor on every standard deviation: the model's own
 numerical accuracy. Without it, a purely proportional model would trust a point
 whose predicted force is zero (Fy of a straight slide along x) without limit.
 
-**Which structure.** :func:`select_structure` takes one channel's residuals
+**Which structure.** `select_structure` takes one channel's residuals
 of the reference fit and picks the structure of lowest BIC = −2ℓ + k ln n (k
 above, n points), ties going to the simpler (the order of the table). Constant
 and proportional have one parameter each, so between them the likelihood
@@ -37,7 +37,7 @@ decides; the combined model must gain more than ln n in −2ℓ.
 **Estimation.** For given residuals r the maximum-likelihood (a, b) solve the
 score equations Σ w_i (r_i² − σ_i²)(1, g_i²) = 0 with w_i = 1/σ_i⁴: Fisher
 scoring is a weighted regression of r² on (1, g²), iterated, with the bounds
-enforced on the free parameters (:func:`fit_channel`). For the robust pass the
+enforced on the free parameters (`fit_channel`). For the robust pass the
 squared residuals are replaced by Huber's bounded version σ_i² min(z², k²)/β
 (z = r/σ, β = E[min(Z², k²)] for Z ~ N(0, 1), so that the estimate is unbiased
 at the normal): the scale equation of Huber's "Proposal 2", whose influence is

@@ -1,11 +1,11 @@
 """Two causes at once: a second extension on top of the chosen one, by the same rules.
 
-Once the single-cause rule of :mod:`~fepost.diagnose.selection` has named an
+Once the single-cause rule of `selection` has named an
 extension C₁, each other extension C₂ is a candidate second cause. The joint
-model C₁ + C₂ (:func:`~fepost.diagnose.causes.joint_candidate`: f shared, both
+model C₁ + C₂ (`joint_candidate`: f shared, both
 parameter sets, the effects combined exactly) nests C₁, C₂, ``friction_level``
 and ``none``, and is **admissible** when against each of them its BIC is lower,
-its likelihood-ratio test has p < :data:`PAIR_ALPHA` = 0.01/8 (Bonferroni over
+its likelihood-ratio test has p < `PAIR_ALPHA` = 0.01/8 (Bonferroni over
 the second causes tried: at most the eight other extensions that combine with
 it, ``load_transfer`` only with the sensor causes, and a friction level other
 than nominal), and its held-out log density is higher. The family-wise
@@ -29,15 +29,15 @@ are C₂'s derivatives at no effect with C₁'s effect left out (the neglected
 interaction is of the order of the product of the two effects, and the
 derivatives are already cached from the single-cause fits, so the screen costs
 no new integrals). The score test is the likelihood-ratio test's first-order
-twin, so only a joint model whose score statistic reaches :data:`SCREEN_FRACTION`
+twin, so only a joint model whose score statistic reaches `SCREEN_FRACTION`
 of the likelihood ratio it would need to be admitted (the larger of the χ²
 quantile at PAIR_ALPHA and the BIC's q ln n_obs, q its new parameters) is
-fitted, at most :data:`MAX_PAIR_FITS` of them, the strongest first. The friction
+fitted, at most `MAX_PAIR_FITS` of them, the strongest first. The friction
 level is screened by the Wald test of f = f₀ at the same fraction.
 
 **What the programme cannot separate.** For the chosen joint model, parameters
 of the two causes whose estimates are correlated beyond
-:data:`CORRELATION_NOTE` (from the fit's covariance) are reported: the test
+`CORRELATION_NOTE` (from the fit's covariance) are reported: the test
 programme moves them together, and only other test points could tell them
 apart; admissible joint models within ΔBIC 10 of the chosen one are listed as
 indistinguishable.
@@ -110,7 +110,7 @@ def numeric_jacobian(cand: Candidate, at: np.ndarray, rows: np.ndarray) -> np.nd
 
     Geometric models are differentiated through their local linear model
     (``expand(at, order=1)``), i.e. with the geometric step of
-    :mod:`~fepost.diagnose.models`; the other parameters enter at most bilinearly.
+    `models`; the other parameters enter at most bilinearly.
     """
     local = cand.expand(at, order=1) if cand.expand is not None else cand
     at = np.asarray(at, float)
@@ -143,7 +143,7 @@ def score_test(base: Fit, second: Candidate, Y: np.ndarray) -> tuple[float, floa
 
 
 def _quiet_fit(*args, **kwargs) -> tuple[Fit, list[str]]:
-    """:func:`fit`, with its FitWarnings returned as reasons instead of shown: a joint
+    """`fit`, with its FitWarnings returned as reasons instead of shown: a joint
     model the data cannot identify is simply not admitted."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FitWarning)
@@ -264,7 +264,7 @@ def friction_test(cand: Candidate, full: Fit, cv: CrossValidation, Y: np.ndarray
 
 
 def correlated_parameters(full: Fit, first: tuple[str, ...], second: tuple[str, ...]) -> list[tuple]:
-    """(name₁, name₂, r) for parameters of two causes correlated beyond :data:`CORRELATION_NOTE`."""
+    """(name₁, name₂, r) for parameters of two causes correlated beyond `CORRELATION_NOTE`."""
     if full.jacobian is None:
         return []
     svd = jacobian_svd(full.jacobian)

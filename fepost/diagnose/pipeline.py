@@ -2,26 +2,26 @@
 
 The steps (each a module of this package):
 
-1. :mod:`~fepost.diagnose.measured` reads and checks the CSV of test points, or
-   :mod:`~fepost.diagnose.recording` and :mod:`~fepost.diagnose.holds` read a
+1. `measured` reads and checks the CSV of test points, or
+   `recording` and `holds` read a
    rig recording and reduce its steady holds to test points
-   (:func:`~fepost.diagnose.inputs.load_measured` decides which);
-   :mod:`~fepost.diagnose.simulation` puts the FE maps on the fit grid.
-2. :mod:`~fepost.diagnose.causes` builds every candidate cause as a model over
-   the exact integrals (:mod:`~fepost.diagnose.models`).
-3. :mod:`~fepost.diagnose.robust` fits every candidate with Huber's loss, flags
+   (`load_measured` decides which);
+   `simulation` puts the FE maps on the fit grid.
+2. `causes` builds every candidate cause as a model over
+   the exact integrals (`models`).
+3. `robust` fits every candidate with Huber's loss, flags
    the rows no candidate explains (outliers, left out from here on) and picks
    the reference prediction of the noise model; each channel's noise structure
-   (constant, proportional, combined) is chosen by BIC (:mod:`~fepost.diagnose.noise`).
-4. :mod:`~fepost.diagnose.fitting` fits each candidate by maximum likelihood
+   (constant, proportional, combined) is chosen by BIC (`noise`).
+4. `fitting` fits each candidate by maximum likelihood
    under that noise model, to all kept rows and, for the held-out check, to each
-   training fold; :mod:`~fepost.diagnose.selection` scores them (BIC, nesting
+   training fold; `selection` scores them (BIC, nesting
    tests, held-out log density) and names the primary cause.
-5. :mod:`~fepost.diagnose.pairs` tries a second cause on top of it by the same
+5. `pairs` tries a second cause on top of it by the same
    rules, and a friction level other than nominal.
-6. :mod:`~fepost.diagnose.lackfit` asks whether the chosen model leaves
+6. `lackfit` asks whether the chosen model leaves
    structure (pure error per channel, from replicates or from the scatter
-   within holds; residual structure per channel; run-order drift); :mod:`~fepost.diagnose.residuals`
+   within holds; residual structure per channel; run-order drift); `residuals`
    tests the residuals against the kinematics; the paper's closed forms are
    compared with the data and with the exact integrals.
 """

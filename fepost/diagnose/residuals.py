@@ -5,7 +5,7 @@ equal count for the continuous variables) and a one-way ANOVA F-test asks
 whether the group means differ; a t-test asks whether the overall mean is zero.
 Noise gives p-values spread on [0, 1]; a systematic misfit gives tiny ones.
 The verdict is ``structure`` when any p-value, Bonferroni-corrected over all the
-tests of the channel, is below :data:`LEVEL`, else ``noise``.
+tests of the channel, is below `LEVEL`, else ``noise``.
 
 Variables: sliding speed |v| (m/s); ε/(1+ε) with ε = |v|/(|ω|R) (0 = pure spin,
 1 = pure sliding); sliding direction atan2(vy, vx) (8 sectors); spin sign; load

@@ -50,7 +50,7 @@ class Diagnosis:
     (primary first); ``parameters`` and ``gain`` are the chosen model's.
     ``outliers`` are 0-based data rows left out of every fit; ``sigma`` (n, 3)
     the noise SD of every row under the chosen noise model (scaled units);
-    ``lack_of_fit`` the verdict of :func:`~fepost.diagnose.lackfit.lack_of_fit`;
+    ``lack_of_fit`` the verdict of `lack_of_fit`;
     ``separation`` what the test programme cannot separate within the chosen model;
     ``holds`` the steady holds the data came from when they were a recording.
     """

@@ -3,9 +3,9 @@
 A load-cell glitch (a sign flip, a spike of several times the reading) pulls a
 least-squares fit far from the rest of the data and can hide a real effect or
 invent one. Before any model is scored, every single-cause candidate is fitted
-robustly (:func:`~fepost.diagnose.fitting.fit` with ``loss="huber"``: Huber's loss
+robustly (`fit` with ``loss="huber"``: Huber's loss
 with k = 1.345 noise SDs and the ``combined`` noise model of
-:mod:`~fepost.diagnose.noise`, its scale from Huber's scale equation started at
+`noise`, its scale from Huber's scale equation started at
 1.4826 × MAD; the reference magnitudes are those of the simulation). A
 candidate that moves the pressure map is fitted here on its second-order
 expansion about the no-effect geometry (one set of exact integrals, no
@@ -16,23 +16,23 @@ data, and the error of the expansion is third order in the effect.
 candidate's robust fit. A row is an outlier when, under *every* candidate, one of
 its three channels lies beyond
 
-    c = Φ⁻¹(1 − α/(2·3n)),   α = :data:`OUTLIER_ALPHA` = 0.05,
+    c = Φ⁻¹(1 − α/(2·3n)),   α = `OUTLIER_ALPHA` = 0.05,
 
 i.e. when no cause in the vocabulary explains it. c is the Bonferroni bound over
 the 3n residuals: on clean Gaussian data the chance that any row at all is
 flagged is below 5 % (c = 4.1 for 400 rows); a flagged row costs one test point.
 A misfit that a candidate explains (a real effect) is not flagged, because that
 candidate's residuals are small there. When more than
-:data:`MAX_OUTLIER_FRACTION` of the rows lie beyond c, they are not isolated
+`MAX_OUTLIER_FRACTION` of the rows lie beyond c, they are not isolated
 glitches but structure: none is removed, and the lack-of-fit tests
-(:mod:`~fepost.diagnose.lackfit`) speak for them.
+(`lackfit`) speak for them.
 
 Outliers are left out of every later fit, score, interval and test.
 
 **Reference for the noise model.** The robust fit of lowest BIC (with the Huber
 log-likelihood) is the reference: its predicted |F| are the magnitudes g of the
 noise model for every candidate, and its residuals on the remaining rows choose
-each channel's noise structure (:func:`~fepost.diagnose.noise.select_structure`).
+each channel's noise structure (`select_structure`).
 """
 
 from __future__ import annotations

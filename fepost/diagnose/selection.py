@@ -1,34 +1,34 @@
 """Choosing the cause: BIC, a nesting test and a held-out check.
 
 Every candidate is fitted to the rows kept (outliers left out,
-:mod:`fepost.diagnose.robust`) by maximum likelihood (:mod:`fepost.diagnose.fitting`)
+`fepost.diagnose.robust`) by maximum likelihood (`fepost.diagnose.fitting`)
 and scored by the Bayesian information criterion BIC = −2ℓ + k ln(n_obs), with ℓ
 the Gaussian log-likelihood under the noise model of
-:mod:`fepost.diagnose.noise` (its parameters estimated with the model's),
+`fepost.diagnose.noise` (its parameters estimated with the model's),
 k = model parameters + noise parameters, n_obs = 3 × rows.
 
 A candidate other than ``none`` is **admissible** when, against every model
 nested in it (``none`` and, for the extensions, ``friction_level``; see
-:mod:`fepost.diagnose.causes`):
+`fepost.diagnose.causes`):
 
 1. its BIC is lower;
 2. the likelihood-ratio statistic 2Δℓ exceeds the χ² quantile with Δk degrees
-   of freedom at level :data:`ALPHA` = 0.05/9 (Bonferroni over the nine
+   of freedom at level `ALPHA` = 0.05/9 (Bonferroni over the nine
    extensions, so that on data with no effect the chance of naming any cause
    stays below 5 %; without the nesting test the richer of two nested models
    wins on AIC about one time in six, P(χ²₁ > 2) = 0.157);
 3. its mean held-out log predictive density per observation under
-   :data:`FOLDS`-fold cross-validation (noise parameters re-estimated on each
+   `FOLDS`-fold cross-validation (noise parameters re-estimated on each
    training set) is higher.
 
 ``none`` is always admissible. The cause is the admissible candidate of lowest
 BIC. Candidates are ranked admissible first, then by BIC.
 
 **Indistinguishable.** Admissible candidates that are not nested in one another
-and lie within :data:`INDISTINGUISHABLE_DBIC` = 10 of the winner's BIC (a
+and lie within `INDISTINGUISHABLE_DBIC` = 10 of the winner's BIC (a
 Bayes factor below e⁵ ≈ 150, "very strong" on the Kass–Raftery scale) are
 listed as ``indistinguishable``: the data support them about equally, and the
-output says so rather than pretending to know. :func:`design_notes` adds what the
+output says so rather than pretending to know. `design_notes` adds what the
 test programme itself cannot separate (e.g. no two absolute speeds at one ratio).
 """
 

@@ -1,8 +1,8 @@
 """The simulation that diagnose judges: FE pressure maps on a modest friction grid.
 
-:class:`Simulation` holds the static map (and optionally the rolling map) resampled
-onto :func:`~fepost.friction.quadrature.edge_grid` ``(nr, nphi)`` (default
-:data:`FIT_NR` × :data:`FIT_NPHI`), the nominal friction coefficient and the
+`Simulation` holds the static map (and optionally the rolling map) resampled
+onto `edge_grid` ``(nr, nphi)`` (default
+`FIT_NR` × `FIT_NPHI`), the nominal friction coefficient and the
 scales that make the channels dimensionless. Per test point the pressure map is
 
 * ``roll = 0``: the static map;
@@ -129,7 +129,7 @@ def simulation_from_maps(
     source: str = "",
     rolling_source: str = "",
 ) -> Simulation:
-    """A :class:`Simulation` from polar maps in the patch frame (centre = static centre of pressure)."""
+    """A `Simulation` from polar maps in the patch frame (centre = static centre of pressure)."""
     if not isinstance(static, PolarMap):
         raise ArgumentError(f"static must be a PolarMap, got {type(static).__name__}")
     if rolling is not None and not isinstance(rolling, PolarMap):
@@ -159,9 +159,9 @@ def load_simulation(
     nphi: int = FIT_NPHI,
     **analyse_kwargs,
 ) -> Simulation:
-    """A :class:`Simulation` from FE exports (paths or ContactFields) or PolarMaps.
+    """A `Simulation` from FE exports (paths or ContactFields) or PolarMaps.
 
-    ``analyse_kwargs`` go to :func:`fepost.analysis.analyse` (field, step, grid, ...).
+    ``analyse_kwargs`` go to `fepost.analysis.analyse` (field, step, grid, ...).
     """
     if isinstance(simulation, Simulation):
         return simulation

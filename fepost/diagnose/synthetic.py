@@ -1,21 +1,21 @@
 """Synthetic rig data with hidden effects, made by the exact integrals.
 
-:func:`rig_programme` lays out a realistic rig programme: several sliding
+`rig_programme` lays out a realistic rig programme: several sliding
 directions, several absolute speeds at the same speed ratios ε = |v|/(|ω|R),
 both spin signs, pure spin and pure sliding (optionally several loads and both
-rolling directions). :func:`synthesize` computes Fx, Fy, Mz at those points
-with :func:`~fepost.friction.exact.friction_resultants` on a fine quadrature of a
+rolling directions). `synthesize` computes Fx, Fy, Mz at those points
+with `friction_resultants` on a fine quadrature of a
 pressure map (48 × 96 nodes, four times the fit grid's), with one or several
-effects of :data:`fepost.diagnose.causes.CAUSES` hidden in it, and adds what rigs
+effects of `fepost.diagnose.causes.CAUSES` hidden in it, and adds what rigs
 add: Gaussian noise in % of each channel's range and/or of the reading, gross
 errors on a few rows (sign flips, 2.5× spikes), a friction level drifting along
 the run order (with an optional ``time`` column and the file sorted by test
-condition). :class:`StribeckLaw` is a speed law fepost does not fit (an
+condition). `StribeckLaw` is a speed law fepost does not fit (an
 exponential fall of friction with sliding speed).
 
 The effects are applied here independently of the diagnosis's own models:
-through :class:`~fepost.friction.law.FrictionLaw` for the friction laws,
-:meth:`~fepost.friction.quadrature.PressureQuadrature.stretched`/``shifted`` for
+through `FrictionLaw` for the friction laws,
+`stretched`/``shifted`` for
 the geometry, offsets added in N and N·m, crosstalk as the matrix C applied to
 the forces in SI, load transfer as a fixed point per distinct test point on the
 map moved by its own shift (``shifted``, one row at a time, where the diagnosis
@@ -211,7 +211,7 @@ class StribeckLaw(FrictionLaw):
 ALTERNATIVE_FORMS: dict[str, dict[str, float]] = {
     "speed_dependent_friction": {"stribeck_ratio": 1.0, "stribeck_speed": 1.0},
 }
-#: Gross errors of :func:`synthesize` (``outliers``): the row's three forces
+#: Gross errors of `synthesize` (``outliers``): the row's three forces
 #: multiplied by these, in turn (a sign flip, a 2.5× spike), as from a load-cell glitch.
 GLITCHES = (-1.0, 2.5)
 #: Seconds per test point of the ``time`` column (plus up to 5 s of jitter).
@@ -294,21 +294,21 @@ def synthesize(
 ) -> SyntheticData:
     """Rig data over ``static`` (and ``rolling``) maps with ``effect`` hidden in it.
 
-    ``effect``: one name of :data:`~fepost.diagnose.causes.CAUSES` or several
+    ``effect``: one name of `CAUSES` or several
     (a tuple, or names joined by ``+``); ``params`` gives their parameters (names
-    as in :data:`EFFECT_PARAMETERS`, or for ``speed_dependent_friction`` the
+    as in `EFFECT_PARAMETERS`, or for ``speed_dependent_friction`` the
     exponential form ``stribeck_ratio``, ``stribeck_speed`` of
-    :class:`StribeckLaw`; the friction level of every effect but
+    `StribeckLaw`; the friction level of every effect but
     ``friction_level`` is ``friction``).
 
     Noise: Gaussian, independent, with SD² = (``noise`` × range of the clean
     channel)² + (``noise_proportional`` × |clean value|)² (a load cell's error
     in % of full scale and in % of reading). ``outliers``: that many rows,
-    chosen at random, get a gross error (:data:`GLITCHES` in turn, on all three
+    chosen at random, get a gross error (`GLITCHES` in turn, on all three
     forces). ``drift``: the friction level changes by this fraction from the
     first measured point to the last, linearly in the run order (−0.1: it falls
     by 10 % as the tread warms). ``time_column``: the data get a ``time`` column
-    (:data:`SECONDS_PER_POINT` per point, in run order) and the rows are written
+    (`SECONDS_PER_POINT` per point, in run order) and the rows are written
     sorted by test condition instead of in run order, so only ``time`` shows the
     run order.
 

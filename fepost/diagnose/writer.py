@@ -1,7 +1,7 @@
 """Write a diagnosis folder atomically: diagnosis.json, summary.txt and PNG figures.
 
 Everything is written into a temporary folder beside ``out`` and moved into
-place only when all of it succeeded (:func:`fepost.output.staged_folder`); an
+place only when all of it succeeded (`fepost.output.staged_folder`); an
 existing non-empty ``out`` is replaced only with ``force``.
 """
 

@@ -1,14 +1,14 @@
 """Figures of the report: they only look at results, never compute the physics.
 
-* :mod:`.render` — Figures 1 and 2: static and rolling contact pressure as a 3-D
+* `.render` — Figures 1 and 2: static and rolling contact pressure as a 3-D
   surface over the FE patch (pyvista, off-screen).
-* :mod:`.section` — Figure 3: pressure along the x and y diameters, from the FE field.
-* :mod:`.patchplan` — the loaded region in plan with its outline circles and ellipse.
-* :mod:`.curves` — Figures 4–6: F∥, M_C and F⊥ against the speed ratio.
-* :mod:`.errormap` — the error of the closed forms over the kinematic sphere.
-* :mod:`.sweep` — a sweep's coefficients against load and against time.
-* :mod:`.theme` — the fixed window size, colours and fonts.
-* :mod:`.units` — how numbers and units are written (the report uses it too).
+* `.section` — Figure 3: pressure along the x and y diameters, from the FE field.
+* `.patchplan` — the loaded region in plan with its outline circles and ellipse.
+* `.curves` — Figures 4–6: F∥, M_C and F⊥ against the speed ratio.
+* `.errormap` — the error of the closed forms over the kinematic sphere.
+* `.sweep` — a sweep's coefficients against load and against time.
+* `.theme` — the fixed window size, colours and fonts.
+* `.units` — how numbers and units are written (the report uses it too).
 
 Every figure function takes data objects and an optional plotter or axes, returns
 the plotter or figure and never calls ``show()``.

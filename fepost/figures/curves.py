@@ -1,7 +1,7 @@
 """Figures 4–6: friction force and torque against the speed ratio.
 
 Each figure shows one quantity (F∥ against ψ = u/v, M_C and F⊥ against
-υ = v/u, with u = ω_z R) as plain arrays held in a :class:`CurveData`:
+υ = v/u, with u = ω_z R) as plain arrays held in a `CurveData`:
 
 * ``exact`` — the exact Coulomb integrals of the FE map,
 * ``closed_form`` — the paper's square-root approximation with the map's
@@ -11,13 +11,13 @@ Each figure shows one quantity (F∥ against ψ = u/v, M_C and F⊥ against
 * ``fit`` with ``band_lo`` … ``band_hi`` — the curve fitted to those points and
   its 95 % prediction band;
 * ``model`` — the generalised friction model built from the FE map
-  (:meth:`fepost.identify.GeneralisedCurves.curves`).
+  (`fepost.identify.GeneralisedCurves.curves`).
 
 Any of them but ``x`` and ``closed_form`` may be ``None``. The module computes
 nothing physical: the report assembles the arrays.
 
 Labels are plain text with subscripts written as ``M_C``, ``F_y``, ``ω_z``
-(and ``F_{xy}`` for longer ones); :func:`mathtext` turns them into matplotlib
+(and ``F_{xy}`` for longer ones); `mathtext` turns them into matplotlib
 mathtext, so they render as subscripts, not as literal underscores.
 """
 
@@ -124,7 +124,7 @@ class CurveData:
 def plot_curve(data: CurveData, ax=None):
     """Plot one of Figures 4–6; return the figure. Series carry ``gid`` =
     their field name so tests can find them. Title, axis labels and legend
-    entries go through :func:`mathtext`."""
+    entries go through `mathtext`."""
     import matplotlib.pyplot as plt
 
     lab = {

@@ -1,13 +1,13 @@
 """Error map: where over the kinematic sphere the friction models miss the exact integrals.
 
 Four panels: rows force (|ΔF|/F0) and torque (|ΔM_z|/M0), columns the models
-of an :class:`~fepost.friction.sphere.ErrorMap` (by default the paper's closed
+of an `ErrorMap` (by default the paper's closed
 forms and the generalised model); x the sliding direction β (0–180°), y the
 meridian coordinate t = (2/π)·atan ε, labelled in ε = |v|/(|ω_z| R) from pure
 spin (ε = 0) to pure sliding (ε = ∞). One logarithmic colour scale for all
 panels, so the panels compare honestly; a contour marks the 3 % goal and each
 panel's title gives its largest error. The module computes nothing physical:
-the data come from :func:`fepost.friction.sphere.error_map`
+the data come from `fepost.friction.sphere.error_map`
 (`fepost.friction.summary.model_error_map` for an FE map).
 """
 

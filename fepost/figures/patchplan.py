@@ -18,7 +18,7 @@ def circularity_verdict(patch: Patch) -> str:
 
 
 def verdict_title(patch: Patch) -> str:
-    """The figure's title: :func:`circularity_verdict` with the radii set as subscripts."""
+    """The figure's title: `circularity_verdict` with the radii set as subscripts."""
     word = "circular" if patch.circular else "NOT circular"
     return (
         f"Loaded region — {word}: aspect {patch.aspect:.3f}, "
@@ -31,7 +31,7 @@ def plot_patch_plan(patch: Patch, ax=None):
 
     Draws the FE triangles coloured by the FE pressure (Gouraud for nodal data,
     flat for face data), the contact edge (the contour where the pressure is
-    :data:`~fepost.figures.render.EDGE_FRACTION` of its peak), the r_max circle
+    `EDGE_FRACTION` of its peak), the r_max circle
     about the origin, the r_equiv circle (√(area/π)) about the area centroid,
     the fitted ellipse, the centre of pressure, and the circularity verdict in
     the title. The legend sits below the axes, clear of the data.

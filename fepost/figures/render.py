@@ -6,7 +6,7 @@ pressure, x the rolling direction, z the road normal) with lengths in m.
 Height = σ/P* (dimensionless, P* the inflation pressure) times a fixed scale;
 colour = σ in kPa, on a colour bar with round ticks.
 
-The surface is drawn where the pressure is at least :data:`EDGE_FRACTION` of
+The surface is drawn where the pressure is at least `EDGE_FRACTION` of
 its peak, cut along that contour of the FE field (linear on each triangle), and
 the contour is drawn at z = 0 as the edge of the contact: the FE faces' own
 outline is a staircase of element edges, and the faces beyond the contour carry
@@ -76,7 +76,7 @@ def check_pressure(inflation_pressure: float) -> float:
 def patch_mesh(
     patch: Patch, inflation_pressure: float = DEFAULT_INFLATION_PRESSURE, height_scale: float = 0.0
 ):
-    """The patch as :class:`pyvista.PolyData` in m.
+    """The patch as `pyvista.PolyData` in m.
 
     Points are (x, y, height_scale·σ/P*) in m (flat when ``height_scale`` = 0);
     arrays ``pressure_kPa`` and ``sigma_over_P`` live where the FE values live
@@ -101,7 +101,7 @@ def patch_mesh(
 
 def default_height_scale(*patches: Patch, inflation_pressure: float = DEFAULT_INFLATION_PRESSURE) -> float:
     """m of height per unit σ/P* so that the tallest of ``patches`` rises to
-    :data:`HEIGHT_FRACTION` × its r_max."""
+    `HEIGHT_FRACTION` × its r_max."""
     p_star = check_pressure(inflation_pressure)
     peak = max(float(np.max(p.node_values())) for p in patches) / p_star
     r = max(p.r_max for p in patches)
@@ -151,17 +151,17 @@ def pressure_surface(
     plotter : pyvista.Plotter, optional
         Draw into this plotter (default: a new off-screen one with fepost's theme).
     height_scale : float, optional
-        m of height per unit σ/P* (default :func:`default_height_scale`; give the
+        m of height per unit σ/P* (default `default_height_scale`; give the
         same value to Figures 1 and 2 so they compare).
     clim : (float, float), optional
         Colour range in kPa (default 0 … peak); the top is rounded up to a round
         tick of the colour bar.
     extent : float, optional
         Half-width in m of the square the axes frame, rounded up to a round value
-        (default :data:`EXTENT_FACTOR` × r_max; give Figures 1 and 2 the same value
+        (default `EXTENT_FACTOR` × r_max; give Figures 1 and 2 the same value
         so they compare).
 
-    The caller saves it with ``plotter.screenshot(path)``; :func:`layout`
+    The caller saves it with ``plotter.screenshot(path)``; `layout`
     gives the text actors, legend and surface it placed.
     """
     p_star = check_pressure(inflation_pressure)
@@ -346,7 +346,7 @@ def _add_axes(plotter, *, ext: float, z_range: float, z_step: float, hs: float, 
 
 @dataclass(frozen=True)
 class SurfaceLayout:
-    """What :func:`pressure_surface` placed, for checking the figure: the text actors
+    """What `pressure_surface` placed, for checking the figure: the text actors
     of the axes and labels, the heading, the legend and the drawn surface (m)."""
 
     texts: tuple
@@ -356,7 +356,7 @@ class SurfaceLayout:
 
 
 def layout(plotter) -> SurfaceLayout:
-    """The :class:`SurfaceLayout` of a plotter made by :func:`pressure_surface`."""
+    """The `SurfaceLayout` of a plotter made by `pressure_surface`."""
     found = getattr(plotter, "_fepost_layout", None)
     if found is None:
         raise ArgumentError("layout: the plotter was not made by pressure_surface")

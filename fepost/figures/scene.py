@@ -30,7 +30,7 @@ def nice_step(span: float, max_intervals: int = MAX_INTERVALS) -> float:
 
 
 def nice_ticks(lo: float, hi: float, max_intervals: int = MAX_INTERVALS) -> np.ndarray:
-    """Round tick values in [lo, hi] (multiples of :func:`nice_step`)."""
+    """Round tick values in [lo, hi] (multiples of `nice_step`)."""
     step = nice_step(hi - lo, max_intervals)
     first = np.ceil(lo / step - 1e-9)
     last = np.floor(hi / step + 1e-9)

@@ -3,7 +3,7 @@
 Renders must be reproducible pixel for pixel on one machine (the image
 regression tests compare them with stored baselines), so the pyvista figures use
 a theme built here rather than the user's global theme, a fixed window size and
-a fixed camera, and the matplotlib figures use :func:`mpl_style`.
+a fixed camera, and the matplotlib figures use `mpl_style`.
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ def use_headless_vtk() -> None:
 
 
 def pyvista_theme():
-    """A fresh :class:`pyvista.themes.DocumentTheme` with fepost's fixed settings."""
+    """A fresh `pyvista.themes.DocumentTheme` with fepost's fixed settings."""
     import pyvista as pv
 
     theme = pv.themes.DocumentTheme()

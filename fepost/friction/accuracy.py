@@ -6,9 +6,9 @@ exact resultants of a pressure map give the curves
     F∥/F0 = −F_x/F0,   M_C/M0 = −M_z/M0,   F⊥/(|k_x| M0/2R) = −sgn(k_x) F_y/(|k_x| M0/2R),
 
 which the closed forms approximate by 1/√(1 + a/υ²), 1/√(1 + mυ²) and
-1/√(1 + mυ²/4). :func:`approximation_error` reports the largest and the RMS
+1/√(1 + mυ²/4). `approximation_error` reports the largest and the RMS
 absolute difference on that υ grid (in units of F0, M0 and |k_x| M0/2R), once with
-the asymptotic a, m (:func:`~fepost.friction.closed_form.asymptotic_coefficients`)
+the asymptotic a, m (`asymptotic_coefficients`)
 and once with a fitted to the F∥ curve and m to the M_C curve by least squares.
 """
 
@@ -146,9 +146,9 @@ def approximation_error(
     """Errors of the closed forms against the exact integrals of ``quad`` (Coulomb, ``f``).
 
     Coefficients left as ``None`` come from the map: F0, M0, a, m from
-    :func:`~fepost.friction.closed_form.asymptotic_coefficients`, k_x from
-    :func:`rolling_shift`, R from ``quad.radius``. ``upsilon``: υ = v/u grid
-    (default :data:`DEFAULT_UPSILON`).
+    `asymptotic_coefficients`, k_x from
+    `rolling_shift`, R from ``quad.radius``. ``upsilon``: υ = v/u grid
+    (default `DEFAULT_UPSILON`).
     """
     ups = DEFAULT_UPSILON if upsilon is None else np.asarray(upsilon, float).ravel()
     if ups.size < 2 or not np.all(np.isfinite(ups)) or np.any(ups <= 0):

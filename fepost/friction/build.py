@@ -1,6 +1,6 @@
 """Build the generalised friction model of a pressure map (from the map alone).
 
-1. The base coefficients are pressure integrals (:mod:`fepost.friction.tensors`):
+1. The base coefficients are pressure integrals (`fepost.friction.tensors`):
 
    ===== ====================================== =====================================
    F0    f N                                    force at pure sliding (N)
@@ -14,7 +14,7 @@
    ===== ====================================== =====================================
 
 2. The correction C is fitted by linear least squares to the exact Coulomb
-   integrals (:func:`fepost.friction.exact.friction_resultants`) at the nodes of a
+   integrals (`fepost.friction.exact.friction_resultants`) at the nodes of a
    θ × t grid on the sphere (periodic trapezoid in θ, Gauss–Legendre in t), the
    rows scaled by F0 (forces) and M0 (torque): a discrete L² projection of the
    base model's error onto the basis. With α ≠ 1 a second fit does the same for
@@ -109,10 +109,10 @@ def build_model(
     ``radius``: R (m) of u = ω_z R (default ``quad.radius``; any R gives the same
     predictions, only the dimensionless coefficients change). ``order``: (K, L)
     of the correction ((2K + 1)·L numbers; the base alone is
-    :meth:`GeneralisedModel.without_correction`), or ``"auto"`` (default): the
-    first of :data:`AUTO_LADDER` whose check-grid error is within
-    :data:`AUTO_TARGET` (72 numbers up to aspect ~2.5, more beyond).
-    ``grid``: (θ nodes, t nodes) of the fit (default: :data:`FIT_GRID`, or the
+    `GeneralisedModel.without_correction`), or ``"auto"`` (default): the
+    first of `AUTO_LADDER` whose check-grid error is within
+    `AUTO_TARGET` (72 numbers up to aspect ~2.5, more beyond).
+    ``grid``: (θ nodes, t nodes) of the fit (default: `FIT_GRID`, or the
     ladder's). ``check``: measure the accuracy on a staggered grid (module
     docstring; always done with ``"auto"``). ``compare``: another model, a callable
     (vx, vy, wz) → (Fx, Fy, Mz) such as the paper's closed forms, whose errors the

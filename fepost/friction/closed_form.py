@@ -7,8 +7,8 @@ With u = ω_z R (m/s) and v = |v| (m/s):
     F⊥ = k_x (M0 / 2R) u / √(u² + (m/4) v²)    (N, lateral)
 
 Magnitudes are returned; the signs of the components on the tire follow from
-the exact integrals (:mod:`fepost.friction.exact`) and are applied by
-:func:`components`. :func:`asymptotic_coefficients` derives a and m of any
+the exact integrals (`fepost.friction.exact`) and are applied by
+`components`. `asymptotic_coefficients` derives a and m of any
 pressure map from the asymptotes of the exact integrals.
 """
 
@@ -67,7 +67,7 @@ def components(vx, vy, wz, *, F0: float, M0: float, a: float, m: float, k_x: flo
 
     ``vx``, ``vy``: sliding velocity of the patch origin (m/s); ``wz``: spin (rad/s);
     ``radius``: R (m), so u = |ω_z| R. Signs, derived from the Coulomb integrals and tested
-    against :func:`fepost.friction.exact.friction_resultants`:
+    against `fepost.friction.exact.friction_resultants`:
 
     - F∥ acts along −v̂ (Coulomb friction opposes sliding);
     - M_z = −sgn(ω_z)·M_C (the torque opposes the spin);
@@ -192,7 +192,7 @@ def _inverse_r_moment(quad: PressureQuadrature, nx: float, ny: float) -> float:
 def paper_coefficients(tensors, f: float, k_x: float = 0.0) -> dict[str, float]:
     """F0, M0, a, m of the paper's definitions for a map's pressure integrals.
 
-    ``tensors``: :class:`~fepost.friction.tensors.MapTensors` (R = ``tensors.radius``).
+    ``tensors``: `MapTensors` (R = ``tensors.radius``).
     With A⁰ = tr S/(2πR), A¹ = N/(2πR²), A² = ∬σ r dA/(2πR³), A³ = tr Q/(2πR⁴)
     (the angular means of the same integrals), √a = 2A¹/A⁰ and √m = 2A²/A³:
     a = (2N/(R tr S))², m = (2R ∬σ r dA/tr Q)². ``k_x`` is passed through.

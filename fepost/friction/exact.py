@@ -2,7 +2,7 @@
 
 For a patch sliding at (v_x, v_y) (m/s) and spinning at ω_z (rad/s) the tire
 point (x, y) slides at w = (v_x − ω_z y, v_y + ω_z x) and carries the traction
-τ = −μσ (ŵ_x, α ŵ_y) of :class:`~fepost.friction.law.FrictionLaw`. The
+τ = −μσ (ŵ_x, α ŵ_y) of `FrictionLaw`. The
 resultants on the tire are F = ∬ τ dA (N) and M_z = ∬ (x τ_y − y τ_x) dA (N·m)
 about the patch origin.
 
@@ -25,7 +25,7 @@ with ρ_max(θ) the distance from p0 to the domain boundary along θ:
 ρ_max is analytic and periodic, so the periodic trapezoid converges spectrally;
 its strip of analyticity narrows like √δ as p0 nears the boundary (δ = 1 − q,
 q the ellipse level of p0), and the number of θ nodes grows accordingly
-(:func:`_theta_nodes`). The subtraction is applied only when p0 is inside the
+(`_theta_nodes`). The subtraction is applied only when p0 is inside the
 domain (when it is outside, the integrand is smooth on the patch).
 """
 

@@ -29,7 +29,7 @@ from ..options import DEFAULT_FRICTION, check_friction
 
 def store_reals(obj, names: tuple[str, ...]) -> None:
     """Check that the fields ``names`` of the frozen dataclass ``obj`` are finite real
-    numbers and store them as floats; :class:`~fepost.errors.ArgumentError` naming the
+    numbers and store them as floats; `ArgumentError` naming the
     first that is not (a bool is not a number here)."""
     for name in names:
         value = getattr(obj, name)

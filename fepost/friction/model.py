@@ -29,7 +29,7 @@ Base, with F0 = f N (N), Û0 = M0/(F0 R), Q̂ (2×2), Ŝ (2×2), ĝ, x̂ (2-vect
   the torque at pure sliding of a map whose centre of pressure is off the
   origin, −f N x_c × v̂. Their blending factors leave the symmetric limits intact.
 
-Correction, for ω_z ≠ 0 (θ, t as in :mod:`fepost.friction.basis`, s = sgn ω_z,
+Correction, for ω_z ≠ 0 (θ, t as in `fepost.friction.basis`, s = sgn ω_z,
 ε = tan(πt/2), c = cos(πt/2) = |u|/√(u² + |v|²)):
 
     Û = t³ (1 − t)² Σ C[k, l] B_k(θ) T_l(2t − 1)          (dimensionless)
@@ -41,12 +41,12 @@ The weight t³(1 − t)² vanishes to third order at pure spin and to second ord
 at pure sliding (in ω_z/|v|), so the correction changes none of the limits
 above: the value and the first derivative of every resultant at both ends come
 from the base alone. C is computed by least squares against the exact
-integrals over the map on a grid of the sphere (:mod:`fepost.friction.build`).
+integrals over the map on a grid of the sphere (`fepost.friction.build`).
 
 Anisotropic friction (τ = −μσ (ŵ_x, α ŵ_y)) is not a gradient law; the model
 then scales F_y by α and adds (α − 1) G to M_z, with G = ∬ x τ_y dA of the
 isotropic law modelled directly (base with its exact limits, plus a correction
-with weight t²(1 − t)²), see :meth:`GeneralisedModel.lateral_moment`.
+with weight t²(1 − t)²), see `GeneralisedModel.lateral_moment`.
 """
 
 from __future__ import annotations
@@ -201,7 +201,7 @@ class GeneralisedModel:
         velocities ``vx``, ``vy`` (m/s) and spin ``wz`` (rad/s); arrays broadcast.
 
         No input checks beyond broadcasting (the fast path for time integration);
-        :meth:`resultants` checks its inputs. Same as ``evaluate(vx, vy, wz)``.
+        `resultants` checks its inputs. Same as ``evaluate(vx, vy, wz)``.
         """
         return self.evaluate(vx, vy, wz)
 
@@ -236,7 +236,7 @@ class GeneralisedModel:
         return kernel.coefficients(self)
 
     def resultants(self, vx, vy, wz) -> Resultants:
-        """:meth:`__call__` with checked inputs, as a :class:`~fepost.friction.exact.Resultants`."""
+        """`__call__` with checked inputs, as a `Resultants`."""
         vx, vy, wz, shape = checked_kinematics(vx, vy, wz)
         fx, fy, mz = self(vx, vy, wz)
         return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))
@@ -404,7 +404,7 @@ class GeneralisedModel:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> GeneralisedModel:
-        """Rebuild a model from :meth:`to_dict` output (a one-line error names a bad key)."""
+        """Rebuild a model from `to_dict` output (a one-line error names a bad key)."""
         if not isinstance(d, Mapping):
             raise DataError(f"model must be a JSON object, got {type(d).__name__}")
         if d.get("format") != FORMAT:

@@ -14,14 +14,14 @@ Output CSV, same rows in the same order: ``vx, vy, wz``, then ``Fx, Fy, Mz``
 
 * ``*_exact``: the exact Coulomb integrals over the FE map,
 * ``*_paper``: the paper's closed forms (1.3)/(1.7) with F0, M0, a, m (and k_x),
-* ``*_model``: the generalised model built from the map (:mod:`fepost.friction.build`).
+* ``*_model``: the generalised model built from the map (`fepost.friction.build`).
 
 With a rolling map the kinematics are those of the rolling tire: the exact
 integrals and the generalised model use the rolling map (in the static patch's
 frame), the closed forms add F⊥ with k_x. Without one, the static map and
-k_x = 0. The CSV is read by :mod:`fepost.csvtable`, as the measured data of
+k_x = 0. The CSV is read by `fepost.csvtable`, as the measured data of
 ``fepost diagnose`` are: every problem with it is a one-line
-:class:`~fepost.errors.DataError` naming the file, the line and the column.
+`DataError` naming the file, the line and the column.
 """
 
 from __future__ import annotations
@@ -106,7 +106,7 @@ class Prediction:
             object.__setattr__(self, name, frozen(getattr(self, name)))
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The output columns, in the order of :data:`OUTPUT_COLUMNS`."""
+        """The output columns, in the order of `OUTPUT_COLUMNS`."""
         out = {"vx": self.vx, "vy": self.vy, "wz": self.wz}
         for tag, res in (("exact", self.exact), ("paper", self.paper), ("model", self.generalised)):
             out[f"Fx_{tag}"], out[f"Fy_{tag}"], out[f"Mz_{tag}"] = res.Fx, res.Fy, res.Mz

@@ -1,16 +1,16 @@
 """A pressure field as a flat quadrature rule, ready for the friction integrals.
 
-:class:`PressureQuadrature` holds nodes (x, y) in the patch frame (m), their area
+`PressureQuadrature` holds nodes (x, y) in the patch frame (m), their area
 weights dA (m²), the pressure σ (Pa) at the nodes, the elliptic ``domain`` that the
 weights integrate over, and ``sigma_at(x, y)``, the pressure at arbitrary points.
 
 Invariant: the weights integrate over exactly ``domain`` (Σ g·dA ≈ ∬_domain g dA),
 and σ = 0 outside it. The exact friction integrals rely on this when they add the
 singular part at the instantaneous centre of rotation analytically over
-``domain`` (see :mod:`fepost.friction.exact`). :meth:`from_polar`, :meth:`stretched`
-and :meth:`shifted` preserve it.
+``domain`` (see `fepost.friction.exact`). `from_polar`, `stretched`
+and `shifted` preserve it.
 
-:func:`edge_grid` builds a polar grid whose radial rule is Gauss–Legendre in t
+`edge_grid` builds a polar grid whose radial rule is Gauss–Legendre in t
 with ρ = sin(πt/2). It integrates maps with a square-root edge, σ ∝ √(1 − ρ²)
 (Hertz), spectrally, where plain Gauss–Legendre in ρ converges only like nr⁻³.
 """
@@ -26,7 +26,7 @@ from .._arrays import frozen
 from ..errors import ArgumentError
 from ..polar import PolarGrid, PolarMap
 
-#: Default grid for the friction integrals (see :func:`edge_grid` and the README
+#: Default grid for the friction integrals (see `edge_grid` and the README
 #: of ``benchmarks/bench_friction.py``): 64 radial × 128 angular nodes, the
 #: smallest grid that meets 1e-4 of fN and M0 on every reference map there.
 FRICTION_NR = 64
@@ -34,7 +34,7 @@ FRICTION_NPHI = 128
 
 
 def edge_grid(nr: int = FRICTION_NR, nphi: int = FRICTION_NPHI) -> PolarGrid:
-    """A :class:`~fepost.polar.PolarGrid` with the radial substitution ρ = sin(πt/2).
+    """A `PolarGrid` with the radial substitution ρ = sin(πt/2).
 
     Gauss–Legendre nodes t_i, weights w_i on [0, 1]; ρ_i = sin(πt_i/2) and the
     radial weight w_i·(π/2)·cos(πt_i/2) = w_i·dρ/dt. Since √(1 − ρ²) = cos(πt/2),
@@ -120,7 +120,7 @@ class PressureQuadrature:
     """A pressure field as nodes, weights and values, with its integration domain.
 
     ``x``, ``y``: node coordinates in the patch frame (m); ``dA``: weights (m²);
-    ``sigma``: pressure at the nodes (Pa); ``domain``: the :class:`Ellipse` the
+    ``sigma``: pressure at the nodes (Pa); ``domain``: the `Ellipse` the
     weights integrate over (it holds the whole support); ``sigma_at(x, y)``: the
     pressure (Pa) at arbitrary points (m), 0 outside the support. Arrays are flat
     and read-only.
@@ -156,7 +156,7 @@ class PressureQuadrature:
     # -- constructors -------------------------------------------------------------
     @classmethod
     def from_polar(cls, pmap: PolarMap) -> PressureQuadrature:
-        """Nodes, weights and values of a :class:`~fepost.polar.PolarMap`.
+        """Nodes, weights and values of a `PolarMap`.
 
         The domain is the disc of radius ``pmap.radius`` about ``pmap.centre``;
         ``sigma_at`` is the map's bilinear (ρ, φ) interpolation.

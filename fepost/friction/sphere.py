@@ -12,8 +12,8 @@ Under Coulomb's law the resultants depend only on the direction of
 
 and measures, at each (β, t), the larger over the two spin signs of
 |ΔF|/F0 (Euclidean norm of the force difference) and |ΔM_z|/M0, for any number
-of models against the exact integrals. :class:`ErrorMap` holds the result;
-:func:`fepost.figures.errormap.plot_error_map` draws it.
+of models against the exact integrals. `ErrorMap` holds the result;
+`fepost.figures.errormap.plot_error_map` draws it.
 """
 
 from __future__ import annotations

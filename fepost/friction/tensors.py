@@ -23,10 +23,10 @@ domain, σ(0) + ∇σ(0)·p is subtracted from σ on the nodes and its integral 
 back exactly along rays from the origin (ρ_max(φ) the distance to the domain
 boundary): ∬ (σ0 + G·p) K(φ) r^k dA = ∫ K(φ) [σ0 ρ_max^{k+2}/(k+2) + (G·ê_r) ρ_max^{k+3}/(k+3)] dφ.
 This is the same subtraction the exact integrals use at the instantaneous centre
-of rotation (:mod:`fepost.friction.exact`); it keeps the integrals accurate on
+of rotation (`fepost.friction.exact`); it keeps the integrals accurate on
 quadratures not centred on the origin (shifted or rolling maps).
 
-:func:`effective_quadrature` folds a pressure-dependent friction coefficient into
+`effective_quadrature` folds a pressure-dependent friction coefficient into
 the pressure (μσ/f), so everything here holds for that law as well.
 """
 
@@ -111,7 +111,7 @@ def effective_quadrature(quad: PressureQuadrature, law: FrictionLaw) -> Pressure
 
     The identity when the law has no pressure dependence. A speed-dependent law has
     no such equivalent (its resultants depend on the speed, not only on the
-    direction of the kinematics): :class:`~fepost.errors.ArgumentError`.
+    direction of the kinematics): `ArgumentError`.
     """
     if not isinstance(quad, PressureQuadrature):
         raise ArgumentError(f"quad must be a PressureQuadrature, got {type(quad).__name__}")

@@ -12,14 +12,14 @@ least squares with 95 % bounds; f = F0/N.
 
 One module per job:
 
-* :mod:`~fepost.identify.curves`: the test curves (:class:`TestCurves`,
-  :func:`make_test_curves`, :func:`exact_curves`, :func:`with_noise`);
-* :mod:`~fepost.identify.forms`: what is fitted to them: the paper's closed
-  forms (:func:`curve_model`) or the generalised model (:class:`GeneralisedCurves`);
-* :mod:`~fepost.identify.fit`: the fit and its intervals (:func:`fit_table1`);
-* :mod:`~fepost.identify.result`: what it returns (:class:`Identification`);
-* :mod:`~fepost.identify.bias`: what the closed forms' own error does to the fit
-  (:func:`approximation_bias`, :class:`BiasReport`, residual tests).
+* `curves`: the test curves (`TestCurves`,
+  `make_test_curves`, `exact_curves`, `with_noise`);
+* `forms`: what is fitted to them: the paper's closed
+  forms (`curve_model`) or the generalised model (`GeneralisedCurves`);
+* `fit`: the fit and its intervals (`fit_table1`);
+* `result`: what it returns (`Identification`);
+* `bias`: what the closed forms' own error does to the fit
+  (`approximation_bias`, `BiasReport`, residual tests).
 """
 
 from .bias import BiasReport, approximation_bias, lag1_autocorrelation, runs_test

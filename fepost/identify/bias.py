@@ -1,6 +1,6 @@
 """How the closed forms fit exact-integral data: the bias the approximation itself causes.
 
-:func:`approximation_bias` fits the paper's closed forms to noise-free and to
+`approximation_bias` fits the paper's closed forms to noise-free and to
 noisy curves made from the exact integrals, and measures the structure left in
 the residuals (lag-1 autocorrelation, Wald–Wolfowitz runs test).
 """
@@ -121,7 +121,7 @@ def approximation_bias(
 ) -> BiasReport:
     """Fit the closed forms to exact-integral curves and measure the bias and structure.
 
-    Same arguments as :func:`make_test_curves` with ``source="exact"``. The noise-free
+    Same arguments as `make_test_curves` with ``source="exact"``. The noise-free
     fit gives the bias of a, m (and F0, M0, k_x) against their asymptotic values; the
     noisy fit shows whether the paper's 20 % noise would hide it.
     """

@@ -1,10 +1,10 @@
 """Identification data: the three friction curves of Table 1, measured or synthetic.
 
-:class:`TestCurves` holds F∥ against ψ = u/v and M_C, F⊥ against υ = v/u
-(u = ω_z R, v = |v|). :func:`make_test_curves` makes them as the paper does
+`TestCurves` holds F∥ against ψ = u/v and M_C, F⊥ against υ = v/u
+(u = ω_z R, v = |v|). `make_test_curves` makes them as the paper does
 (its closed forms (1.8) plus noise of amplitude 0.2·max of each curve) or from
 the exact Coulomb integrals over a pressure map (the ground truth);
-:func:`exact_curves` gives the noise-free exact curves.
+`exact_curves` gives the noise-free exact curves.
 """
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ class TestCurves:
     the patch radius of u = ω_z R. Synthetic curves also carry the noise-free
     values (``*_true``), the coefficients they were made from (``truth``), their
     ``source`` (``"closed_form"`` or ``"exact"``) and a description of the ``noise``.
-    Arrays are read-only; non-finite values raise :class:`~fepost.errors.DataError`.
+    Arrays are read-only; non-finite values raise `DataError`.
     """
 
     __test__ = False  # not a pytest test class
@@ -107,7 +107,7 @@ class TestCurves:
         return self.psi.size + 2 * self.upsilon.size
 
     def data(self, name: str) -> tuple[np.ndarray, np.ndarray]:
-        """(abscissa, values) of curve ``name`` (one of :data:`CURVES`)."""
+        """(abscissa, values) of curve ``name`` (one of `CURVES`)."""
         if name not in CURVES:
             raise ArgumentError(f"name must be one of {', '.join(CURVES)}, got {name!r}")
         return (self.psi if name == "f_parallel" else self.upsilon), getattr(self, name)
@@ -262,7 +262,7 @@ def make_test_curves(
     ``coefficients``) or ``"exact"`` (the exact integrals on ``quad``, the static
     map, and for F⊥ on ``rolling_quad``, or, when that is None, on the rolling
     model σ0(1 + k_x x/R) of ``quad``; f = F0/N).
-    ``coefficients``: a :class:`~fepost.coefficients.Coefficients` or a mapping with
+    ``coefficients``: a `Coefficients` or a mapping with
     F0 (N), M0 (N·m), a, m, k_x (R-based, dimensionless), R (m), N (N).
     Grids: ψ and υ = ``n_points`` equally spaced values on [0, ``span``].
     ``noise``: ``"uniform"`` on [−A, A] (the paper's) or ``"gaussian"`` with the
@@ -323,7 +323,7 @@ def with_noise(
 ) -> TestCurves:
     """``curves`` with fresh seeded noise added to their noise-free values (``*_true``).
 
-    The noise of :func:`make_test_curves` (which calls this): ``"uniform"`` on
+    The noise of `make_test_curves` (which calls this): ``"uniform"`` on
     [−A, A] or ``"gaussian"`` with standard deviation A/√3, A = ``amplitude``·max|curve|,
     drawn F∥, M_C, F⊥ in turn from ``numpy.random.default_rng(seed)``. Lets a
     Monte-Carlo study integrate the exact curves once.

@@ -2,7 +2,7 @@
 
 Statistics (all from scipy; nothing hand-rolled in the fit)
 -----------------------------------------------------------
-* Solver: :func:`scipy.optimize.least_squares` (MINPACK Levenberg–Marquardt) with
+* Solver: `scipy.optimize.least_squares` (MINPACK Levenberg–Marquardt) with
   the form's Jacobian, in the parameters θ = (F0/s_F, M0/s_M, ln a, ln m, k_x):
   s_F, s_M are the data scales (max |F∥|, max |M_C|), so θ is O(1), and ln a,
   ln m keep a, m > 0 and make their Wald intervals follow the skew of the
@@ -13,25 +13,25 @@ Statistics (all from scipy; nothing hand-rolled in the fit)
   matrix H = J(JᵀJ)⁻¹Jᵀ of the weighted Jacobian that falls on curve c (the
   parameters the curve "uses up"; Σ_c h_c = p). This is the unbiased estimator
   of each σ_c² in the linearised model. Fit and σ_c are iterated to a fixed point
-  (:data:`REWEIGHT_RTOL`, at most :data:`REWEIGHT_MAX` refits).
-* Covariance: as in :func:`scipy.optimize.curve_fit` with ``absolute_sigma=False``:
+  (`REWEIGHT_RTOL`, at most `REWEIGHT_MAX` refits).
+* Covariance: as in `scipy.optimize.curve_fit` with ``absolute_sigma=False``:
   pcov = s²·(JᵀJ)⁻¹ from the SVD of J, s² = χ²/(n − p). A singular value below
-  eps·max(J.shape)·s_max, or a condition number above :data:`COND_MAX`, makes the
-  covariance indeterminate: a :class:`~fepost.errors.FitWarning` naming the
+  eps·max(J.shape)·s_max, or a condition number above `COND_MAX`, makes the
+  covariance indeterminate: a `FitWarning` naming the
   unidentifiable parameter, and NaN intervals (never a silently wrong interval).
 * Wald 95 % bounds: θ̂ ± t_{0.975, n−p}·se(θ̂), mapped to F0, M0, a, m, k_x.
   f = F0/N with N known exactly, so its bounds are those of F0 divided by N.
 * Profile-likelihood 95 % bounds for a and m: θ_j fixed, the others re-fitted
   (same weights), bounds where χ²_prof(θ_j) − χ²_min = s²·t²_{0.975, n−p}
   (the F(1, n − p) test). Flagged when an end differs from the Wald end by more
-  than :data:`PROFILE_TOLERANCE` of the Wald half-width.
-* Curves: :meth:`Identification.prediction_band` gives the fitted curve with its
+  than `PROFILE_TOLERANCE` of the Wald half-width.
+* Curves: `Identification.prediction_band` gives the fitted curve with its
   pointwise 95 % *prediction* band ŷ ± t·√(gᵀΣg + s²σ_c²) (parameter covariance
   through the form's Jacobian g, plus the curve's noise level);
-  :meth:`Identification.curve_stderr` the standard error √(gᵀΣg) of the mean curve.
+  `Identification.curve_stderr` the standard error √(gᵀΣg) of the mean curve.
 
 The form is the paper's closed forms by default, or the generalised model
-(:class:`~fepost.identify.forms.GeneralisedCurves`).
+(`GeneralisedCurves`).
 
 Why scipy and not lmfit: the fit needs the weighted Jacobian itself (its SVD for
 the covariance and the condition check, its hat matrix for each curve's share
@@ -344,13 +344,13 @@ def fit_table1(
     """Fit F0, M0, a, m, k_x jointly to the three curves; f = F0/N (N in N).
 
     See the module docstring for the method (weights, covariance, intervals).
-    ``form``: the curves fitted: the paper's closed forms (default, :data:`PAPER`)
-    or a :class:`~fepost.identify.forms.GeneralisedCurves`.
+    ``form``: the curves fitted: the paper's closed forms (default, `PAPER`)
+    or a `GeneralisedCurves`.
     ``profile``: also compute profile-likelihood bounds of a and m.
     ``max_nfev``: cap on model evaluations per least-squares solve.
-    Raises :class:`~fepost.errors.FitError` when the solver does not converge and
-    :class:`~fepost.errors.DataError` for too few points; warns
-    :class:`~fepost.errors.FitWarning` (with NaN intervals) when the covariance is
+    Raises `FitError` when the solver does not converge and
+    `DataError` for too few points; warns
+    `FitWarning` (with NaN intervals) when the covariance is
     indeterminate.
 
     Examples

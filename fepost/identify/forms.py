@@ -1,11 +1,11 @@
 """The curve forms fitted to the test curves, with their gradients in the parameters.
 
 Both take the parameters (F0 (N), M0 (N·m), a, m, k_x) in the order of
-:data:`~fepost.identify.curves.PARAMETERS` and return a curve and its gradient:
+`PARAMETERS` and return a curve and its gradient:
 
-* :func:`curve_model`: the paper's closed forms (1.8), analytic gradient;
-* :class:`GeneralisedCurves`: the generalised friction model
-  (:mod:`fepost.friction.model`) restricted to the test kinematics (sliding
+* `curve_model`: the paper's closed forms (1.8), analytic gradient;
+* `GeneralisedCurves`: the generalised friction model
+  (`fepost.friction.model`) restricted to the test kinematics (sliding
   along x), with F0, M0, a = a(0°), m = m(0°) and k_x substituted into the model
   built from the FE maps; its shape beyond those five numbers (the off-axis
   tensors and the fitted correction) stays the map's. Gradient by central
@@ -28,7 +28,7 @@ from .curves import CURVES, PARAMETERS
 def curve_model(name: str, x, values, R: float) -> tuple[np.ndarray, np.ndarray]:
     """Closed-form curve ``name`` at ``x`` and its gradient in the parameters.
 
-    ``values``: (F0 (N), M0 (N·m), a, m, k_x), the order of :data:`PARAMETERS`;
+    ``values``: (F0 (N), M0 (N·m), a, m, k_x), the order of `PARAMETERS`;
     ``x``: ψ for ``"f_parallel"``, υ for ``"torque"`` and ``"f_perp"``; ``R`` (m).
     Returns y (N, N·m or N; shape of ``x``) and ∂y/∂(F0, M0, a, m, k_x) (shape of
     ``x`` + (5,)), analytic:
@@ -81,10 +81,10 @@ class PaperCurves:
         return "PaperCurves()"
 
 
-#: The default form of :func:`~fepost.identify.fit.fit_table1`.
+#: The default form of `fit_table1`.
 PAPER = PaperCurves()
 
-#: Relative step of the central differences of :class:`GeneralisedCurves`
+#: Relative step of the central differences of `GeneralisedCurves`
 #: (the model is smooth in its coefficients; truncation ~h², round-off ~eps/h).
 FD_STEP = 1e-6
 
@@ -199,7 +199,7 @@ class GeneralisedCurves:
         return y, grad
 
     def curves(self, x) -> dict[str, np.ndarray]:
-        """The three curves at the FE maps' own values (:meth:`theory`), for Figures 4–6:
+        """The three curves at the FE maps' own values (`theory`), for Figures 4–6:
         F∥ (N) at ψ = ``x``, M_C (N·m) and F⊥ (N) at υ = ``x``."""
         th = self.theory()
         values = [th[p] for p in PARAMETERS]

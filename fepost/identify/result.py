@@ -21,13 +21,13 @@ CONFIDENCE = 0.95
 
 @dataclass(frozen=True)
 class Identification:
-    """Result of :func:`fit_table1`: the five fitted coefficients with 95 % bounds.
+    """Result of `fit_table1`: the five fitted coefficients with 95 % bounds.
 
-    ``values``, ``stderr``: F0 (N), M0 (N·m), a, m, k_x (order :data:`PARAMETERS`);
+    ``values``, ``stderr``: F0 (N), M0 (N·m), a, m, k_x (order `PARAMETERS`);
     ``ci95`` (5, 2): Wald bounds from the t-quantile (NaN when the covariance is
     indeterminate); ``covariance`` (5, 5) in those units (delta method for a, m);
     ``profile_ci95``: profile-likelihood bounds of a and m, and ``profile_agrees``
-    whether they match the Wald bounds within :data:`PROFILE_TOLERANCE`;
+    whether they match the Wald bounds within `PROFILE_TOLERANCE`;
     ``f``, ``f_ci95``: F0/N; ``N`` (N); ``noise_sigma``: estimated noise level σ_c
     of each curve (its units); ``dof_share``: h_c, the parameters each curve uses;
     ``residuals``: data − model per curve (its units); ``chi2`` (weighted), ``dof``,
@@ -76,11 +76,11 @@ class Identification:
         return self.names.index(name)
 
     def value(self, name: str) -> float:
-        """Fitted value of ``name`` (``"f"`` or one of :data:`PARAMETERS`)."""
+        """Fitted value of ``name`` (``"f"`` or one of `PARAMETERS`)."""
         return self.f if name == "f" else float(self.values[self._index(name)])
 
     def interval(self, name: str) -> tuple[float, float]:
-        """Wald 95 % bounds of ``name`` (``"f"`` or one of :data:`PARAMETERS`)."""
+        """Wald 95 % bounds of ``name`` (``"f"`` or one of `PARAMETERS`)."""
         if name == "f":
             return self.f_ci95
         lo, hi = self.ci95[self._index(name)]
@@ -94,7 +94,7 @@ class Identification:
             return frozen(self.covariance / np.outer(sd, sd))
 
     def curve(self, name: str, x) -> np.ndarray:
-        """Fitted closed-form curve ``name`` (one of :data:`CURVES`) at ``x`` (ψ or υ).
+        """Fitted closed-form curve ``name`` (one of `CURVES`) at ``x`` (ψ or υ).
 
         Units: N for ``"f_parallel"`` and ``"f_perp"``, N·m for ``"torque"``.
         """
@@ -104,7 +104,7 @@ class Identification:
         """Standard error of the fitted curve at ``x``: √(gᵀΣg) (units of the curve).
 
         g = ∂ŷ/∂(F0, M0, a, m, k_x) (the form's gradient) and Σ =
-        :attr:`covariance` (delta method, linearised about the fit). This is the
+        `covariance` (delta method, linearised about the fit). This is the
         uncertainty of the *mean* curve; ± t·curve_stderr is its confidence band.
         NaN when the covariance is indeterminate.
         """
@@ -122,15 +122,15 @@ class Identification:
         pointwise (not simultaneously over x). Half-width t·√(gᵀΣg + s²σ_c²):
 
         * gᵀΣg, the parameter uncertainty propagated through the Jacobian g =
-          ∂ŷ/∂(F0, M0, a, m, k_x) with the fit's covariance Σ (:meth:`curve_stderr`);
+          ∂ŷ/∂(F0, M0, a, m, k_x) with the fit's covariance Σ (`curve_stderr`);
         * s²σ_c², the noise variance of one measurement of curve c: σ_c from
-          :attr:`noise_sigma`, s² = :attr:`redchi` (the scale of the covariance,
+          `noise_sigma`, s² = `redchi` (the scale of the covariance,
           which is 1 at the fixed point of the reweighting);
         * t = Student-t quantile (1 + level)/2 with ν_c = n_c − h_c degrees of
-          freedom, those of the σ_c estimate (n_c points, h_c = :attr:`dof_share`).
+          freedom, those of the σ_c estimate (n_c points, h_c = `dof_share`).
           The noise term dominates the variance; the Welch–Satterthwaite degrees
-          of freedom of the sum lie between ν_c and :attr:`dof`, so using ν_c errs
-          on the wide side (with :attr:`dof` instead, a band at 50 points per curve
+          of freedom of the sum lie between ν_c and `dof`, so using ν_c errs
+          on the wide side (with `dof` instead, a band at 50 points per curve
           covers about 94.5 % rather than 95 %).
 
         For one curve with known shape and Gaussian noise this is the textbook

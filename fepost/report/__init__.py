@@ -1,6 +1,6 @@
 """The report: every figure, the coefficients and Table 1 in one folder (``fepost report``).
 
-:func:`build_report` runs the pipeline on a static (and optionally a rolling) FE
+`build_report` runs the pipeline on a static (and optionally a rolling) FE
 map and writes into ``out``:
 
 ==============================  ====================================================
@@ -17,40 +17,40 @@ map and writes into ``out``:
 ``error_map.*``                 error of the closed forms and of the generalised
                                 model over the kinematic sphere (PNG, SVG, PDF;
                                 ``error_map_rolling.*`` with a rolling map)
-``error_map.json``              :meth:`fepost.friction.sphere.ErrorMap.to_dict`
+``error_map.json``              `fepost.friction.sphere.ErrorMap.to_dict`
                                 of that map (``error_map_rolling.json``)
-``coefficients.json``           :meth:`fepost.analysis.Analysis.to_dict`
-``table1.json``                 :meth:`fepost.table1.Table1.to_dict` (``rows`` of
+``coefficients.json``           `fepost.analysis.Analysis.to_dict`
+``table1.json``                 `fepost.table1.Table1.to_dict` (``rows`` of
                                 name, theory, fitted, ci95)
-``closed_form_vs_exact.json``   :meth:`FrictionCurves.errors_dict`: largest gap
+``closed_form_vs_exact.json``   `FrictionCurves.errors_dict`: largest gap
                                 between the closed forms and the exact integrals
 ``curves.csv``                  the curves of Figures 4–6 in long form
 ``static_map.vtu``              the polar maps, patches and outlines as VTK files
-``static_patch.vtp``            for ParaView (:mod:`fepost.report.vtkfiles`; and
+``static_patch.vtp``            for ParaView (`fepost.report.vtkfiles`; and
 ``static_outline.vtp``          ``rolling_*`` with a rolling map)
 ``sweep/``                      the optional sections' files: the load sweep of the
-                                sample tire in its report (:mod:`.sections`)
+                                sample tire in its report (`.sections`)
 ==============================  ====================================================
 
 Everything is written into a temporary folder beside ``out`` and moved into
-place only when every step succeeded (:func:`fepost.output.staged_folder`).
+place only when every step succeeded (`fepost.output.staged_folder`).
 
-Table 1 is :func:`fepost.table1.table1` with its defaults (the same call as
+Table 1 is `fepost.table1.table1` with its defaults (the same call as
 ``fepost table1``, so ``table1.json`` equals ``fepost table1 --json`` on the same
-inputs and seed, default :data:`fepost.table1.DEFAULT_SEED`): the closed-form
+inputs and seed, default `fepost.table1.DEFAULT_SEED`): the closed-form
 curves (1.8) with the map's coefficients, 20 % uniform noise, a joint
 least-squares fit, and the same fit on exact-integral data for the bias of the
 approximation. Figures 4–6 show its test points and fitted curves with their
-95 % prediction band (:meth:`fepost.identify.Identification.prediction_band`),
+95 % prediction band (`fepost.identify.Identification.prediction_band`),
 and the generalised model of the FE maps (Table 1's generalised form).
 
-The subpackage, by job: :mod:`.assemble` (the data the page shows),
-:mod:`.figures` (saving and embedding figures), :mod:`.vtkfiles` (VTK output),
-:mod:`.sections` (what an optional section is), :mod:`.providers` (the sections
-the report registers), :mod:`.sweepsection` (a sweep as a section),
-:mod:`.sweeppage` and :mod:`.sweepembed` (a sweep's trends page and its
-embeddable HTML section), :mod:`.html` (the Jinja2 templates in
-``templates/``), :mod:`.build` (the steps), :mod:`.samples` (the default inputs).
+The subpackage, by job: `.assemble` (the data the page shows),
+`.figures` (saving and embedding figures), `.vtkfiles` (VTK output),
+`.sections` (what an optional section is), `.providers` (the sections
+the report registers), `.sweepsection` (a sweep as a section),
+`.sweeppage` and `.sweepembed` (a sweep's trends page and its
+embeddable HTML section), `.html` (the Jinja2 templates in
+``templates/``), `.build` (the steps), `.samples` (the default inputs).
 Names are imported on first use, so ``import fepost.report`` stays cheap.
 """
 

@@ -1,7 +1,7 @@
 """Assembling the report's data: P*, the curves of Figures 4–6, the page's context.
 
-Nothing here draws or writes: :func:`friction_curves` computes the arrays the
-curve figures plot, :func:`page_context` gathers every value the HTML template
+Nothing here draws or writes: `friction_curves` computes the arrays the
+curve figures plot, `page_context` gathers every value the HTML template
 shows (from the JSON documents written beside it, so page and files agree).
 """
 
@@ -73,7 +73,7 @@ def resolve_inflation_pressure(option: float | None, analysis: Analysis) -> tupl
 class FrictionCurves:
     """The curves of Figures 4–6 and how far the closed forms lie from the exact integrals.
 
-    ``curves``: one :class:`~fepost.figures.curves.CurveData` per figure (F∥, M_C and,
+    ``curves``: one `CurveData` per figure (F∥, M_C and,
     with a rolling map, F⊥); ``errors``: per curve, the largest |exact − closed form|
     relative to the curve's scale (``max_abs_relative``), where (``at``, ψ or υ) and
     the scale (N or N·m).
@@ -98,13 +98,13 @@ class FrictionCurves:
 def friction_curves(analysis: Analysis, table: Table1) -> FrictionCurves:
     """Assemble the arrays of Figures 4–6 from the analysis and its Table 1.
 
-    Dense curves on :data:`CURVE_POINTS` values of ψ, υ in [0, ``table.span``]: the
+    Dense curves on `CURVE_POINTS` values of ψ, υ in [0, ``table.span``]: the
     exact Coulomb integrals over the static map (F∥, M_C) and the rolling map (F⊥);
     the closed forms (1.8) with the theoretical coefficients of ``table``; the
     generalised model built from the FE maps (``table.generalised.form``, at the
     maps' own coefficients; absent when ``table`` has no generalised rows); the
     fitted curves with their 95 % prediction band
-    (:meth:`fepost.identify.Identification.prediction_band`); and the noisy test
+    (`fepost.identify.Identification.prediction_band`); and the noisy test
     points of ``table.curves``. Figure 6 only with a rolling map.
 
     ``errors[curve]`` holds the closed form's largest gap (``max_abs_relative``,
@@ -336,7 +336,7 @@ def _dig(doc: Any, dotted: str) -> Any:
 
 
 def model_rows(coef: Mapping[str, Any]) -> list[dict]:
-    """Rows of the generalised model (:data:`MODEL_ROWS`) present in ``coef["model"]``."""
+    """Rows of the generalised model (`MODEL_ROWS`) present in ``coef["model"]``."""
     model = coef.get("model")
     if not model:
         return []

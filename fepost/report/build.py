@@ -113,7 +113,7 @@ def inflation_pressure_of(option: float | None, a) -> tuple[float, str]:
 
 @dataclass(frozen=True)
 class ReportResult:
-    """What :func:`build_report` wrote: the folder, its files and the time per step (s)."""
+    """What `build_report` wrote: the folder, its files and the time per step (s)."""
 
     out: Path
     files: tuple[str, ...]

@@ -1,7 +1,7 @@
 """Saving the report's figures: files beside the HTML and the same bytes embedded in it.
 
 Every figure is written as PNG (and the matplotlib ones also as SVG and PDF);
-:class:`Figure` records the files and carries the PNG as a ``data:`` URI, so
+`Figure` records the files and carries the PNG as a ``data:`` URI, so
 ``report.html`` shows every image without the files beside it.
 """
 

@@ -3,9 +3,9 @@
 The page is ``templates/report.html.j2`` (layout, prose, tables) with the style
 sheet ``templates/style.css`` inlined and the figures embedded as ``data:``
 URIs, so the one file shows everything. Values are autoescaped; a number cell
-made by :func:`cell` carries the exact JSON value and its dotted key
+made by `cell` carries the exact JSON value and its dotted key
 (``data-key``, ``data-value``) so the page can be checked against the JSON.
-Optional sections (:mod:`fepost.report.sections`) render their own template
+Optional sections (`fepost.report.sections`) render their own template
 from ``templates/sections/``.
 """
 
@@ -32,7 +32,7 @@ def cell(value, key: str | None = None, fmt: str = "{:.6g}", scale: float = 1.0)
 
 
 def tagged(value, key: str, fmt: str = "{:.5g}", scale: float = 1.0) -> Markup:
-    """An inline ``<span>`` like :func:`cell` (for two numbers in one cell)."""
+    """An inline ``<span>`` like `cell` (for two numbers in one cell)."""
     v = float(value)
     return Markup('<span data-key="{}" data-value="{}">{}</span>').format(
         key, repr(v), units.number(v * scale, fmt)
@@ -65,7 +65,7 @@ def environment():
 
 
 def render_report(context: dict) -> str:
-    """The HTML text of the report for ``context`` (see :func:`fepost.report.assemble.page_context`)."""
+    """The HTML text of the report for ``context`` (see `fepost.report.assemble.page_context`)."""
     env = environment()
     css = env.loader.get_source(env, "style.css")[0]  # type: ignore[union-attr]
     return env.get_template("report.html.j2").render(css=Markup(css), **context)

@@ -1,7 +1,7 @@
 """The sample FE exports the report uses when it is given no inputs.
 
 The one place that names them: ``fepost report`` without inputs, ``make demo``
-and the documentation's examples all go through :func:`sample_inputs`. They are
+and the documentation's examples all go through `sample_inputs`. They are
 the aircraft main-gear tire of ``meshes/aircraft/`` (46×17R20 size class,
 1.38 MPa) at its rated load, static and rolling; ``meshes/README.md`` describes
 the model. The small stand-in tire (``meshes/static.vtu``, ``rolling.vtu``,
@@ -26,7 +26,7 @@ def meshes_folder() -> Path:
 
 
 def sample_inputs() -> tuple[Path, Path | None]:
-    """(static, rolling) sample paths; a one-line :class:`ArgumentError` when one is missing."""
+    """(static, rolling) sample paths; a one-line `ArgumentError` when one is missing."""
     paths: list[Path | None] = []
     for name in (SAMPLE_STATIC, SAMPLE_ROLLING):
         if name is None:

@@ -1,15 +1,15 @@
 """Optional sections of the report: shown only when their data exist.
 
 A section provider is a function ``provider(data, folder) -> Section | None``:
-it gets the :class:`ReportData` (the analysis, Table 1, the friction curves,
+it gets the `ReportData` (the analysis, Table 1, the friction curves,
 P*, ...) and the folder being written (to save figures or tables into), and
-returns a :class:`Section`, or ``None`` when it has nothing to show (then the
+returns a `Section`, or ``None`` when it has nothing to show (then the
 report has no trace of it). This module knows no provider: the report
 registers the ones it runs, in page order, in ``fepost.report.providers``
 (``DEFAULT_SECTIONS``); they come after the friction curves.
 
 A section renders ``templates/sections/<template>`` with the names ``section``
-(the :class:`Section`) and ``figure`` (the figure macro) in scope; the generic
+(the `Section`) and ``figure`` (the figure macro) in scope; the generic
 template ``generic.html.j2`` shows ``section.paragraphs`` (plain text),
 ``section.table`` (a header row and rows of plain values) and
 ``section.figures`` (each with ``section.captions[figure.key]``).

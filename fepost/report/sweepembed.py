@@ -1,6 +1,6 @@
 """A sweep as a section of another page (the report): run it, draw it, return the HTML.
 
-:func:`sweep_report_section` is the one call a report needs: it runs the sweep
+`sweep_report_section` is the one call a report needs: it runs the sweep
 of ``inputs`` into ``folder/<href>/`` (table files and figures, no work
 folder left behind) on a small in-process Dask cluster and returns the HTML
 section with the files it wrote.
@@ -35,14 +35,14 @@ def sweep_report_section(
     Parameters
     ----------
     inputs : sequence of paths, folders or glob patterns
-        The sweep's FE exports (see :func:`fepost.sweep.run_sweep`).
+        The sweep's FE exports (see `fepost.sweep.run_sweep`).
     folder : path
         The page's folder; the sweep writes ``folder/href/coefficients.csv``,
         ``coefficients.parquet`` and its figures there.
     href : str
         Sub-folder name, also the relative URL prefix of the figures.
     rolling_pairs, heading_level, title
-        As in :func:`~fepost.sweep.run_sweep` and :func:`~fepost.sweep.sweep_section`.
+        As in `run_sweep` and `sweep_section`.
     workers, processes, client
         Where the rows run: by default one worker thread in this process
         (starts in well under a second; right for the few small sample files).

@@ -2,7 +2,7 @@
 
 HTML comes from Jinja2 templates kept as files in ``fepost/report/templates/sweep/``:
 ``section.html.j2`` (figures, power-law fits, the table) is what
-:func:`sweep_section` returns for embedding in another page (the report);
+`sweep_section` returns for embedding in another page (the report);
 ``trends.html.j2`` wraps it into a standalone page.
 """
 
@@ -137,8 +137,8 @@ def sweep_section(
     Parameters
     ----------
     rows : sequence of mappings
-        The sweep table (:attr:`SweepResult.rows` or
-        :func:`fepost.sweep.table.read_table` of ``coefficients.parquet``).
+        The sweep table (`SweepResult.rows` or
+        `fepost.sweep.table.read_table` of ``coefficients.parquet``).
     figure_dir : path
         Folder the figures are drawn into (created).
     href : str
@@ -161,7 +161,7 @@ def _section(
     heading_level: int,
     title: str | None,
 ) -> str:
-    """:func:`sweep_section` of normalised ``rows`` with their fits ``fits``."""
+    """`sweep_section` of normalised ``rows`` with their fits ``fits``."""
     figures = draw_figures(rows, fits, Path(figure_dir))
     prefix = href.rstrip("/") + "/" if href else ""
     listed = list(rows)[:MAX_TABLE_ROWS]

@@ -1,13 +1,13 @@
 """A sweep as an optional section of ``fepost report`` (a report section provider).
 
-:func:`sample_sweep_section` is the provider for the sample load sweep shipped
+`sample_sweep_section` is the provider for the sample load sweep shipped
 in ``meshes/aircraft/`` (``static_*.vtu``, ``rolling_*.vtu`` paired by
 ``static=rolling``), registered in ``fepost.report.providers.DEFAULT_SECTIONS``:
 when the report's static map is one of those files (the report of the sample
 tire, as ``fepost report`` without inputs and ``make demo`` write it) it runs
-the sweep, draws the load trends and returns a :class:`fepost.report.Section`;
+the sweep, draws the load trends and returns a `fepost.report.Section`;
 otherwise (a report of other inputs, or the files are absent) it returns None
-and the report has no trace of it. :func:`sweep_provider` makes a provider for
+and the report has no trace of it. `sweep_provider` makes a provider for
 any other inputs.
 
 The sweep runs on one worker thread of an in-process Dask cluster (it starts
@@ -16,7 +16,7 @@ friction coefficient and reading options, and writes into ``sweep/`` beside
 ``report.html``: ``coefficients.csv``, ``coefficients.parquet`` and the
 figures (PNG, SVG). The row of the report's own case (same static and rolling
 file, same options) is not analysed again: it is made from the report's
-analysis (:func:`fepost.sweep.jobs.analysis_row`) and handed to the sweep as a
+analysis (`fepost.sweep.jobs.analysis_row`) and handed to the sweep as a
 finished row.
 
 The sweep only computes; this module is its presentation in the report (it

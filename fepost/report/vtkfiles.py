@@ -6,7 +6,7 @@ carries the frame as field data (``frame_origin``: the origin in the FE model's
 global coordinates, m; ``frame_axes``: the rows x, y, z as global unit
 vectors), so ParaView's *Transform* filter can put it back into the model.
 
-``<map>_map.vtu`` (:func:`polar_map_grid`)
+``<map>_map.vtu`` (`polar_map_grid`)
     The polar map σ(ρ_i, φ_j) that every coefficient is integrated from: one
     point per grid node at (r cos φ, r sin φ, 0) about the map's centre, quads
     between neighbouring rings (closed in φ). Point data ``sigma`` (Pa),
@@ -14,14 +14,14 @@ vectors), so ParaView's *Transform* filter can put it back into the model.
     (1 where the node fell on a loaded FE face). Field data ``R`` (m), ``centre``
     (m, patch frame), ``N`` (N); numbers only, so that other readers (meshio)
     read it too.
-``<map>_patch.vtp`` (:func:`patch_surface`)
+``<map>_patch.vtp`` (`patch_surface`)
     The loaded FE faces (triangles) flat in the patch plane, with the FE
     pressure ``pressure`` (Pa) where the FE values live (point or cell data).
-``<map>_outline.vtp`` (:func:`patch_outline`)
+``<map>_outline.vtp`` (`patch_outline`)
     Lines: the boundary edges of the loaded faces, the frame axes (x and y,
     length R), the circle of radius r_max = R about the origin, the circle of
     radius r_equiv about the area centroid, and the best-fit ellipse. Cell data
-    ``part`` (integer code, :data:`PARTS`) tells them apart (ParaView:
+    ``part`` (integer code, `PARTS`) tells them apart (ParaView:
     *Threshold* on ``part``); field data ``part_names`` lists the names by code.
 
 Written with pyvista (VTK's XML writers, binary and compressed).
@@ -47,7 +47,7 @@ def _frame_data(mesh, patch: Patch) -> None:
 
 
 def polar_map_grid(pmap: PolarMap, patch: Patch):
-    """The polar map as a :class:`pyvista.UnstructuredGrid` of quads (see the module docstring).
+    """The polar map as a `pyvista.UnstructuredGrid` of quads (see the module docstring).
 
     ``patch`` supplies the frame recorded as field data (the static patch for
     both maps: the rolling map lives in the static frame).
@@ -78,7 +78,7 @@ def polar_map_grid(pmap: PolarMap, patch: Patch):
 
 
 def patch_surface(patch: Patch, frame_of: Patch | None = None):
-    """The loaded FE faces as flat :class:`pyvista.PolyData` with ``pressure`` (Pa)."""
+    """The loaded FE faces as flat `pyvista.PolyData` with ``pressure`` (Pa)."""
     import pyvista as pv
 
     pts = np.column_stack([patch.xy, np.zeros(len(patch.xy))])
@@ -90,7 +90,7 @@ def patch_surface(patch: Patch, frame_of: Patch | None = None):
 
 
 def patch_outline(patch: Patch, frame_of: Patch | None = None):
-    """Outline, frame axes, circles and ellipse of ``patch`` as :class:`pyvista.PolyData` lines."""
+    """Outline, frame axes, circles and ellipse of ``patch`` as `pyvista.PolyData` lines."""
     import pyvista as pv
 
     pieces: list[tuple[str, np.ndarray, np.ndarray]] = []  # (part, points (k, 2), lines (m, 2))

@@ -6,21 +6,21 @@
     res = run_sweep(["runs/*.e"], "sweep_out", steps="all", workers=2)
     res.rows[0]["M0"], res.ok, res.parquet
 
-Every row is one :func:`fepost.analysis.analyse` call (the call behind
+Every row is one `fepost.analysis.analyse` call (the call behind
 ``fepost coefficients``), run as a task on a ``dask.distributed`` cluster.
 Modules, one job each:
 
-* :mod:`.inputs` – files, folders and globs → sources
-* :mod:`.pairs` – ``--rolling-pairs``: naming rule or CSV of static/rolling pairs
-* :mod:`.steps` – which time steps an export holds
-* :mod:`.metadata` – case metadata from a sidecar ``<case>.json``
-* :mod:`.jobs` – one row: its identity and the function a worker runs
-* :mod:`.store` – the work folder that makes a sweep resumable
-* :mod:`.engine` – the Dask client (embedded local cluster or an existing one)
-* :mod:`.progress` – the progress bar
-* :mod:`.table` – columns, units, Parquet and CSV
-* :mod:`.run` – :func:`run_sweep`, the steps above in order
-* :mod:`.trends` – power-law fits of the coefficients against the load
+* `.inputs` – files, folders and globs → sources
+* `.pairs` – ``--rolling-pairs``: naming rule or CSV of static/rolling pairs
+* `.steps` – which time steps an export holds
+* `.metadata` – case metadata from a sidecar ``<case>.json``
+* `.jobs` – one row: its identity and the function a worker runs
+* `.store` – the work folder that makes a sweep resumable
+* `.engine` – the Dask client (embedded local cluster or an existing one)
+* `.progress` – the progress bar
+* `.table` – columns, units, Parquet and CSV
+* `.run` – `run_sweep`, the steps above in order
+* `.trends` – power-law fits of the coefficients against the load
 
 The sweep computes; its presentation lives above it: the figures in
 ``fepost.figures.sweep``, the trends page and the embeddable section in

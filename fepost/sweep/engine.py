@@ -1,7 +1,7 @@
 """The Dask plumbing: a client on an embedded local cluster or an existing one.
 
 The sweep computes on ``dask.distributed``: by default a
-:class:`~distributed.LocalCluster` of ``workers`` processes (one thread each,
+`LocalCluster` of ``workers`` processes (one thread each,
 so numpy and VTK in one worker do not compete with the next), started on first
 use and torn down at the end; with ``scheduler="tcp://HOST:PORT"`` the
 workers of an existing cluster. Rows are sent as tasks; each result (a small
@@ -36,13 +36,13 @@ def default_workers() -> int:
 
 
 class Cluster:
-    """A Dask client, connected on first use and closed by :meth:`close`.
+    """A Dask client, connected on first use and closed by `close`.
 
     Parameters
     ----------
     workers : int, optional
-        Worker processes of the embedded :class:`~distributed.LocalCluster`
-        (default :func:`default_workers`).
+        Worker processes of the embedded `LocalCluster`
+        (default `default_workers`).
     scheduler : str, optional
         Address of an existing scheduler (``tcp://HOST:PORT``); no embedded cluster.
     client : distributed.Client, optional
@@ -133,8 +133,8 @@ class Cluster:
         """(future, result or exception) pairs as they finish.
 
         A worker that died while running a task (a crash in a reader, out of
-        memory) gives that task a :class:`WorkerDied`; a cancelled task (the
-        scheduler went away) raises :class:`ClusterError`.
+        memory) gives that task a `WorkerDied`; a cancelled task (the
+        scheduler went away) raises `ClusterError`.
         """
         from concurrent.futures import CancelledError
 

@@ -1,6 +1,6 @@
 """The sweep's inputs: files, folders and globs expanded into FE exports.
 
-Every INPUT yields at least one :class:`Source`. An input that names nothing
+Every INPUT yields at least one `Source`. An input that names nothing
 (a missing file or folder, a glob without matches, a folder without FE exports)
 is a usage error (`ArgumentError`, exit status 2), raised before anything is
 written: a typo never leaves an output folder behind.
@@ -15,7 +15,7 @@ A file reached twice (the same resolved path) is kept once, at its first place.
 
 One case written in several formats (files of one folder with the same stem,
 ``static_100.vtu`` and ``static_100.e``) is one source: the file whose suffix
-comes first in :data:`PREFERENCE` is read, the others are noted in its
+comes first in `PREFERENCE` is read, the others are noted in its
 ``also`` (the table's ``also_as`` column). Exodus comes first because it holds
 every time step (``--steps all``) and the side sets; then VTK XML, then legacy
 VTK, then any other format in the reader's order.
@@ -89,7 +89,7 @@ def _expand_one(given: str, suffixes: tuple[str, ...]) -> list[Source]:
 
 
 def _rank(path: str) -> tuple[int, int]:
-    """Sort key of a format: :data:`PREFERENCE` first, then the reader's order."""
+    """Sort key of a format: `PREFERENCE` first, then the reader's order."""
     suffix = Path(path).suffix.lower()
     if suffix in PREFERENCE:
         return (0, PREFERENCE.index(suffix))
@@ -100,7 +100,7 @@ def _rank(path: str) -> tuple[int, int]:
 def one_per_case(sources: Iterable[Source]) -> list[Source]:
     """One source per case: files of one folder with the same stem are one case.
 
-    The preferred format (:data:`PREFERENCE`) is kept, at the place of the
+    The preferred format (`PREFERENCE`) is kept, at the place of the
     case's first file; the others are listed in its ``also``.
     """
     sources = list(sources)
@@ -126,8 +126,8 @@ def one_per_case(sources: Iterable[Source]) -> list[Source]:
 
 
 def expand_inputs(inputs: Iterable[str | os.PathLike]) -> list[Source]:
-    """Expand files, folders and globs into :class:`Source` items, in the order given,
-    one per case (:func:`one_per_case`).
+    """Expand files, folders and globs into `Source` items, in the order given,
+    one per case (`one_per_case`).
 
     Raises
     ------

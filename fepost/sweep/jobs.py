@@ -1,8 +1,8 @@
 """One row of the sweep: a job description and the function a worker runs for it.
 
-:func:`run_job` is exactly one single-file run: it calls
-:func:`fepost.analysis.analyse` with the options ``fepost coefficients`` would
-use and copies the numbers from :meth:`~fepost.analysis.Analysis.to_dict` (the
+`run_job` is exactly one single-file run: it calls
+`fepost.analysis.analyse` with the options ``fepost coefficients`` would
+use and copies the numbers from `to_dict` (the
 ``--json`` document). Errors fepost raises on purpose become an error row with
 their one-line message; anything else is reported with its exception type,
 so a bug in one file's analysis shows in its row instead of stopping the sweep.
@@ -102,10 +102,10 @@ class Job:
 
 
 def analysis_row(job: Job, res) -> dict:
-    """The ok row of ``job`` from its analysis ``res`` (:class:`fepost.analysis.Analysis`):
+    """The ok row of ``job`` from its analysis ``res`` (`fepost.analysis.Analysis`):
     the job's identity columns, the coefficient columns and the sidecar metadata.
 
-    :func:`run_job` makes its rows with it; a caller that already holds the
+    `run_job` makes its rows with it; a caller that already holds the
     analysis of a job (the report, for its own case) makes the same row without
     analysing the file again.
 

@@ -3,7 +3,7 @@
 Solvers do not store the load case in the mesh file, so a sweep takes it from
 ``<stem>.json`` next to the export: the sidecar the reader already reads,
 validates, converts with the model's units (``--units``) and resolves at the
-time step read (:mod:`fepost.reader.sidecar`; a per-step list gives the value
+time step read (`fepost.reader.sidecar`; a per-step list gives the value
 of that step). Recognised keys, SI units:
 
 ====================== ========================================= ======
@@ -40,7 +40,7 @@ def sidecar_path(path: str | Path) -> Path:
 
 def case_metadata(sidecar: Mapping | None) -> dict:
     """The metadata columns of one row from the sidecar the reader resolved for it
-    (:attr:`fepost.field.ContactField.sidecar`); missing keys (or no sidecar) give None."""
+    (`fepost.field.ContactField.sidecar`); missing keys (or no sidecar) give None."""
     row: dict = dict.fromkeys(COLUMNS)
     if not sidecar:
         return row

@@ -19,7 +19,7 @@ a folder or glob also matched it.
 
 A rolling map is never a static load point. Without ``--rolling-pairs`` (and for
 the inputs a given rule or CSV leaves unpaired), an input recognised as a
-rolling map (:func:`is_rolling_map`: ``rolling`` in its file name, or a sidecar
+rolling map (`is_rolling_map`: ``rolling`` in its file name, or a sidecar
 with a ``rolling_standin`` block) is paired with the input named like it with
 ``rolling`` replaced by ``static`` (``rolling_100.vtu`` → ``static_100.vtu``);
 without such an input it stays a row of its own with the role ``rolling``,
@@ -48,7 +48,7 @@ _ROLLING_WORD = re.compile("rolling", re.IGNORECASE)
 class Pairing:
     """A source and its rolling map (absolute path and as written), if any.
 
-    ``role`` is :data:`STATIC` (a load point) or :data:`ROLLING` (an unpaired
+    ``role`` is `STATIC` (a load point) or `ROLLING` (an unpaired
     rolling map: a row of its own, not a load point); ``rolling_also`` the
     rolling map's other formats, not read.
     """
@@ -184,7 +184,7 @@ def _default_partners(sources: Sequence[Source], taken: set[str]) -> dict[str, t
 
 def pair_sources(sources: Sequence[Source], pairs: RollingPairs | None) -> list[Pairing]:
     """Attach rolling maps to the static sources; drop the rolling maps that were paired;
-    mark the rolling maps left unpaired with the role :data:`ROLLING`."""
+    mark the rolling maps left unpaired with the role `ROLLING`."""
     found = [(s, pairs.partner(s) if pairs is not None else None) for s in sources]
     partners = {p[0] for _, p in found if p is not None}
     if (

@@ -3,14 +3,14 @@
 The steps of a sweep:
 
 1. expand the inputs (files, folders, globs) and pair rolling maps
-   (:mod:`.inputs`, :mod:`.pairs`);
+   (`.inputs`, `.pairs`);
 2. with ``steps="all"``, list the time steps of every Exodus file, as tasks
    on the cluster (a hostile file may crash a reader: it then fails its own
    row, not the sweep);
-3. one :class:`~.jobs.Job` per (file, step); rows finished by an earlier run
+3. one `Job` per (file, step); rows finished by an earlier run
    with the same inputs and options are taken from the work folder;
-4. the other rows run on Dask (:func:`~.jobs.run_job`, one
-   :func:`fepost.analysis.analyse` call each); each row is saved the moment it
+4. the other rows run on Dask (`run_job`, one
+   `fepost.analysis.analyse` call each); each row is saved the moment it
    arrives;
 5. the table is written whole (``coefficients.parquet``, ``coefficients.csv``),
    then, when the caller gives a page writer (``trends``, e.g.
@@ -55,7 +55,7 @@ class SweepResult:
         The output folder.
     rows : tuple of mappings
         The table, one read-only row per (file, step), columns of
-        :data:`fepost.sweep.table.COLUMNS`.
+        `fepost.sweep.table.COLUMNS`.
     reused, computed : int
         Rows taken from an earlier run / computed by this one.
     parquet, csv : Path
@@ -207,7 +207,7 @@ def run_sweep(
     Parameters
     ----------
     inputs : sequence of paths, folders or glob patterns
-        FE exports; see :mod:`fepost.sweep.inputs`.
+        FE exports; see `fepost.sweep.inputs`.
     out : path
         Output folder: ``coefficients.parquet``, ``coefficients.csv``,
         ``trends.html``, ``trends.json``, ``trends/`` and the work folder
@@ -217,7 +217,7 @@ def run_sweep(
         ``"last"``: one row per file (its last time step); ``"all"``: one row
         per time step of every Exodus file; an int: that step of every file.
     rolling_pairs : str or RollingPairs, optional
-        ``STATIC=ROLLING`` naming rule or a CSV of pairs (:mod:`.pairs`).
+        ``STATIC=ROLLING`` naming rule or a CSV of pairs (`.pairs`).
     options : AnalysisOptions, optional
         Analysis options of every row (default: those of ``fepost coefficients``); its
         ``step`` is replaced by each row's (see ``steps``).

@@ -1,6 +1,6 @@
 """Which time steps an FE export holds: the one question the sweep asks the reader.
 
-A thin adapter over :func:`fepost.reader.time_steps` (which reads the Exodus
+A thin adapter over `fepost.reader.time_steps` (which reads the Exodus
 header in a child process, so a hostile file cannot take the worker down),
 giving the sweep what it needs: the time values, or None for a file that is
 one state.
@@ -19,7 +19,7 @@ SERIES_SUFFIXES = tuple(s.lower() for s in EXODUS_SUFFIXES)
 def time_steps(path: str | Path, units=None) -> tuple[float, ...] | None:
     """Time values (s) of the steps in ``path``.
 
-    Step ``k`` of the result is the ``step=k`` of :func:`fepost.reader.read_contact`.
+    Step ``k`` of the result is the ``step=k`` of `fepost.reader.read_contact`.
     ``units`` is the model's unit system (it scales the times), as in the reader.
 
     Returns

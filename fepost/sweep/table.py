@@ -2,7 +2,7 @@
 
 One row per (input file, time step). The coefficient columns are copied from
 the ``fepost coefficients --json`` document of that row's analysis
-(:meth:`fepost.analysis.Analysis.to_dict`), so a row equals the single-file
+(`fepost.analysis.Analysis.to_dict`), so a row equals the single-file
 result number for number.
 """
 
@@ -161,7 +161,7 @@ def write_table(rows: Sequence[Mapping], folder: Path) -> tuple[Path, Path]:
 
 
 def read_table(path: str | Path) -> list[dict]:
-    """Rows of a sweep table written by :func:`write_table` (``.parquet`` or ``.csv``)."""
+    """Rows of a sweep table written by `write_table` (``.parquet`` or ``.csv``)."""
     path = Path(path)
     if path.suffix.lower() == ".parquet":
         import pyarrow.parquet as pq

@@ -181,7 +181,7 @@ def groups(rows: Sequence[Mapping]) -> dict[str, list[Mapping]]:
 
 
 def load_trends(rows: Sequence[Mapping]) -> list[PowerLaw]:
-    """Every power law of :data:`QUANTITIES` for every group of ``rows``."""
+    """Every power law of `QUANTITIES` for every group of ``rows``."""
     fits = []
     for name, members in groups(rows).items():
         N = [r.get("N") for r in members]
