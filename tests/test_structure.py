@@ -13,8 +13,6 @@ import re
 from collections import defaultdict
 from pathlib import Path
 
-import pytest
-
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = REPO / "fepost"
 #: Longest function allowed in fepost/ (the aim is a screen: under 100 lines).
