@@ -17,9 +17,9 @@ cannot be made from the header (no candidate, several, a name not in the file,
 string arrays, several pieces), `plan` returns None and the file is read whole:
 the general path then gives the same choice and the same error as ever.
 
-The component names are read with a regular expression over the XML tags
-(before ``<AppendedData>``, where raw bytes begin): VTK's information keys give
-names and counts but not component names.
+The component names are read from the XML tags (found with ``find``, tag to
+tag, up to ``<AppendedData>``, where raw bytes begin): VTK's information keys
+give names and counts but not component names.
 """
 
 from __future__ import annotations
@@ -54,7 +54,13 @@ def _header_tags(path: Path) -> tuple[dict[tuple[str, str], tuple[str, ...]], in
     pieces = 0
     section = ""
     with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
-        for m in _TAG.finditer(data):
+        pos = data.find(b"<")
+        while pos >= 0:
+            # memchr from tag to tag: inline base64 and ASCII arrays hold no "<"
+            m = _TAG.match(data, pos)
+            pos = data.find(b"<", pos + 1)
+            if m is None:
+                continue
             closing, tag, body = m.group(1), m.group(2), m.group(3)
             if tag == b"AppendedData":
                 break
