@@ -105,6 +105,16 @@ def write_solver_vtu(path: Path) -> None:
     grid.save(path)
 
 
+def nodal_values(pts: np.ndarray, p: np.ndarray, i: int, scale: float) -> np.ndarray:
+    """Nodal variable ``i`` of the Exodus series at load factor ``scale``: pressure, displacement
+    (small: 0.1 mm), then smooth fields."""
+    if i == 0:
+        return p * scale
+    if i in (1, 2, 3):
+        return -1e-4 * scale * (1.0 + pts[:, 2]) * (1.0 if i == 3 else 0.01 * _smooth(pts, i))
+    return scale * _smooth(pts, i)
+
+
 def write_exodus(path: Path) -> None:
     import netCDF4
 
@@ -172,13 +182,8 @@ def write_exodus(path: Path) -> None:
         p = _hertz(pts)
         for s in range(STEPS):
             t[s] = (s + 1) / STEPS
-            scale = (s + 1) / STEPS
             for i, v in enumerate(var):
-                v[s, :] = (
-                    p * scale
-                    if i == 0
-                    else (-1e-4 * scale * (1.0 + pts[:, 2]) if i == 3 else scale * _smooth(pts, i))
-                )
+                v[s, :] = nodal_values(pts, p, i, (s + 1) / STEPS)
     finally:
         ds.close()
 
@@ -235,6 +240,74 @@ def run(argv: list[str]) -> tuple[float, float]:
     return dt, peak[0] / 2**20
 
 
+BREAKDOWN = r"""
+import sys, time
+t0 = time.perf_counter()
+T = {}
+def lap(name):
+    global t0
+    t = time.perf_counter(); T[name] = t - t0; t0 = t
+from pathlib import Path
+path = Path(sys.argv[1])
+from fepost.cli import coefficients as cli
+lap("parent: import fepost.cli")
+from fepost.reader import isolate
+from fepost.reader.contact import read_here
+lap("parent: import fepost.reader")
+def timed_read(p):
+    s = {}
+    t = time.perf_counter()
+    from vtkmodules import vtkIOXML  # noqa: F401
+    import netCDF4  # noqa: F401
+    s["child: import VTK, netCDF4"] = time.perf_counter() - t
+    t = time.perf_counter()
+    f = read_here(p)
+    s["child: read_here (check, select, read, arrays, surface)"] = time.perf_counter() - t
+    return f, s, time.time()
+pending = isolate.start(timed_read, path, what=str(path), nbytes=path.stat().st_size)
+lap("parent: fork the reading child")
+from fepost.analysis import _warm_up
+from fepost.patch import build_patch
+from fepost.resample import resample
+from fepost.moments import moments
+from fepost.polar import PolarGrid
+from fepost.coefficients import coefficients_from_moments
+_warm_up()
+lap("parent: import the pipeline (child reads meanwhile)")
+sf, child, sent = pending.result()
+got = time.time()
+lap("parent: wait for the child's answer")
+from threadpoolctl import threadpool_limits
+with threadpool_limits(limits=1, user_api="blas"):
+    sp = build_patch(sf)
+    lap("parent: patch")
+    sm = resample(sp, PolarGrid.make(), radius=sp.r_max)
+    lap("parent: resample")
+    smo = moments(sm)
+    coef = coefficients_from_moments(smo, None, friction=0.3)
+    lap("parent: moments, coefficients")
+from fepost.analysis import Analysis
+text = cli.format_analysis(Analysis(sf, sp, sm, smo, coef, None, None, None, None))
+lap("parent: format the output (generalised model summary)")
+for k, v in child.items():
+    print(f"  {k:<58} {v:6.2f} s")
+print(f"  {'transfer child -> parent (child sent .. parent has it)':<58} {got - sent:6.2f} s")
+for k, v in T.items():
+    print(f"  {k:<58} {v:6.2f} s")
+print(f"  {'parent total after interpreter start':<58} {sum(T.values()):6.2f} s")
+"""
+
+
+def breakdown(path: Path) -> None:
+    """Where the time of one ``fepost coefficients``-like process goes (one run, stage by stage)."""
+    t = time.perf_counter()
+    subprocess.run([sys.executable, "-c", "pass"], check=True)
+    start = time.perf_counter() - t
+    print(f"breakdown of {path.name} (load {load()}):")
+    print(f"  {'interpreter start (python -c pass)':<58} {start:6.2f} s")
+    subprocess.run([sys.executable, "-c", BREAKDOWN, str(path)], check=True)
+
+
 def load() -> str:
     return ", ".join(f"{v:.1f}" for v in os.getloadavg())
 
@@ -244,6 +317,7 @@ def main() -> None:
     ap.add_argument("--dir", type=Path, required=True, help="folder of the generated files (reused)")
     ap.add_argument("--pairs", type=int, default=7)
     ap.add_argument("--files", default="surface,solver,exodus")
+    ap.add_argument("--breakdown", action="store_true", help="also time the stages of one run per file")
     args = ap.parse_args()
     args.dir.mkdir(parents=True, exist_ok=True)
     import compileall
@@ -262,6 +336,8 @@ def main() -> None:
                 f"wrote {path}: {path.stat().st_size / 1e6:.0f} MB in {time.perf_counter() - t:.0f} s",
                 flush=True,
             )
+        if args.breakdown:
+            breakdown(path)
         bare = [sys.executable, "-c", f"import pyvista; pyvista.read({str(path)!r})"]
         ours = [sys.executable, "-m", "fepost", "coefficients", str(path)]
         before = load()
