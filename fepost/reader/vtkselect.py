@@ -32,8 +32,10 @@ from pathlib import Path
 from ..errors import FepostError
 from .names import ArrayInfo, pick_displacement, pick_field
 
-#: Serial XML suffixes whose point arrays are selected before the read.
-SELECTABLE = (".vtu", ".vtp", ".vts", ".vtr")
+#: Serial XML suffixes whose point arrays are selected before the read. Structured grids
+#: (``.vts .vtr``) are not: their conversion to cells (VTK's append filter) reorders the
+#: arrays, and the order of the names a field lists must not depend on the path taken.
+SELECTABLE = (".vtu", ".vtp")
 #: VTK array types read as numbers (VTK's type ids: char ... unsigned long long, id type).
 _NUMERIC = {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 15, 16, 17}
 _TAG = re.compile(rb"<(/?)(PointData|CellData|DataArray|Piece|AppendedData)\b([^>]*)>")
