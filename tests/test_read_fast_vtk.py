@@ -118,6 +118,7 @@ OPTIONS = [
     {"field": "CPRESS"},
     {"field": "CONTACT:3"},
     {"field": "CONTACT:CPRESS"},
+    {"field": "CSHEAR1"},
     {"field": "cpress"},
     {"displacement": None},
     {"displacement": "U"},
@@ -255,6 +256,6 @@ def test_rectilinear_grid(tmp_path):
 
 
 def test_pressure_chosen_by_component_name_keeps_the_other_arrays_lazy(solver_vtu):
-    """--field naming a component (CPRESS of CONTACT): only CONTACT and U are decoded."""
-    raw = read_vtk(solver_vtu, field="CONTACT:CPRESS", displacement="auto")
+    """--field naming a component (CSHEAR1 of CONTACT): only CONTACT and U are decoded."""
+    raw = read_vtk(solver_vtu, field="CSHEAR1", displacement="auto")
     assert "CONTACT" not in raw.ncomp and "U" not in raw.ncomp and "CPRESS" in raw.ncomp
