@@ -217,11 +217,14 @@ def _tree_rss(pid: int) -> int:
     return total
 
 
-def run(argv: list[str]) -> tuple[float, float]:
+def run(argv: list[str], pythonpath: str | None = None) -> tuple[float, float]:
     """Wall time (s) of a whole process and its sampled peak tree RSS (MB)."""
+    env = dict(os.environ)
+    if pythonpath:
+        env["PYTHONPATH"] = pythonpath
     peak = [0]
     t = time.perf_counter()
-    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
     done = threading.Event()
 
     def sample() -> None:
@@ -320,6 +323,7 @@ def main() -> None:
     ap.add_argument("--pairs", type=int, default=7)
     ap.add_argument("--files", default="surface,solver,exodus")
     ap.add_argument("--breakdown", action="store_true", help="also time the stages of one run per file")
+    ap.add_argument("--baseline", type=Path, help="another checkout whose fepost is timed in the same rounds")
     args = ap.parse_args()
     args.dir.mkdir(parents=True, exist_ok=True)
     import compileall
@@ -343,13 +347,23 @@ def main() -> None:
         bare = [sys.executable, "-c", f"import pyvista; pyvista.read({str(path)!r})"]
         ours = [sys.executable, "-m", "fepost", "coefficients", str(path)]
         before = load()
-        tb, to, mb, mo = [], [], [], []
+        tb, to, mb, mo, tbase = [], [], [], [], []
+        here = str(Path(__file__).resolve().parents[1])
+        sides = [("bare", bare, None), ("ours", ours, here)]
+        if args.baseline:
+            sides.append(("base", ours, str(args.baseline)))
         for k in range(args.pairs):
-            order = (bare, ours) if k % 2 == 0 else (ours, bare)
-            for argv in order:
-                dt, peak = run(argv)
-                (tb if argv is bare else to).append(dt)
-                (mb if argv is bare else mo).append(peak)
+            # the order rotates every round: bare, ours(, base); ours(, base), bare; ...
+            for label, argv, pythonpath in sides[k % len(sides) :] + sides[: k % len(sides)]:
+                dt, peak = run(argv, pythonpath)
+                if label == "bare":
+                    tb.append(dt)
+                    mb.append(peak)
+                elif label == "ours":
+                    to.append(dt)
+                    mo.append(peak)
+                else:
+                    tbase.append(dt)
         rows.append((key, tb, to, mb, mo, before, load()))
         r = rows[-1]
         print(
@@ -357,6 +371,14 @@ def main() -> None:
             f"ratio {statistics.median(to) / statistics.median(tb):.2f}; load {before} -> {r[6]}",
             flush=True,
         )
+        if tbase:
+            mbase = statistics.median(tbase)
+            print(
+                f"{key}: baseline {args.baseline} fepost {mbase:.2f} s, "
+                f"ratio to bare {mbase / statistics.median(tb):.2f}; "
+                f"this checkout / baseline {statistics.median(to) / mbase:.2f}",
+                flush=True,
+            )
     print()
     print(
         f"{'file':<8} {'bare read s':>12} {'fepost s':>9} {'ratio':>6} {'pair ratios':>24} "
