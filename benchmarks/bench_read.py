@@ -224,7 +224,11 @@ def run(argv: list[str], pythonpath: str | None = None) -> tuple[float, float]:
         env["PYTHONPATH"] = pythonpath
     peak = [0]
     t = time.perf_counter()
-    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    # run from a neutral folder: with ``-m`` the working directory comes first on sys.path and
+    # would decide which checkout's fepost is imported, whatever PYTHONPATH says
+    proc = subprocess.Popen(
+        argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env, cwd=os.path.dirname(argv[-1])
+    )
     done = threading.Event()
 
     def sample() -> None:
