@@ -217,7 +217,7 @@ def _tree_rss(pid: int) -> int:
     return total
 
 
-def run(argv: list[str], pythonpath: str | None = None) -> tuple[float, float]:
+def run(argv: list[str], pythonpath: str | None = None, cwd: Path | None = None) -> tuple[float, float]:
     """Wall time (s) of a whole process and its sampled peak tree RSS (MB)."""
     env = dict(os.environ)
     if pythonpath:
@@ -226,9 +226,7 @@ def run(argv: list[str], pythonpath: str | None = None) -> tuple[float, float]:
     t = time.perf_counter()
     # run from a neutral folder: with ``-m`` the working directory comes first on sys.path and
     # would decide which checkout's fepost is imported, whatever PYTHONPATH says
-    proc = subprocess.Popen(
-        argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env, cwd=os.path.dirname(argv[-1])
-    )
+    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env, cwd=cwd)
     done = threading.Event()
 
     def sample() -> None:
@@ -359,7 +357,7 @@ def main() -> None:
         for k in range(args.pairs):
             # the order rotates every round: bare, ours(, base); ours(, base), bare; ...
             for label, argv, pythonpath in sides[k % len(sides) :] + sides[: k % len(sides)]:
-                dt, peak = run(argv, pythonpath)
+                dt, peak = run(argv, pythonpath, args.dir)
                 if label == "bare":
                     tb.append(dt)
                     mb.append(peak)
