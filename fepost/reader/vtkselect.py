@@ -87,7 +87,7 @@ def _infos(reader, key) -> list[tuple[str, int, int]]:
     from vtkmodules.vtkCommonDataModel import vtkDataObject
 
     vec = reader.GetOutputInformation(0).Get(key)
-    out = []
+    out: list[tuple[str, int, int]] = []
     if vec is None:
         return out
     for i in range(vec.GetNumberOfInformationObjects()):
