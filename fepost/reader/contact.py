@@ -61,8 +61,11 @@ def _absurd(source: str, what: str, values: np.ndarray, limit: float) -> None:
         )
 
 
-def read_raw(path: Path, step: int | None) -> RawMesh:
-    """The file's content (Exodus by netCDF4, VTK files by VTK's readers)."""
+def read_raw(
+    path: Path, step: int | None, field: str | None = None, displacement: str | None = "auto"
+) -> RawMesh:
+    """The file's content (Exodus by netCDF4, VTK files by VTK's readers, the arrays
+    ``field`` and ``displacement`` choose decoded first)."""
     if path.suffix.lower() in EXODUS_SUFFIXES:
         return read_exodus(path, step)
     if path.suffix.lower() in XDMF_SUFFIXES:
@@ -71,7 +74,7 @@ def read_raw(path: Path, step: int | None) -> RawMesh:
         return read_frd(path, step)
     if step is not None:
         raise InputFileError(f"{path}: --step applies to Exodus time series, not to {path.suffix} files")
-    return read_vtk(path)
+    return read_vtk(path, field=field, displacement=displacement)
 
 
 def read_here(
@@ -83,7 +86,7 @@ def read_here(
     surface: str | None = None,
 ) -> ContactField:
     """`fepost.reader.read_contact` without the child process (see there)."""
-    raw = read_raw(path, step)
+    raw = read_raw(path, step, field, displacement)
     try:
         return _contact(raw, path, field, displacement, units, surface)
     finally:

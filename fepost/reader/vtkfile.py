@@ -140,22 +140,33 @@ def _pieces(reader) -> tuple[list, bool]:
     return out, ghosts
 
 
-def read_vtk(path: Path) -> RawMesh:
-    """Read a VTK file into a `fepost.reader.raw.RawMesh`."""
+def read_vtk(
+    path: Path, *, field: str | None = None, displacement: str | None = "auto", select: bool = True
+) -> RawMesh:
+    """Read a VTK file into a `fepost.reader.raw.RawMesh`.
+
+    ``field`` and ``displacement`` are `fepost.reader.read_contact`'s: with ``select``
+    (the default) a serial XML file's point arrays that they do not choose are not
+    decoded (`fepost.reader.vtkselect`); they are read on demand if asked for.
+    """
     from .pieces import join_pieces
     from .vtkcheck import check_file
+    from .vtkselect import SELECTABLE, plan
 
     suffix = path.suffix.lower()
     counts = check_file(path)
     reader = _reader_for(suffix)
     ghosts = False
     pieces: list = []
+    chosen = None
     with _ErrorWindow() as win:
         reader.SetFileName(str(path))
         if suffix in PARALLEL_SUFFIXES:
             pieces, ghosts = _pieces(reader)
             out = None
         else:
+            if select and suffix in SELECTABLE:
+                chosen = plan(path, reader, field, displacement)
             reader.Update()
             out = reader.GetOutputDataObject(0)
     errors = win.errors()
@@ -182,7 +193,48 @@ def read_vtk(path: Path) -> RawMesh:
     if suffix in PARALLEL_SUFFIXES:
         raw, merged = join_pieces(raw, [int(leaf.GetNumberOfPoints()) for leaf in leaves])
         raw.notes = [f"{len(leaves)} pieces joined ({merged} nodes shared by pieces merged)"]
+    if chosen is not None:
+        _add_skipped(raw, path, chosen)
     return raw
+
+
+def _add_skipped(raw: RawMesh, path: Path, chosen) -> None:
+    """Put the point arrays left out of the read back into ``raw``, in file order, as loaders."""
+    from functools import partial
+
+    from .raw import LazyArrays
+
+    data = LazyArrays()
+    for name in chosen.order:
+        if name in chosen.skipped:
+            ncomp, names = chosen.skipped[name]
+            data.add(name, partial(_read_one, path, name, len(raw.points)))
+            raw.ncomp[name] = ncomp
+            if names:
+                raw.components.setdefault(name, names)
+        else:
+            data.add(name, raw.point_data[name])
+    raw.point_data = data
+
+
+def _read_one(path: Path, name: str, n: int) -> np.ndarray:
+    """One point array of a serial XML file, read on its own (a file read whole but for the other arrays)."""
+    reader = _reader_for(path.suffix.lower())
+    with _ErrorWindow() as win:
+        reader.SetFileName(str(path))
+        reader.UpdateInformation()
+        sel = reader.GetPointDataArraySelection()
+        sel.DisableAllArrays()
+        sel.EnableArray(name)
+        reader.GetCellDataArraySelection().DisableAllArrays()
+        reader.Update()
+    if win.errors() or reader.GetErrorCode():
+        raise InputFileError(f"{path}: cannot read point array {name!r} (corrupt or changed file)")
+    ds = _as_unstructured(reader.GetOutputDataObject(0))
+    got = _data_arrays(path, ds.GetPointData(), n, "point", {})
+    if name not in got:
+        raise InputFileError(f"{path}: point array {name!r} is gone (the file changed while read)")
+    return got[name]
 
 
 def _as_unstructured(ds):
