@@ -52,29 +52,35 @@ def _runs(rig: Path) -> list[Path]:
 
 
 def predictions(rig: Path, runs: list[Path], friction: float):
-    """FE table, static analysis and a dict model -> (n, 3) predicted (Fx, Fy, Mz)."""
+    """FE table, static analysis, a dict model -> (n, 3) predicted (Fx, Fy, Mz) and the runs' maps."""
     from fepost.analysis import analyse
+    from fepost.friction.exact import friction_resultants
+    from fepost.friction.law import FrictionLaw
     from fepost.friction.predict import predict
+    from fepost.friction.quadrature import PressureQuadrature
     from fepost.rig import rig_table
 
+    law = FrictionLaw(f=friction)
     table = rig_table(runs)
     vx = np.array([r.vx for r in table.runs])
     vy = np.array([r.vy for r in table.runs])
     wz = np.array([r.wz for r in table.runs])
     static = analyse(rig / "static.vtu", friction=friction)
-    p = predict(static, vx, vy, wz)
+    p = predict(vx, vy, wz, pmap=static.static_map, coefficients=static.coefficients, law=law)
     n_static = static.coefficients.N
     scale = np.array([r.reaction.N for r in table.runs]) / n_static
     out = {}
     for key, res in (("paper", p.paper), ("exact", p.exact), ("model", p.generalised)):
         out[key] = np.column_stack([res.Fx, res.Fy, res.Mz]) * scale[:, None]
-    own = []
+    own, shifts = [], []
+    c0 = np.array(static.static_moments.centroid)
     for i, run in enumerate(runs):
         a = analyse(rig / "static.vtu", run, friction=friction)
-        q = predict(a, vx[i : i + 1], vy[i : i + 1], wz[i : i + 1])
-        own.append([q.exact.Fx[0], q.exact.Fy[0], q.exact.Mz[0]])
+        q = friction_resultants(PressureQuadrature.from_polar(a.rolling_map), vx[i], vy[i], wz[i], law)
+        own.append([float(q.Fx[()]), float(q.Fy[()]), float(q.Mz[()])])
+        shifts.append(np.array(a.rolling_moments.centroid) - c0)
     out["own"] = np.array(own)
-    return table, static, out
+    return table, static, out, np.array(shifts)
 
 
 def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], list[dict]]:
@@ -262,7 +268,7 @@ def main(argv=None) -> int:
     if not runs:
         print(f"rig_study: no rig runs in {args.rig}", file=sys.stderr)
         return 2
-    table, static, preds = predictions(args.rig, runs, args.friction)
+    table, static, preds, shifts = predictions(args.rig, runs, args.friction)
     rows, summary = misfit_table(table, static, preds, args.friction)
     write_outputs(args.out, rows, summary, static, len(runs))
     conv = convergence(args.rig, static, args.friction)
