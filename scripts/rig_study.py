@@ -41,6 +41,12 @@ MODELS = {
     "model": "(d) generalised model",
 }
 
+#: The load-transfer extension (``fepost.rig.extension``), after the decomposition row.
+EXTENSION = {
+    "fit": "(e) static map shifted by load transfer, h from all runs' maps",
+    "shift": "(e) the same, cross-validated (h from the other directions' maps)",
+}
+
 
 def _runs(rig: Path) -> list[Path]:
     out = []
@@ -102,6 +108,8 @@ def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], lis
             "Mz_fe": fe[i, 2] / unit[i, 2],
         }
         for key, p in preds.items():
+            if key == "fit":
+                continue
             for j, q in enumerate(("Fx", "Fy", "Mz")):
                 row[f"{q}_{key}"] = p[i, j] / unit[i, j]
         rows.append(row)
@@ -119,8 +127,10 @@ def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], lis
             }
         )
     # the decomposition: (b) - (c) isolates the pressure redistribution, (c) - FE the compliance
-    for label, a, b in (("(b) - (c): pressure redistribution", "exact", "own"),):
-        d = (preds[a] - preds[b]) / unit
+    pairs = [("(b) - (c): pressure redistribution", "exact", "own")]
+    pairs += [(label, key, None) for key, label in EXTENSION.items() if key in preds]
+    for label, a, b in pairs:
+        d = (preds[a] - (fe if b is None else preds[b])) / unit
         df = np.hypot(d[:, 0], d[:, 1])
         summary.append(
             {
@@ -132,6 +142,34 @@ def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], lis
             }
         )
     return rows, summary
+
+
+def extension(table, static, shifts, friction: float) -> tuple[dict, object]:
+    """The load-transfer extension: (n, 3) predictions (all runs' h; cross-validated) and the law.
+
+    The law is identified from each run's centre-of-pressure shift (its own map against
+    the static map) and its friction force per load from the integral of the export's
+    shear traction (not the reactions the predictions are checked against). Held-out
+    groups: the sliding directions and the pure-spin runs.
+    """
+    from fepost.friction.law import FrictionLaw
+    from fepost.friction.quadrature import PressureQuadrature
+    from fepost.rig.extension import cross_validate, identify_shift, predict_shifted
+
+    law = FrictionLaw(f=friction)
+    vx, vy, wz = (np.array([getattr(r, k) for r in table.runs]) for k in ("vx", "vy", "wz"))
+    force = np.array([[r.shear.Fx / r.shear.N, r.shear.Fy / r.shear.N] for r in table.runs])
+    groups = [Path(r.source).stem.split("_")[0] for r in table.runs]
+    quad = PressureQuadrature.from_polar(static.static_map)
+    shift_law = identify_shift(shifts, force)
+    scale = np.array([r.reaction.N for r in table.runs])[:, None] / static.coefficients.N
+    fit = predict_shifted(quad, vx, vy, wz, law=shift_law, friction=law).resultants
+    cv = cross_validate(quad, vx, vy, wz, shifts=shifts, forces=force, groups=groups, friction=law)
+    out = {
+        "fit": np.column_stack([fit.Fx, fit.Fy, fit.Mz]) * scale,
+        "shift": np.column_stack([cv.Fx, cv.Fy, cv.Mz]) * scale,
+    }
+    return out, shift_law
 
 
 def write_outputs(out: Path, rows, summary, static, n_runs: int) -> None:
@@ -154,6 +192,24 @@ def write_outputs(out: Path, rows, summary, static, n_runs: int) -> None:
             f"| {s['model']} | {s['rms_F']:.4f} | {s['max_F']:.4f} | {s['rms_Mz']:.4f} | {s['max_Mz']:.4f} |"
         )
     (out / "table.txt").write_text("\n".join(md) + "\n")
+
+
+def law_lines(law) -> list[str]:
+    """Markdown: the identified load-transfer law with its intervals."""
+    pct = f"{law.level:.0%}"
+    return [
+        "",
+        f"(e) load transfer identified from the {law.n} runs' own maps (centre-of-pressure shift "
+        "against the friction force per load from the shear-traction integral; least squares "
+        f"through the origin, {pct} intervals):",
+        "",
+        f"| axis | h / mm | {pct} interval / mm | RMS shift / mm | RMS unexplained / mm |",
+        "|---|---|---|---|---|",
+        f"| x | {law.h_x * 1e3:.2f} | {law.interval_x[0] * 1e3:.2f} .. {law.interval_x[1] * 1e3:.2f} | "
+        f"{law.scatter_x * 1e3:.3f} | {law.residual_x * 1e3:.3f} |",
+        f"| y | {law.h_y * 1e3:.2f} | {law.interval_y[0] * 1e3:.2f} .. {law.interval_y[1] * 1e3:.2f} | "
+        f"{law.scatter_y * 1e3:.3f} | {law.residual_y * 1e3:.3f} |",
+    ]
 
 
 def convergence(rig: Path, static, friction: float) -> list[str]:
@@ -203,6 +259,7 @@ def figures(out: Path, rows) -> None:
         "exact": ("C1", "^"),
         "own": ("C2", "v"),
         "model": ("C3", "x"),
+        "shift": ("C4", "d"),
     }
     for d, rs in sorted(dirs.items()):
         rs = rs + spin
@@ -214,7 +271,7 @@ def figures(out: Path, rows) -> None:
             fx = np.array([r[f"Fx_{key}"] for r in rs])
             fy = np.array([r[f"Fy_{key}"] for r in rs])
             m = np.array([r[f"Mz_{key}"] for r in rs])
-            label = "FE (CalculiX)" if key == "fe" else MODELS[key]
+            label = "FE (CalculiX)" if key == "fe" else {**MODELS, **EXTENSION}[key]
             # along and across the sliding direction d (across: +90 degrees from it)
             along, across = fx * c + fy * s_, -fx * s_ + fy * c
             for a, y in zip(ax, (along, across, m), strict=True):
@@ -230,6 +287,30 @@ def figures(out: Path, rows) -> None:
         fig.tight_layout()
         fig.savefig(out / f"rig_{d:03d}.png", dpi=80)
         plt.close(fig)
+
+
+def shift_figure(out: Path, table, shifts, law) -> None:
+    """Each run's centre-of-pressure shift against its friction force per load, with the law."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    force = np.array([[r.shear.Fx / r.shear.N, r.shear.Fy / r.shear.N] for r in table.runs])
+    fig, ax = plt.subplots(1, 2, figsize=(9, 3.6))
+    for j, (q, h, ci) in enumerate((("x", law.h_x, law.interval_x), ("y", law.h_y, law.interval_y))):
+        g = np.linspace(force[:, j].min(), force[:, j].max(), 2)
+        ax[j].plot(force[:, j], shifts[:, j] * 1e3, "ko", ms=4, label="runs' own maps")
+        ax[j].plot(g, h * g * 1e3, "C4", label=f"h_{q} = {h * 1e3:.1f} mm")
+        ax[j].fill_between(g, ci[0] * g * 1e3, ci[1] * g * 1e3, color="C4", alpha=0.25, lw=0)
+        ax[j].set_xlabel(f"F{q} / N (shear-traction integral)")
+        ax[j].set_ylabel(f"d{q}, centre of pressure shift, mm")
+        ax[j].grid(alpha=0.3)
+        ax[j].legend(fontsize=7)
+    fig.suptitle(f"load transfer identified from the {law.n} runs' maps")
+    fig.tight_layout()
+    fig.savefig(out / "rig_shift.png", dpi=80)
+    plt.close(fig)
 
 
 def history_figure(rig: Path, out: Path, runs: list[Path], friction: float) -> None:
@@ -269,8 +350,12 @@ def main(argv=None) -> int:
         print(f"rig_study: no rig runs in {args.rig}", file=sys.stderr)
         return 2
     table, static, preds, shifts = predictions(args.rig, runs, args.friction)
+    ext, shift_law = extension(table, static, shifts, args.friction)
+    preds.update(ext)
     rows, summary = misfit_table(table, static, preds, args.friction)
     write_outputs(args.out, rows, summary, static, len(runs))
+    with open(args.out / "table.txt", "a") as fh:
+        fh.write("\n".join(law_lines(shift_law)) + "\n")
     conv = convergence(args.rig, static, args.friction)
     if conv:
         head = [
@@ -283,6 +368,7 @@ def main(argv=None) -> int:
         with open(args.out / "table.txt", "a") as fh:
             fh.write("\n".join(head + conv) + "\n")
     figures(args.out, rows)
+    shift_figure(args.out, table, shifts, shift_law)
     history_figure(args.rig, args.out, runs, args.friction)
     print((args.out / "table.txt").read_text())
     return 0

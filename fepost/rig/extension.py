@@ -125,7 +125,9 @@ def identify_shift(shifts, forces, *, level: float = LEVEL) -> ShiftLaw:
     d = np.asarray(shifts, float)
     g = np.asarray(forces, float)
     if d.ndim != 2 or d.shape[1] != 2 or g.shape != d.shape:
-        raise ArgumentError(f"identify_shift: shifts and forces must both be (n, 2), got {d.shape} and {g.shape}")
+        raise ArgumentError(
+            f"identify_shift: shifts and forces must both be (n, 2), got {d.shape} and {g.shape}"
+        )
     if d.shape[0] < 3:
         raise ArgumentError(f"identify_shift: need at least 3 runs, got {d.shape[0]}")
     if not (np.all(np.isfinite(d)) and np.all(np.isfinite(g))):
@@ -150,7 +152,9 @@ def identify_shift(shifts, forces, *, level: float = LEVEL) -> ShiftLaw:
     )
 
 
-def shifted_resultants(quad: PressureQuadrature, vx, vy, wz, *, dx, dy, law: FrictionLaw | None = None) -> Resultants:
+def shifted_resultants(
+    quad: PressureQuadrature, vx, vy, wz, *, dx, dy, law: FrictionLaw | None = None
+) -> Resultants:
     """Exact Coulomb resultants over the map ``quad`` moved rigidly by (dx, dy) (m); Mz about the origin."""
     vx, vy, wz, dx, dy = (np.asarray(a, float) for a in np.broadcast_arrays(vx, vy, wz, dx, dy))
     base = friction_resultants(quad, vx - wz * dy, vy + wz * dx, wz, law)
@@ -214,7 +218,9 @@ def predict_shifted(
         if change <= tol:
             res = shifted_resultants(quad, vx, vy, wz, dx=dx, dy=dy, law=friction)
             return ShiftedPrediction(resultants=res, dx=dx, dy=dy, iterations=it, change=change)
-    raise FitError(f"predict_shifted: no fixed point after {max_iter} iterations (last change {change:.3g} m)")
+    raise FitError(
+        f"predict_shifted: no fixed point after {max_iter} iterations (last change {change:.3g} m)"
+    )
 
 
 @dataclass(frozen=True)
