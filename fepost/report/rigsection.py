@@ -74,7 +74,17 @@ def rig_section(data: ReportData, folder: Path) -> Section | None:
         f"{law.interval_y[1] * 1e3:.2f}); {_text(cmp.misfit('shifted'))}. h is identified on "
         "all these runs here; the held-out measure is in the rig study (scripts/rig_study.py).",
     )
-    head = ("run", "vx (m/s)", "vy (m/s)", "wz (rad/s)", "Fx/fN", "Fy/fN", "Mz/fNR", "(b) |dF|/fN", "(e) |dF|/fN")
+    head = (
+        "run",
+        "vx (m/s)",
+        "vy (m/s)",
+        "wz (rad/s)",
+        "Fx/fN",
+        "Fy/fN",
+        "Mz/fNR",
+        "(b) |dF|/fN",
+        "(e) |dF|/fN",
+    )
     rows = []
     for i, name in enumerate(cmp.names):
         db = cmp.static[i, :2] - cmp.fe[i, :2]

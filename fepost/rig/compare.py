@@ -77,7 +77,9 @@ def _shear_per_load(table: RigTable) -> np.ndarray:
     out = []
     for r in table.runs:
         if r.shear is None or not r.shear.N > 0.0:
-            raise DataError(f"{r.source}: the export has no shear traction to identify the load transfer from")
+            raise DataError(
+                f"{r.source}: the export has no shear traction to identify the load transfer from"
+            )
         out.append([r.shear.Fx / r.shear.N, r.shear.Fy / r.shear.N])
     return np.array(out)
 
