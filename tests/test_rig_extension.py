@@ -189,7 +189,9 @@ def test_committed_gain_is_what_the_docs_state(committed):
     assert round(b["rms_F"], 3) == 0.054 and round(cv["rms_F"], 3) == 0.020
     assert round(b["rms_Mz"], 3) == 0.017 and round(cv["rms_Mz"], 3) == 0.010
     text = (ROOT / "docs" / "rig.md").read_text()
-    assert "0.0199" in text and f"{committed.law.h_x * 1e3:.1f} mm" in text
+    law = committed.law
+    assert f"| x | {law.h_x * 1e3:.2f} |" in text and f"| y | {law.h_y * 1e3:.2f} |" in text
+    assert f"| {study.EXTENSION['shift']} | {cv['rms_F']:.4f} | {cv['max_F']:.4f} |" in text
 
 
 def test_compare_runs_agrees_with_the_study(committed):
