@@ -106,8 +106,10 @@ def compare_runs(analysis, runs, *, options=None) -> RigComparison:
     c0 = np.array(analysis.static_moments.centroid)
     shifts = []
     for r in table.runs:
-        own = analyse(analysis.static_field, r.source, friction=c.f, options=opts)
-        shifts.append(np.array(own.rolling_moments.centroid) - c0)
+        own = analyse(analysis.static_field, r.source, friction=c.f, options=opts).rolling_moments
+        if own is None:  # analyse always places the second map; kept for the type checker
+            raise DataError(f"{r.source}: no pressure map of the run")
+        shifts.append(np.array(own.centroid) - c0)
     shift_law = identify_shift(np.array(shifts), _shear_per_load(table))
     quad = PressureQuadrature.from_polar(analysis.static_map)
     per_load = unit / (n[:, None] / c.N)  # the predictions carry the static load
