@@ -11,13 +11,22 @@ on the tire from CalculiX's reactions) and compares them with
     pressure map, placed in the static patch's frame,
 (d) fepost's generalised model built from the static map,
 
-all through ``fepost.predict`` (``fepost.friction.predict``). The predictions
+all through ``fepost.friction.predict``, and the extension
+
+(e) the exact integrals over the static map shifted by load transfer
+    (``fepost.rig.extension``), h identified from the runs' own maps and the
+    shear-traction force per load: on all runs, and held out (h from the
+    other sliding directions' runs; the table's cross-validated row and the
+    ``*_shift`` columns of ``misfit.csv``).
+
+The predictions
 over a static map carry the static load; the FE load changes a little during
-the slide (the rim is held at its height), so (a), (b) and (d) are scaled by
+the slide (the rim is held at its height), so (a), (b), (d) and (e) are scaled by
 N_run / N_static (the Coulomb forces are proportional to the load at a fixed
 pressure shape). Misfits are in units of f N (forces) and f N R (torque),
 N the run's load, R the static patch radius. Writes ``misfit.csv`` (per run),
-``table.txt`` (RMS and max per model), figures ``rig_<direction>.png`` and the
+``table.txt`` (RMS and max per model, the identified law), figures
+``rig_<direction>.png``, the shifts against the forces ``rig_shift.png`` and the
 forces against the sliding path, ``rig_history.png``.
 """
 
