@@ -54,6 +54,10 @@ MODELS = {
 EXTENSION = {
     "fit": "(e) static map shifted by load transfer, h from all runs' maps",
     "shift": "(e) the same, cross-validated (h from the other directions' maps)",
+    "lo": "(e) sensitivity: h_x, h_y both at the lower 95% interval ends",
+    "hi": "(e) sensitivity: h_x, h_y both at the upper 95% interval ends",
+    "only_y": "(e) sensitivity: h_x = 0 (lateral transfer only)",
+    "only_x": "(e) sensitivity: h_y = 0 (longitudinal transfer only)",
 }
 
 
@@ -117,8 +121,8 @@ def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], lis
             "Mz_fe": fe[i, 2] / unit[i, 2],
         }
         for key, p in preds.items():
-            if key == "fit":
-                continue
+            if key in EXTENSION and key != "shift":
+                continue  # per run: only the held-out extension
             for j, q in enumerate(("Fx", "Fy", "Mz")):
                 row[f"{q}_{key}"] = p[i, j] / unit[i, j]
         rows.append(row)
@@ -161,6 +165,8 @@ def extension(table, static, shifts, friction: float) -> tuple[dict, object]:
     shear traction (not the reactions the predictions are checked against). Held-out
     groups: the sliding directions and the pure-spin runs.
     """
+    from dataclasses import replace
+
     from fepost.friction.law import FrictionLaw
     from fepost.friction.quadrature import PressureQuadrature
     from fepost.rig.extension import cross_validate, identify_shift, predict_shifted
@@ -178,6 +184,16 @@ def extension(table, static, shifts, friction: float) -> tuple[dict, object]:
         "fit": np.column_stack([fit.Fx, fit.Fy, fit.Mz]) * scale,
         "shift": np.column_stack([cv.Fx, cv.Fy, cv.Mz]) * scale,
     }
+    lx, ly = shift_law.interval_x, shift_law.interval_y
+    for key, hx, hy in (
+        ("lo", lx[0], ly[0]),
+        ("hi", lx[1], ly[1]),
+        ("only_y", 0.0, shift_law.h_y),
+        ("only_x", shift_law.h_x, 0.0),
+    ):
+        other = replace(shift_law, h_x=hx, h_y=hy)
+        r = predict_shifted(quad, vx, vy, wz, law=other, friction=law).resultants
+        out[key] = np.column_stack([r.Fx, r.Fy, r.Mz]) * scale
     return out, shift_law
 
 
