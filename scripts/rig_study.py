@@ -11,13 +11,22 @@ on the tire from CalculiX's reactions) and compares them with
     pressure map, placed in the static patch's frame,
 (d) fepost's generalised model built from the static map,
 
-all through ``fepost.predict`` (``fepost.friction.predict``). The predictions
+all through ``fepost.friction.predict``, and the extension
+
+(e) the exact integrals over the static map shifted by load transfer
+    (``fepost.rig.extension``), h identified from the runs' own maps and the
+    shear-traction force per load: on all runs, and held out (h from the
+    other sliding directions' runs; the table's cross-validated row and the
+    ``*_shift`` columns of ``misfit.csv``).
+
+The predictions
 over a static map carry the static load; the FE load changes a little during
-the slide (the rim is held at its height), so (a), (b) and (d) are scaled by
+the slide (the rim is held at its height), so (a), (b), (d) and (e) are scaled by
 N_run / N_static (the Coulomb forces are proportional to the load at a fixed
 pressure shape). Misfits are in units of f N (forces) and f N R (torque),
 N the run's load, R the static patch radius. Writes ``misfit.csv`` (per run),
-``table.txt`` (RMS and max per model), figures ``rig_<direction>.png`` and the
+``table.txt`` (RMS and max per model, the identified law), figures
+``rig_<direction>.png``, the shifts against the forces ``rig_shift.png`` and the
 forces against the sliding path, ``rig_history.png``.
 """
 
@@ -41,6 +50,16 @@ MODELS = {
     "model": "(d) generalised model",
 }
 
+#: The load-transfer extension (``fepost.rig.extension``), after the decomposition row.
+EXTENSION = {
+    "fit": "(e) static map shifted by load transfer, h from all runs' maps",
+    "shift": "(e) the same, cross-validated (h from the other directions' maps)",
+    "lo": "(e) sensitivity: h_x, h_y both at the lower 95% interval ends",
+    "hi": "(e) sensitivity: h_x, h_y both at the upper 95% interval ends",
+    "only_y": "(e) sensitivity: h_x = 0 (lateral transfer only)",
+    "only_x": "(e) sensitivity: h_y = 0 (longitudinal transfer only)",
+}
+
 
 def _runs(rig: Path) -> list[Path]:
     out = []
@@ -52,29 +71,35 @@ def _runs(rig: Path) -> list[Path]:
 
 
 def predictions(rig: Path, runs: list[Path], friction: float):
-    """FE table, static analysis and a dict model -> (n, 3) predicted (Fx, Fy, Mz)."""
+    """FE table, static analysis, a dict model -> (n, 3) predicted (Fx, Fy, Mz) and the runs' maps."""
     from fepost.analysis import analyse
+    from fepost.friction.exact import friction_resultants
+    from fepost.friction.law import FrictionLaw
     from fepost.friction.predict import predict
+    from fepost.friction.quadrature import PressureQuadrature
     from fepost.rig import rig_table
 
+    law = FrictionLaw(f=friction)
     table = rig_table(runs)
     vx = np.array([r.vx for r in table.runs])
     vy = np.array([r.vy for r in table.runs])
     wz = np.array([r.wz for r in table.runs])
     static = analyse(rig / "static.vtu", friction=friction)
-    p = predict(static, vx, vy, wz)
+    p = predict(vx, vy, wz, pmap=static.static_map, coefficients=static.coefficients, law=law)
     n_static = static.coefficients.N
     scale = np.array([r.reaction.N for r in table.runs]) / n_static
     out = {}
     for key, res in (("paper", p.paper), ("exact", p.exact), ("model", p.generalised)):
         out[key] = np.column_stack([res.Fx, res.Fy, res.Mz]) * scale[:, None]
-    own = []
+    own, shifts = [], []
+    c0 = np.array(static.static_moments.centroid)
     for i, run in enumerate(runs):
         a = analyse(rig / "static.vtu", run, friction=friction)
-        q = predict(a, vx[i : i + 1], vy[i : i + 1], wz[i : i + 1])
-        own.append([q.exact.Fx[0], q.exact.Fy[0], q.exact.Mz[0]])
+        q = friction_resultants(PressureQuadrature.from_polar(a.rolling_map), vx[i], vy[i], wz[i], law)
+        own.append([float(q.Fx[()]), float(q.Fy[()]), float(q.Mz[()])])
+        shifts.append(np.array(a.rolling_moments.centroid) - c0)
     out["own"] = np.array(own)
-    return table, static, out
+    return table, static, out, np.array(shifts)
 
 
 def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], list[dict]]:
@@ -96,6 +121,8 @@ def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], lis
             "Mz_fe": fe[i, 2] / unit[i, 2],
         }
         for key, p in preds.items():
+            if key in EXTENSION and key != "shift":
+                continue  # per run: only the held-out extension
             for j, q in enumerate(("Fx", "Fy", "Mz")):
                 row[f"{q}_{key}"] = p[i, j] / unit[i, j]
         rows.append(row)
@@ -113,8 +140,10 @@ def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], lis
             }
         )
     # the decomposition: (b) - (c) isolates the pressure redistribution, (c) - FE the compliance
-    for label, a, b in (("(b) - (c): pressure redistribution", "exact", "own"),):
-        d = (preds[a] - preds[b]) / unit
+    pairs = [("(b) - (c): pressure redistribution", "exact", "own")]
+    pairs += [(label, key, None) for key, label in EXTENSION.items() if key in preds]
+    for label, a, b in pairs:
+        d = (preds[a] - (fe if b is None else preds[b])) / unit
         df = np.hypot(d[:, 0], d[:, 1])
         summary.append(
             {
@@ -126,6 +155,46 @@ def misfit_table(table, static, preds, friction: float) -> tuple[list[dict], lis
             }
         )
     return rows, summary
+
+
+def extension(table, static, shifts, friction: float) -> tuple[dict, object]:
+    """The load-transfer extension: (n, 3) predictions (all runs' h; cross-validated) and the law.
+
+    The law is identified from each run's centre-of-pressure shift (its own map against
+    the static map) and its friction force per load from the integral of the export's
+    shear traction (not the reactions the predictions are checked against). Held-out
+    groups: the sliding directions and the pure-spin runs.
+    """
+    from dataclasses import replace
+
+    from fepost.friction.law import FrictionLaw
+    from fepost.friction.quadrature import PressureQuadrature
+    from fepost.rig.extension import cross_validate, identify_shift, predict_shifted
+
+    law = FrictionLaw(f=friction)
+    vx, vy, wz = (np.array([getattr(r, k) for r in table.runs]) for k in ("vx", "vy", "wz"))
+    force = np.array([[r.shear.Fx / r.shear.N, r.shear.Fy / r.shear.N] for r in table.runs])
+    groups = [Path(r.source).stem.split("_")[0] for r in table.runs]
+    quad = PressureQuadrature.from_polar(static.static_map)
+    shift_law = identify_shift(shifts, force)
+    scale = np.array([r.reaction.N for r in table.runs])[:, None] / static.coefficients.N
+    fit = predict_shifted(quad, vx, vy, wz, law=shift_law, friction=law).resultants
+    cv = cross_validate(quad, vx, vy, wz, shifts=shifts, forces=force, groups=groups, friction=law)
+    out = {
+        "fit": np.column_stack([fit.Fx, fit.Fy, fit.Mz]) * scale,
+        "shift": np.column_stack([cv.Fx, cv.Fy, cv.Mz]) * scale,
+    }
+    lx, ly = shift_law.interval_x, shift_law.interval_y
+    for key, hx, hy in (
+        ("lo", lx[0], ly[0]),
+        ("hi", lx[1], ly[1]),
+        ("only_y", 0.0, shift_law.h_y),
+        ("only_x", shift_law.h_x, 0.0),
+    ):
+        other = replace(shift_law, h_x=hx, h_y=hy)
+        r = predict_shifted(quad, vx, vy, wz, law=other, friction=law).resultants
+        out[key] = np.column_stack([r.Fx, r.Fy, r.Mz]) * scale
+    return out, shift_law
 
 
 def write_outputs(out: Path, rows, summary, static, n_runs: int) -> None:
@@ -148,6 +217,24 @@ def write_outputs(out: Path, rows, summary, static, n_runs: int) -> None:
             f"| {s['model']} | {s['rms_F']:.4f} | {s['max_F']:.4f} | {s['rms_Mz']:.4f} | {s['max_Mz']:.4f} |"
         )
     (out / "table.txt").write_text("\n".join(md) + "\n")
+
+
+def law_lines(law) -> list[str]:
+    """Markdown: the identified load-transfer law with its intervals."""
+    pct = f"{law.level:.0%}"
+    return [
+        "",
+        f"(e) load transfer identified from the {law.n} runs' own maps (centre-of-pressure shift "
+        "against the friction force per load from the shear-traction integral; least squares "
+        f"through the origin, {pct} intervals):",
+        "",
+        f"| axis | h / mm | {pct} interval / mm | RMS shift / mm | RMS unexplained / mm |",
+        "|---|---|---|---|---|",
+        f"| x | {law.h_x * 1e3:.2f} | {law.interval_x[0] * 1e3:.2f} .. {law.interval_x[1] * 1e3:.2f} | "
+        f"{law.scatter_x * 1e3:.3f} | {law.residual_x * 1e3:.3f} |",
+        f"| y | {law.h_y * 1e3:.2f} | {law.interval_y[0] * 1e3:.2f} .. {law.interval_y[1] * 1e3:.2f} | "
+        f"{law.scatter_y * 1e3:.3f} | {law.residual_y * 1e3:.3f} |",
+    ]
 
 
 def convergence(rig: Path, static, friction: float) -> list[str]:
@@ -197,6 +284,7 @@ def figures(out: Path, rows) -> None:
         "exact": ("C1", "^"),
         "own": ("C2", "v"),
         "model": ("C3", "x"),
+        "shift": ("C4", "d"),
     }
     for d, rs in sorted(dirs.items()):
         rs = rs + spin
@@ -208,7 +296,7 @@ def figures(out: Path, rows) -> None:
             fx = np.array([r[f"Fx_{key}"] for r in rs])
             fy = np.array([r[f"Fy_{key}"] for r in rs])
             m = np.array([r[f"Mz_{key}"] for r in rs])
-            label = "FE (CalculiX)" if key == "fe" else MODELS[key]
+            label = "FE (CalculiX)" if key == "fe" else {**MODELS, **EXTENSION}[key]
             # along and across the sliding direction d (across: +90 degrees from it)
             along, across = fx * c + fy * s_, -fx * s_ + fy * c
             for a, y in zip(ax, (along, across, m), strict=True):
@@ -224,6 +312,30 @@ def figures(out: Path, rows) -> None:
         fig.tight_layout()
         fig.savefig(out / f"rig_{d:03d}.png", dpi=80)
         plt.close(fig)
+
+
+def shift_figure(out: Path, table, shifts, law) -> None:
+    """Each run's centre-of-pressure shift against its friction force per load, with the law."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    force = np.array([[r.shear.Fx / r.shear.N, r.shear.Fy / r.shear.N] for r in table.runs])
+    fig, ax = plt.subplots(1, 2, figsize=(9, 3.6))
+    for j, (q, h, ci) in enumerate((("x", law.h_x, law.interval_x), ("y", law.h_y, law.interval_y))):
+        g = np.linspace(force[:, j].min(), force[:, j].max(), 2)
+        ax[j].plot(force[:, j], shifts[:, j] * 1e3, "ko", ms=4, label="runs' own maps")
+        ax[j].plot(g, h * g * 1e3, "C4", label=f"h_{q} = {h * 1e3:.1f} mm")
+        ax[j].fill_between(g, ci[0] * g * 1e3, ci[1] * g * 1e3, color="C4", alpha=0.25, lw=0)
+        ax[j].set_xlabel(f"F{q} / N (shear-traction integral)")
+        ax[j].set_ylabel(f"d{q}, centre of pressure shift, mm")
+        ax[j].grid(alpha=0.3)
+        ax[j].legend(fontsize=7)
+    fig.suptitle(f"load transfer identified from the {law.n} runs' maps")
+    fig.tight_layout()
+    fig.savefig(out / "rig_shift.png", dpi=80)
+    plt.close(fig)
 
 
 def history_figure(rig: Path, out: Path, runs: list[Path], friction: float) -> None:
@@ -262,9 +374,13 @@ def main(argv=None) -> int:
     if not runs:
         print(f"rig_study: no rig runs in {args.rig}", file=sys.stderr)
         return 2
-    table, static, preds = predictions(args.rig, runs, args.friction)
+    table, static, preds, shifts = predictions(args.rig, runs, args.friction)
+    ext, shift_law = extension(table, static, shifts, args.friction)
+    preds.update(ext)
     rows, summary = misfit_table(table, static, preds, args.friction)
     write_outputs(args.out, rows, summary, static, len(runs))
+    with open(args.out / "table.txt", "a") as fh:
+        fh.write("\n".join(law_lines(shift_law)) + "\n")
     conv = convergence(args.rig, static, args.friction)
     if conv:
         head = [
@@ -277,6 +393,7 @@ def main(argv=None) -> int:
         with open(args.out / "table.txt", "a") as fh:
             fh.write("\n".join(head + conv) + "\n")
     figures(args.out, rows)
+    shift_figure(args.out, table, shifts, shift_law)
     history_figure(args.rig, args.out, runs, args.friction)
     print((args.out / "table.txt").read_text())
     return 0

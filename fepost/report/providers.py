@@ -5,15 +5,18 @@
 imports it, and this module lists the providers, in page order, so no
 provider is imported by the module it depends on (no import cycle).
 
-Today one provider: the load sweep of the sample aircraft tire
+Two providers: the load sweep of the sample aircraft tire
 (``fepost.report.sweepsection.sample_sweep_section``), shown in the report of
-one of its cases. Its module imports the sweep only when it runs.
+one of its cases, and the slide/spin rig runs beside the report's static map
+(``fepost.report.rigsection.rig_section``). Each imports its heavier parts only
+when it runs.
 """
 
 from __future__ import annotations
 
+from .rigsection import rig_section
 from .sections import SectionProvider
 from .sweepsection import sample_sweep_section
 
 #: Providers run by ``fepost report``, in page order.
-DEFAULT_SECTIONS: tuple[SectionProvider, ...] = (sample_sweep_section,)
+DEFAULT_SECTIONS: tuple[SectionProvider, ...] = (sample_sweep_section, rig_section)

@@ -38,19 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError, InputFileError
-
-
-@dataclass(frozen=True)
-class Resultants:
-    """Friction force (N) of the road on the tire and torque about the static patch origin (N m)."""
-
-    Fx: float
-    Fy: float
-    Mz: float
-    N: float
-
-    def to_dict(self) -> dict:
-        return {"Fx": self.Fx, "Fy": self.Fy, "Mz": self.Mz, "N": self.N}
+from .resultants import Resultants
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError, InputFileError
-from .run import Resultants
+from .resultants import Resultants
 
 _G = np.array([-1.0, 1.0]) / np.sqrt(3.0)
 
