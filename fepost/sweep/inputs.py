@@ -12,6 +12,8 @@ written: a typo never leaves an output folder behind.
   matches, sorted.
 
 A file reached twice (the same resolved path) is kept once, at its first place.
+The pieces of a parallel file (the ``.vtu``/``.vtp`` files a ``.pvtu``/``.pvtp``
+among the inputs names) are read through it, never as cases of their own.
 
 One case written in several formats (files of one folder with the same stem,
 ``static_100.vtu`` and ``static_100.e``) is one source: the file whose suffix
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import glob
 import os
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -32,6 +35,11 @@ from pathlib import Path
 from ..errors import ArgumentError
 
 _MAGIC = ("*", "?", "[")
+#: Parallel VTK files, whose pieces are read through them.
+PARALLEL_SUFFIXES = (".pvtu", ".pvtp")
+#: Most bytes of a parallel file looked at for its pieces' names (the files are a few lines).
+_PIECES_HEAD = 1 << 20
+_PIECE_SOURCE = re.compile(rb"<Piece\b[^>]*?\bSource\s*=\s*[\"']([^\"']+)[\"']")
 #: Suffixes in the order a case written in several formats is read (the first present wins).
 PREFERENCE = (".e", ".exo", ".ex2", ".exii", ".vtu", ".vtp", ".vtk")
 
@@ -125,6 +133,30 @@ def one_per_case(sources: Iterable[Source]) -> list[Source]:
     return out
 
 
+def piece_paths(path: str | os.PathLike) -> set[str]:
+    """Resolved paths of the pieces a parallel file (``.pvtu``/``.pvtp``) names.
+
+    Only the names are looked at (the first `_PIECES_HEAD` bytes); the file itself
+    is checked and read by the reader. An unreadable file names no pieces.
+    """
+    p = Path(path)
+    try:
+        with open(p, "rb") as fh:
+            head = fh.read(_PIECES_HEAD)
+    except OSError:
+        return set()
+    return {str((p.parent / m.decode("utf-8", "replace")).resolve()) for m in _PIECE_SOURCE.findall(head)}
+
+
+def without_pieces(sources: list[Source]) -> list[Source]:
+    """``sources`` less the pieces of the parallel files among them."""
+    pieces: set[str] = set()
+    for src in sources:
+        if src.path is not None and Path(src.path).suffix.lower() in PARALLEL_SUFFIXES:
+            pieces |= piece_paths(src.path)
+    return [s for s in sources if s.path is None or s.path not in pieces]
+
+
 def expand_inputs(inputs: Iterable[str | os.PathLike]) -> list[Source]:
     """Expand files, folders and globs into `Source` items, in the order given,
     one per case (`one_per_case`).
@@ -144,4 +176,4 @@ def expand_inputs(inputs: Iterable[str | os.PathLike]) -> list[Source]:
                     continue
                 seen.add(src.path)
             out.append(src)
-    return one_per_case(out)
+    return one_per_case(without_pieces(out))

@@ -10,10 +10,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..reader import EXODUS_SUFFIXES
+from ..reader import EXODUS_SUFFIXES, FRD_SUFFIXES, XDMF_SUFFIXES
 
-#: Suffixes of formats that hold a series of time steps (Exodus II).
-SERIES_SUFFIXES = tuple(s.lower() for s in EXODUS_SUFFIXES)
+#: Suffixes of formats that hold a series of time steps (Exodus II, XDMF time series,
+#: CalculiX .frd increments).
+SERIES_SUFFIXES = tuple(s.lower() for s in (*EXODUS_SUFFIXES, *XDMF_SUFFIXES, *FRD_SUFFIXES))
 
 
 def time_steps(path: str | Path, units=None) -> tuple[float, ...] | None:
