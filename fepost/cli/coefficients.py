@@ -20,7 +20,11 @@ def add_parser(sub) -> None:
             "friction model of the map. Definitions: docs/theory.md; the model: docs/model.md."
         ),
     )
-    p.add_argument("static", metavar="STATIC", help="static contact map (.vtu .vtk .vtp .e .exo)")
+    p.add_argument(
+        "static",
+        metavar="STATIC",
+        help="static contact map (.vtu .vtk .vtp .pvtu .vts .e .xdmf .frd ...: see docs/formats.md)",
+    )
     p.add_argument("--rolling", metavar="ROLLING", help="rolling contact map at the same deflection")
     add_friction_option(p)
     p.add_argument("--json", metavar="PATH", help="write the coefficients as JSON")

@@ -43,7 +43,7 @@ def add_parser(sub) -> None:
         "--simulation",
         required=True,
         metavar="SIM",
-        help="static FE contact map (.vtu .vtk .vtp .e .exo)",
+        help="static FE contact map (.vtu .vtk .vtp .pvtu .vts .e .xdmf .frd ...: see docs/formats.md)",
     )
     p.add_argument(
         "--rolling",

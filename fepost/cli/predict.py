@@ -26,7 +26,11 @@ def add_parser(sub) -> None:
             "rolling map is used (the tire rolls); without, the static map."
         ),
     )
-    p.add_argument("static", metavar="STATIC", help="static contact map (.vtu .vtk .vtp .e .exo)")
+    p.add_argument(
+        "static",
+        metavar="STATIC",
+        help="static contact map (.vtu .vtk .vtp .pvtu .vts .e .xdmf .frd ...: see docs/formats.md)",
+    )
     p.add_argument("--rolling", metavar="ROLLING", help="rolling contact map at the same deflection")
     p.add_argument(
         "--kinematics",
