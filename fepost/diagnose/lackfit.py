@@ -201,11 +201,19 @@ def structure_test(z: np.ndarray, J: np.ndarray, basis: np.ndarray) -> dict:
     this channel's block J_c they are (I − P_J_c) times the noise exactly (linear
     model): F = [SS_basis/q] / [SS_rest/(n − k − q)] ~ F(q, n − k − q).
     """
-    Qb = _rank_basis(J)
-    r0 = z - Qb @ (Qb.T @ z)
-    d = basis - Qb @ (Qb.T @ basis)
-    Qd = _rank_basis(d, rtol=1e-6)
-    q, N, k = Qd.shape[1], z.size, Qb.shape[1]
+    return _partial_f(z, J, basis, rtol=1e-6)
+
+
+def _partial_f(y: np.ndarray, base: np.ndarray, extra: np.ndarray, *, rtol: float = 1e-9) -> dict:
+    """Partial F-test of the columns ``extra`` for ``y`` after the columns ``base``.
+
+    ``rtol``: rank tolerance of the extra columns once ``base`` is projected out.
+    """
+    Qb = _rank_basis(base)
+    r0 = y - Qb @ (Qb.T @ y)
+    d = extra - Qb @ (Qb.T @ extra)
+    Qd = _rank_basis(d, rtol=rtol)
+    q, N, k = Qd.shape[1], y.size, Qb.shape[1]
     if q == 0 or N - k - q < 1:
         return {"p": 1.0, "statistic": 0.0, "df": [0, N - k]}
     ss_d = float(np.sum((Qd.T @ r0) ** 2))
@@ -223,20 +231,7 @@ def trend_test(z: np.ndarray, level: np.ndarray, inv_sigma: np.ndarray, J: np.nd
     base = np.column_stack([J, *static]) if J.size else np.column_stack(static)
     drift = np.column_stack([(tt[:, None] * s.reshape(n, 3)).ravel() for s in static])
     keep = np.ravel(inv_sigma) > 0
-    base, drift = base[keep], drift[keep]
-    Qb = _rank_basis(base)
-    y = z.ravel()[keep]
-    r0 = y - Qb @ (Qb.T @ y)
-    d = drift - Qb @ (Qb.T @ drift)
-    Qd = _rank_basis(d)
-    q = Qd.shape[1]
-    N, k = y.size, Qb.shape[1]
-    if q == 0 or N - k - q < 1:
-        return {"p": 1.0, "statistic": 0.0, "df": [0, N - k]}
-    ss_d = float(np.sum((Qd.T @ r0) ** 2))
-    ss_e = float(np.sum(r0**2)) - ss_d
-    F = (ss_d / q) / (max(ss_e, 1e-300) / (N - k - q))
-    return {"p": float(stats.f.sf(F, q, N - k - q)), "statistic": F, "df": [q, N - k - q]}
+    return _partial_f(z.ravel()[keep], base[keep], drift[keep])
 
 
 def serial_test(z: np.ndarray, level: np.ndarray, order: np.ndarray) -> dict:
