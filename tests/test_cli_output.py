@@ -261,6 +261,47 @@ def test_sigterm_message_is_the_last_line_even_when_finalisers_fail(small_map):
     assert p.stderr == "fepost: terminated by SIGTERM\n"
 
 
+_IN_A_FINALISER = """
+import gc, os, signal, sys, time
+import fepost.cli as cli
+import fepost.cli.coefficients as command
+
+REST = float(sys.argv[2])
+
+class Finaliser:  # the signal lands while a finaliser runs: its exception cannot propagate
+    def __del__(self):
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(0.2)
+
+def run(args):
+    Finaliser()
+    gc.collect()
+    time.sleep(REST)  # the command goes on: the stop must still come
+    print("finished", flush=True)
+    return 0
+
+command.run = run
+sys.argv = ["fepost", "coefficients", sys.argv[1]]
+cli.console_main()
+"""
+
+
+@pytest.mark.parametrize("rest", [0.0, 1.0])
+def test_sigterm_inside_a_finaliser_still_stops(small_map, rest):
+    """A stop raised inside a finaliser is not lost: raised again later, or, if the command ends
+    first, reported as a stop all the same."""
+    p = subprocess.run(
+        [sys.executable, "-c", _IN_A_FINALISER, str(small_map), str(rest)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert p.returncode == 143, (p.stdout, p.stderr)
+    assert p.stderr == "fepost: terminated by SIGTERM\n"
+    if rest:
+        assert "finished" not in p.stdout  # stopped in the sleep, not after it
+
+
 def test_sigkill_litter_is_removed_by_the_next_run(small_map, tmp_path, capsys):
     out = tmp_path / "rep"
     p = _start_report(small_map, out)

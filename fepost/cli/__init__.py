@@ -129,6 +129,7 @@ class _Run:
     def __init__(self) -> None:
         self.debug = False
         self.signum: int | None = None
+        self.reported = False
 
     def show_warning(self, message, category, filename, lineno, file=None, line=None) -> None:
         """``warnings.showwarning``: fepost's warnings as one line, others only with --debug."""
@@ -146,12 +147,24 @@ class _Run:
         a SIGALRM 50 ms later that checks again (`on_alarm`).
         """
         self.signum = self.signum or signum
-        if not self.debug:
-            # The exception unwinds through half-built objects (a renderer stopped in its
-            # constructor); their finalisers then fail, and Python would print each such
-            # failure as "Exception ignored in ..." after the one-line message.
-            sys.unraisablehook = _ignore_unraisable
+        # The exception unwinds through half-built objects (a renderer stopped in its
+        # constructor); their finalisers then fail, and Python would print each such
+        # failure as "Exception ignored in ..." after the one-line message. And when the
+        # signal lands inside a finaliser, the stop itself is such an "ignored" exception.
+        sys.unraisablehook = self.on_unraisable
         self.on_alarm(signal.SIGALRM, frame)
+
+    def on_unraisable(self, unraisable) -> None:
+        """``sys.unraisablehook`` after a stopping signal.
+
+        A stop raised where Python cannot propagate it (a finaliser, a weakref
+        callback) would be lost: it is raised again `_RECHECK` later, in whatever
+        ordinary frame runs then. Finalisers' own errors stay quiet (shown with --debug).
+        """
+        if issubclass(unraisable.exc_type, KeyboardInterrupt | Terminated):
+            signal.setitimer(signal.ITIMER_REAL, _RECHECK)
+        elif self.debug:
+            sys.__unraisablehook__(unraisable)
 
     def on_alarm(self, signum, frame) -> None:
         if self.signum is None:
@@ -166,15 +179,13 @@ class _Run:
     def stopped(self) -> int:
         """Report the recorded signal; the exit status 128 + signal number (130 for Ctrl-C)."""
         assert self.signum is not None
-        if self.signum == signal.SIGINT:
-            _say("fepost: interrupted")
-        else:
-            _say(f"fepost: terminated by {signal.Signals(self.signum).name}")
+        if not self.reported:  # once, whichever way the stop came up
+            self.reported = True
+            if self.signum == signal.SIGINT:
+                _say("fepost: interrupted")
+            else:
+                _say(f"fepost: terminated by {signal.Signals(self.signum).name}")
         return 128 + self.signum
-
-
-def _ignore_unraisable(unraisable) -> None:
-    """``sys.unraisablehook`` after a stopping signal: finalisers' errors stay quiet."""
 
 
 #: Delay (s) before a signal that arrived during an import is checked again.
@@ -324,7 +335,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         warnings.showwarning = run.show_warning
         try:
             with _signals_unwind(run):
-                return _run(argv, run)
+                status = _run(argv, run)
+            # a stop whose exception was swallowed on its way up (e.g. by a library's
+            # `except BaseException`) still ends the run as a stop
+            return status if run.signum is None else run.stopped()
         except KeyboardInterrupt:
             run.signum = run.signum or signal.SIGINT
             return run.stopped()
