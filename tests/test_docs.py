@@ -20,7 +20,7 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 DOCS = REPO / "docs"
-#: Pages the docs engineer writes; others' pages (reading, diagnose, model, sweep,
+#: The core pages of the site; the other pages (reading, diagnose, model, sweep, rig,
 #: cli-exit-codes) join the nav when their files exist.
 CORE_PAGES = ("index.md", "tutorial.md", "theory.md", "formats.md", "cli.md", "api.md")
 
