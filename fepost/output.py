@@ -148,24 +148,15 @@ def write_text_atomic(path: str | Path, text: str) -> Path:
         return _write_through(given, text)
     if not folder.is_dir():
         raise OutputError(f"{given}: folder {folder} does not exist")
-    remove_stale_temporaries(folder)
-    tmp = folder / _temporary_name(path.name)
-    try:
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-    except OSError as exc:
-        raise OutputError(f"{given}: cannot write ({exc.strerror or exc})") from None
-    try:
+    with atomic_path(path, name=given) as tmp:
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        except OSError as exc:
+            raise OutputError(f"{given}: cannot write ({exc.strerror or exc})") from None
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise OutputError(f"{given}: cannot write ({exc.strerror or exc})") from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
     return given
 
 
@@ -179,14 +170,15 @@ def _write_through(path: Path, text: str) -> Path:
 
 
 @contextmanager
-def atomic_path(path: str | Path) -> Iterator[Path]:
+def atomic_path(path: str | Path, *, name: str | Path | None = None) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` (not created) for a writer that makes its own
     file (pyarrow, matplotlib); renamed over ``path`` when the block ends, removed on error.
 
     The writer creates the file with the usual mode masked by the umask, unlike
-    `tempfile.mkstemp`'s private 0600.
+    `tempfile.mkstemp`'s private 0600. Errors name ``name`` (default ``path``).
     """
     path = Path(path)
+    name = path if name is None else name
     folder = _folder_of(path)
     remove_stale_temporaries(folder)
     tmp = folder / _temporary_name(path.name)
@@ -195,7 +187,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         os.replace(tmp, path)
     except OSError as exc:
         tmp.unlink(missing_ok=True)
-        raise OutputError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        raise OutputError(f"{name}: cannot write ({exc.strerror or exc})") from None
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
