@@ -123,19 +123,27 @@ def test_arrays_arrive_intact_as_views_of_one_receiving_map():
         assert got[name].ctypes.data % 64 == 0
 
 
-def _lying_send(fd, payload, ack):
+def _lying_send(fd, payload, ack, shared=None):
     # a header that declares far more than a reading child can hold (a compromised child)
-    os.write(fd, transfer.LEN.pack(10) + transfer.LEN.pack(1) + transfer.LEN.pack(1 << 62) + bytes(8))
+    head = transfer.LEN.pack(10) + transfer.LEN.pack(1) + transfer.LEN.pack(transfer.IN_CHILD)
+    os.write(fd, head + transfer.LEN.pack(1 << 62) + bytes(8))
 
 
-def _short_send(fd, payload, ack):
+def _lying_file_send(fd, payload, ack, shared=None):
+    # buffers said to lie in the shared memory file beyond its end (a compromised child)
+    head = transfer.LEN.pack(10) + transfer.LEN.pack(1) + transfer.LEN.pack(transfer.IN_FILE)
+    os.write(fd, head + transfer.LEN.pack(4096) + transfer.LEN.pack(1 << 40) + bytes(10))
+
+
+def _short_send(fd, payload, ack, shared=None):
     # the header of a real answer (with addresses the caller cannot copy from), then the
     # child stops after a little of its buffers (killed mid-transfer)
     buffers = []
     head = __import__("pickle").dumps(payload, protocol=5, buffer_callback=buffers.append)
     raws = [b.raw() for b in buffers]
     table = b"".join(transfer.LEN.pack(r.nbytes) + transfer.LEN.pack(8) for r in raws)
-    os.write(fd, transfer.LEN.pack(len(head)) + transfer.LEN.pack(len(raws)) + table + head)
+    sizes = transfer.LEN.pack(len(head)) + transfer.LEN.pack(len(raws)) + transfer.LEN.pack(transfer.IN_CHILD)
+    os.write(fd, sizes + table + head)
     assert os.read(ack, 1) == b"p"
     os.write(fd, bytes(raws[0][:1000]))
 
@@ -155,6 +163,7 @@ def test_buffers_are_copied_straight_from_the_child_where_allowed(monkeypatch):
         return copies[-1]
 
     monkeypatch.setattr(transfer, "copy_from", spy)
+    monkeypatch.setattr(transfer, "shared_file", lambda: None)  # no memory file: the copy path
     got = isolate.call(_array, what="big")
     np.testing.assert_array_equal(got["a"], np.arange(3_000_000, dtype=float))
     if copies != [True]:
@@ -163,6 +172,7 @@ def test_buffers_are_copied_straight_from_the_child_where_allowed(monkeypatch):
 
 def test_buffers_come_through_the_pipe_where_the_caller_cannot_copy_them(monkeypatch):
     monkeypatch.setattr(transfer, "copy_from", _copy_refused)
+    monkeypatch.setattr(transfer, "shared_file", lambda: None)
     got = isolate.call(_mixed_arrays, what="big")
     for name, arr in _mixed_arrays().items():
         np.testing.assert_array_equal(got[name], arr)
@@ -172,6 +182,7 @@ def test_buffers_come_through_the_pipe_where_the_caller_cannot_copy_them(monkeyp
     "send,pattern",
     [
         (_lying_send, r"^f\.vtu: the file reader sent a malformed answer: corrupt or malformed file$"),
+        (_lying_file_send, r"^f\.vtu: the file reader sent a malformed answer: corrupt or malformed file$"),
         (_short_send, r"^f\.vtu: the file reader failed \(exit status 0\): corrupt or malformed file$"),
     ],
 )

@@ -182,10 +182,15 @@ def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.
     speed = np.multiply(wx, wx)
     speed += wy * wy
     np.sqrt(speed, out=speed)
-    odd = ~((speed > 1e-150) & (speed < 1e150))
-    if odd.any():
+    # two reductions decide whether any square could have under- or overflowed (rare)
+    if not (speed.min(initial=np.inf) > 1e-150 and speed.max(initial=0.0) < 1e150):
+        odd = ~((speed > 1e-150) & (speed < 1e150))
         speed[odd] = np.hypot(wx[odd], wy[odd])
-    inv = np.divide(1.0, speed, out=np.zeros_like(speed), where=speed > 0)
+    if law.depends_on_speed:
+        inv = np.divide(1.0, speed, out=np.zeros_like(speed), where=speed > 0)
+    else:  # |w| is not needed after this: 1/|w| in its place (0 at the centre of rotation)
+        where = True if speed.min(initial=np.inf) > 0 else speed > 0  # 0 stays 0
+        inv = np.divide(1.0, speed, out=speed, where=where)
     wx *= inv
     wy *= inv
     ncol = nodes.bx.shape[1]
@@ -291,12 +296,17 @@ def friction_resultants(
     setting = _Setting(quad=quad, law=law, sigma_ref=sigma_ref, order=order)
     workers = threads or os.cpu_count() or 1
     big = vx.size * quad.x.size >= KERNEL_MIN_ELEMENTS
-    if backend == "numpy" or (backend == "auto" and not (nodesums.AVAILABLE and big)):
-        sx, sy = _numpy_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
-    else:
-        sx, sy = _compiled_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
+    centres = _centres(setting, vx=vx, vy=vy, wz=wz)
+    with ThreadPoolExecutor(max_workers=1) as side:
+        # the polar moments about the centres need no node sums: they are computed meanwhile
+        rays = side.submit(ray_integrals, quad.domain, centres[1], centres[2]) if centres[0].size else None
+        if backend == "numpy" or (backend == "auto" and not (nodesums.AVAILABLE and big)):
+            sx, sy = _numpy_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
+        else:
+            sx, sy = _compiled_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
+        r = rays.result() if rays is not None else None
     with threadpool_limits(limits=1, user_api="blas"):
-        fx, fy, mz = _finish(setting, vx=vx, vy=vy, wz=wz, sx=sx, sy=sy)
+        fx, fy, mz = _finish(setting, vx=vx, vy=vy, wz=wz, sx=sx, sy=sy, centres=centres, rays=r)
     return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))
 
 
@@ -351,29 +361,39 @@ def _compiled_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.n
     return sx, sy
 
 
-def _finish(setting: _Setting, *, vx, vy, wz, sx, sy) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(F_x, F_y, M_z) from the node sums, with the ICR subtraction where it applies."""
-    alpha = setting.law.anisotropy
-    fx = -sx[:, 0]
-    fy = -alpha * sy[:, 0]
-    mz = -(alpha * sy[:, 1] - sx[:, 1])
+def _centres(setting: _Setting, *, vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(indices, p0x, p0y) of the points whose centre of rotation p0 lies inside the domain
+    (where the subtraction applies; none without it)."""
     if not setting.order:
-        return fx, fy, mz
+        return np.empty(0, np.int64), np.empty(0), np.empty(0)
     spin = wz != 0
     p0x = np.zeros(vx.size)
     p0y = np.zeros(vx.size)
     p0x[spin] = -vy[spin] / wz[spin]
     p0y[spin] = vx[spin] / wz[spin]
     i = np.flatnonzero(spin & (setting.quad.domain.level(p0x, p0y) < 1.0))
+    return i, p0x[i], p0y[i]
+
+
+def _finish(
+    setting: _Setting, *, vx, vy, wz, sx, sy, centres, rays
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(F_x, F_y, M_z) from the node sums, with the ICR subtraction where it applies
+    (``centres`` from `_centres`, ``rays`` the `ray_integrals` about them)."""
+    alpha = setting.law.anisotropy
+    fx = -sx[:, 0]
+    fy = -alpha * sy[:, 0]
+    mz = -(alpha * sy[:, 1] - sx[:, 1])
+    i, px, py = centres
     if i.size:
-        dx, dy, dm = _subtraction(setting, px=p0x[i], py=p0y[i], sgn=np.sign(wz[i]), X=sx[i], Y=sy[i])
+        dx, dy, dm = _subtraction(setting, px=px, py=py, sgn=np.sign(wz[i]), X=sx[i], Y=sy[i], rays=rays)
         fx[i] += dx
         fy[i] += dy
         mz[i] += dm
     return fx, fy, mz
 
 
-def _subtraction(setting: _Setting, *, px, py, sgn, X, Y) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _subtraction(setting: _Setting, *, px, py, sgn, X, Y, rays) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For points whose ICR p0 = (px, py) is inside, with node sums X, Y (rows of sx, sy):
     the change of (F_x, F_y, M_z) when the node sums of L ŵ, L = g0 + G·(p − p0), are
     swapped for their exact integrals over the domain."""
@@ -392,8 +412,7 @@ def _subtraction(setting: _Setting, *, px, py, sgn, X, Y) -> tuple[np.ndarray, n
     node_m = alpha * (c0 * Y[:, 3] + gx * Y[:, 5] + gy * Y[:, 6]) - (
         c0 * X[:, 4] + gx * X[:, 5] + gy * X[:, 6]
     )
-    r = ray_integrals(quad.domain, px, py)
-    ix, iy, cc, cs, ss, qccc, qccs, qcss, qsss = r.T
+    ix, iy, cc, cs, ss, qccc, qccs, qcss, qsss = rays.T
     exact_x = sgn * (-g0 * iy - (gx * cs + gy * ss))
     exact_y = sgn * (g0 * ix + gx * cc + gy * cs)
     exact_m = sgn * (

@@ -262,7 +262,7 @@ def _chatter(fd: int, limit: int = 1 << 16) -> str:
         return ""
 
 
-def _child_main(wfd: int, ack: int, func, args, kwargs, nbytes: int) -> None:
+def _child_main(wfd: int, ack: int, shared: int | None, func, args, kwargs, nbytes: int) -> None:
     afterfork.settle()  # first: locks of the caller's other threads are held for ever here
     import faulthandler
 
@@ -290,10 +290,10 @@ def _child_main(wfd: int, ack: int, func, args, kwargs, nbytes: int) -> None:
     caught = [(w.category, str(w.message)) for w in rec if issubclass(w.category, FepostWarning)]
     text = _chatter(cap)
     try:
-        transfer.send(wfd, (payload, caught, text), ack)
+        transfer.send(wfd, (payload, caught, text), ack, shared)
     except Exception as exc:  # the result itself could not be pickled: say so
         other = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
-        transfer.send(wfd, (other, caught, text), ack)
+        transfer.send(wfd, (other, caught, text), ack, shared)
 
 
 # ----------------------------------------------------------------------------- parent side
@@ -349,6 +349,7 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
 
     rfd, wfd = os.pipe()
     ack_r, ack_w = os.pipe()
+    shared = transfer.shared_file()
     if hasattr(fcntl, "F_SETPIPE_SZ"):
         try:
             fcntl.fcntl(wfd, fcntl.F_SETPIPE_SZ, _PIPE_SIZE)
@@ -369,7 +370,7 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
         try:
             os.close(rfd)
             os.close(ack_w)
-            _child_main(wfd, ack_r, func, args, kwargs, nbytes)
+            _child_main(wfd, ack_r, shared, func, args, kwargs, nbytes)
         except BaseException:
             code = 70
         finally:
@@ -377,11 +378,11 @@ def _fork(func, args, kwargs, what, nbytes, timeout):
     try:
         os.close(wfd)
         os.close(ack_r)
-        reader = transfer.Reader(rfd, time.monotonic() + timeout, ack_w)
+        reader = transfer.Reader(rfd, time.monotonic() + timeout, ack_w, shared)
         _restore_signals(old_mask)  # a signal that came meanwhile is handled here
     except BaseException:
         _reap(pid, kill=True)
-        for fd in (rfd, ack_w):
+        for fd in (rfd, ack_w, shared if shared is not None else -1):
             try:
                 os.close(fd)
             except OSError:
@@ -409,7 +410,7 @@ def _finish(pid: int, reader: transfer.Reader, what: str, timeout: float, nbytes
     killed = malformed = False
     try:
         try:
-            received = transfer.receive(pid, reader, _budget(nbytes))
+            received = transfer.receive(pid, reader, _budget(nbytes), reader.shared)
         except transfer.Deadline:
             killed = True
         except EOFError:  # the child stopped short: its exit status says why

@@ -1,18 +1,24 @@
 """How the reading child's answer travels to the caller (`fepost.reader.isolate`).
 
 The answer is a pickle (protocol 5) whose large numpy buffers go out of band.
-The child writes, through a pipe, a header (the pickle's length, then the size
-and address of each out-of-band buffer) and the pickle, and waits for the
-caller's word on a second pipe:
+The child writes, through a pipe, a header (the pickle's length, the number of
+out-of-band buffers, where they are, then the size and place of each) and the pickle.
 
-* ``v``: the caller copied the buffers straight out of the waiting child with
-  ``process_vm_readv`` (Linux; one copy, no scheduling round trips);
-* ``p``: they follow through the pipe (where that copy is not allowed).
+* Shared file (Linux): the caller made an anonymous memory file (``memfd``)
+  before the fork; the child writes the buffers into it (the kernel copies them
+  into its pages: no page faults, no huge-page compaction) and the caller maps
+  the file: its arrays are views of pages the child filled, nothing is copied
+  again. The child does not wait for the caller.
+* Otherwise the child waits for the caller's word on a second pipe: ``v``, the
+  caller copied the buffers straight out of the waiting child with
+  ``process_vm_readv``; ``p``, they follow through the pipe. They land in one
+  anonymous private map in the caller, backed by transparent huge pages where
+  the system offers them.
 
-The buffers land in one anonymous private map in the caller, backed by
-transparent huge pages where the system offers them; the caller's arrays are
-views of it. (A shared map made before the fork cost 2-3x as much: its pages
-fault one by one in both processes and are slow to free.)
+(A shared map made before the fork cost 2-3x as much as either: its pages fault
+one by one in both processes and are slow to free. The copy into a huge-page
+map stalled now and then for 0.2-0.3 s on a 90 MB answer while the kernel
+compacted memory for the huge pages.)
 
 ``process_vm_readv`` is reached through `ctypes`: neither the standard
 library nor numpy wraps it.
@@ -47,17 +53,55 @@ def _write_all(fd: int, data) -> None:
         view = view[n:]
 
 
-def send(fd: int, payload: Any, ack: int | None = None) -> None:
-    """Write the payload: its header (size and address of each out-of-band buffer), the pickle,
-    then wait for the caller's word on ``ack``: it has copied the buffers itself (``v``), or they
-    follow through the pipe (``p``)."""
+#: Where the buffers are: the child's memory (the caller copies them or they follow the pickle) ...
+IN_CHILD = 0
+#: ... or the shared memory file, at the offsets the header gives.
+IN_FILE = 1
+
+
+def shared_file() -> int | None:
+    """An anonymous memory file for a child's buffers (made before the fork), or None where
+    the system has none."""
+    if not hasattr(os, "memfd_create"):
+        return None
+    try:
+        return os.memfd_create("fepost-read-answer", getattr(os, "MFD_CLOEXEC", 0))
+    except OSError:
+        return None
+
+
+def _into_file(shared: int, raws: list[memoryview]) -> list[int] | None:
+    """Write the buffers into the memory file at aligned offsets; their offsets, or None if it failed."""
+    offsets, pos = [], 0
+    try:
+        for r in raws:
+            offsets.append(pos)
+            view, at = r.cast("B"), pos
+            while view.nbytes:
+                n = os.pwrite(shared, view, at)
+                view, at = view[n:], at + n
+            pos += -(-r.nbytes // _ALIGN) * _ALIGN
+        os.ftruncate(shared, max(pos, 1))
+    except OSError:
+        return None
+    return offsets
+
+
+def send(fd: int, payload: Any, ack: int | None = None, shared: int | None = None) -> None:
+    """Write the payload: its header (where the out-of-band buffers are, the size and place of
+    each), then the pickle. With the memory file ``shared``, the buffers are written into it
+    first; else, after the pickle, wait for the caller's word on ``ack``: it has copied the
+    buffers itself (``v``), or they follow through the pipe (``p``)."""
     buffers: list[pickle.PickleBuffer] = []
     head = pickle.dumps(payload, protocol=5, buffer_callback=buffers.append)
     raws = [b.raw() for b in buffers]
-    table = b"".join(LEN.pack(r.nbytes) + LEN.pack(_address(r)) for r in raws)
-    _write_all(fd, LEN.pack(len(head)) + LEN.pack(len(raws)) + table)
+    offsets = _into_file(shared, raws) if shared is not None and raws else None
+    where = IN_FILE if offsets is not None else IN_CHILD
+    places = offsets if offsets is not None else [_address(r) for r in raws]
+    table = b"".join(LEN.pack(r.nbytes) + LEN.pack(at) for r, at in zip(raws, places, strict=True))
+    _write_all(fd, LEN.pack(len(head)) + LEN.pack(len(raws)) + LEN.pack(where) + table)
     _write_all(fd, head)
-    if not raws:
+    if not raws or where == IN_FILE:
         return
     how = os.read(ack, 1) if ack is not None else b"p"
     if how == b"p":
@@ -84,10 +128,11 @@ class Deadline(Exception):
 class Reader:
     """The caller's end of the pipes: reads with a deadline, replies ``v``/``p``."""
 
-    def __init__(self, fd: int, deadline: float, ack: int | None = None):
+    def __init__(self, fd: int, deadline: float, ack: int | None = None, shared: int | None = None):
         self.f = io.FileIO(fd, "rb", closefd=True)
         self.deadline = deadline
         self.ack = ack  # the write end of the caller's reply to the child
+        self.shared = shared  # the memory file the child may write its buffers into
 
     def reply(self, word: bytes) -> None:
         """Tell the child how its buffers travel (it waits for this once its header is sent)."""
@@ -122,13 +167,16 @@ class Reader:
 
     def close(self) -> None:
         self.f.close()
-        if self.ack is not None:
-            os.close(self.ack)
-            self.ack = None
+        for name in ("ack", "shared"):
+            fd = getattr(self, name)
+            if fd is not None:
+                setattr(self, name, None)
+                os.close(fd)
 
 
-def receive(pid: int, reader: Reader, limit: int) -> Any:
-    """The child's answer, unpickled; its arrays are views of one receiving map.
+def receive(pid: int, reader: Reader, limit: int, shared: int | None = None) -> Any:
+    """The child's answer, unpickled; its arrays are views of one map (of the memory file
+    ``shared`` when the child wrote its buffers there).
 
     ``limit`` (bytes) caps what the child may declare.
 
@@ -141,28 +189,41 @@ def receive(pid: int, reader: Reader, limit: int) -> Any:
     ValueError, struct.error, pickle.UnpicklingError
         A malformed answer.
     """
-    sizes = reader.exact(16)
-    nhead, nbuf = LEN.unpack_from(sizes, 0)[0], LEN.unpack_from(sizes, 8)[0]
-    if nbuf > 1 << 20:
-        raise ValueError("too many buffers")
+    sizes = reader.exact(24)
+    nhead, nbuf, where = (LEN.unpack_from(sizes, k)[0] for k in (0, 8, 16))
+    if nbuf > 1 << 20 or where not in (IN_CHILD, IN_FILE) or (where == IN_FILE and shared is None):
+        raise ValueError("malformed header")
     table = reader.exact(16 * nbuf)
     lengths = [LEN.unpack_from(table, 16 * i)[0] for i in range(nbuf)]
-    addresses = [LEN.unpack_from(table, 16 * i + 8)[0] for i in range(nbuf)]
+    places = [LEN.unpack_from(table, 16 * i + 8)[0] for i in range(nbuf)]
     if nhead > limit or sum(lengths) > limit:
         raise ValueError("the child declares more than it could hold")
     head = reader.exact(nhead)
+    if where == IN_FILE:
+        return pickle.loads(head, buffers=_mapped_file(shared, lengths, places))  # type: ignore[arg-type]
     buf, offsets = _receiving_map(lengths)
     view = memoryview(buf) if buf is not None else memoryview(bytearray(0))
     # the arrays are views of the receiving map: no further copy
     bufs = [view[at : at + n] for n, at in zip(lengths, offsets, strict=True)]
     if bufs:
-        if buf is not None and copy_from(pid, buf, offsets, lengths, addresses):
+        if buf is not None and copy_from(pid, buf, offsets, lengths, places):
             reader.reply(b"v")
         else:
             reader.reply(b"p")
             for part in bufs:
                 reader.into(part)
     return pickle.loads(head, buffers=bufs)
+
+
+def _mapped_file(shared: int, lengths: list[int], offsets: list[int]) -> list[memoryview]:
+    """Views of the buffers the child wrote into the memory file (its pages mapped at once)."""
+    size = os.fstat(shared).st_size
+    if any(at < 0 or at + n > size for n, at in zip(lengths, offsets, strict=True)):
+        raise ValueError("a buffer outside the shared file")
+    flags = getattr(mmap, "MAP_SHARED", 0) | getattr(mmap, "MAP_POPULATE", 0)
+    buf = mmap.mmap(shared, size, flags=flags) if flags else mmap.mmap(shared, size)
+    view = memoryview(buf)
+    return [view[at : at + n] for n, at in zip(lengths, offsets, strict=True)]
 
 
 def copy_from(pid: int, buf: mmap.mmap, offsets: list[int], sizes: list[int], addresses: list[int]) -> bool:
@@ -230,7 +291,13 @@ def _receiving_map(sizes: list[int]) -> tuple[mmap.mmap | None, list[int]]:
         pos += -(-n // _ALIGN) * _ALIGN
     if pos == 0:
         return None, offsets
-    size = -(-pos // _HUGE) * _HUGE
+    return huge_map(pos), offsets
+
+
+def huge_map(nbytes: int) -> mmap.mmap:
+    """A private anonymous map of at least ``nbytes`` (> 0), zero-filled, backed by transparent
+    huge pages where the system allows it (one page fault per 2 MB instead of per 4 kB)."""
+    size = -(-nbytes // _HUGE) * _HUGE
     private = getattr(mmap, "MAP_PRIVATE", 0) | getattr(mmap, "MAP_ANONYMOUS", 0)
     buf = mmap.mmap(-1, size, flags=private) if private else mmap.mmap(-1, size)
     if hasattr(mmap, "MADV_HUGEPAGE"):
@@ -238,4 +305,4 @@ def _receiving_map(sizes: list[int]) -> tuple[mmap.mmap | None, list[int]]:
             buf.madvise(mmap.MADV_HUGEPAGE)
         except OSError:
             pass  # no transparent huge pages here: ordinary pages
-    return buf, offsets
+    return buf

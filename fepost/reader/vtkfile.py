@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputFileError
-from .cells import SPECS, VTK_TYPES, check_connectivity
-from .raw import Block, RawMesh
+from .raw import RawMesh
+from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
 
 VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm", ".vts", ".vtr", ".pvtu", ".pvtp")
 #: Parallel files: pieces read one by one and joined.
@@ -44,20 +44,6 @@ _FORMAT_NAMES = {
     ".vtr": "VTK XML rectilinear grid",
     ".pvtu": "VTK parallel XML",
     ".pvtp": "VTK parallel XML",
-}
-#: VTK cell types without area that are passed over (named in the notes): they carry no contact pressure.
-_PASSED_OVER = {2: "poly-vertex", 4: "poly-line", 35: "cubic line", 68: "Lagrange curve", 75: "Bezier curve"}
-#: VTK cell types with area that fepost cannot read: refused by name, so no load is dropped silently.
-_UNSUPPORTED = {
-    6: "triangle-strip",
-    7: "polygon",
-    42: "polyhedron",
-    69: "Lagrange triangle",
-    70: "Lagrange quadrilateral",
-    71: "Lagrange tetrahedron",
-    72: "Lagrange hexahedron",
-    73: "Lagrange wedge",
-    74: "Lagrange pyramid",
 }
 
 
@@ -149,11 +135,16 @@ def read_vtk(
     (the default) a serial XML file's point arrays that they do not choose are not
     decoded (`fepost.reader.vtkselect`); they are read on demand if asked for.
     """
+    from . import vtkdirect
     from .pieces import join_pieces
     from .vtkcheck import check_file
     from .vtkselect import SELECTABLE, plan
 
     suffix = path.suffix.lower()
+    if select and suffix in SELECTABLE and suffix in vtkdirect.DIRECT_SUFFIXES:
+        direct = vtkdirect.read_direct(path, field=field, displacement=displacement)
+        if direct is not None:
+            return direct
     counts = check_file(path)
     reader = _reader_for(suffix)
     ghosts = False
@@ -267,35 +258,17 @@ def _cells(ds) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     from vtkmodules.vtkCommonDataModel import vtkPolyData
 
     if isinstance(ds, vtkPolyData):
-        parts = []
-        for getter, vtype in ((ds.GetVerts, 1), (ds.GetLines, 3), (ds.GetPolys, 7), (ds.GetStrips, 6)):
-            ca = getter()
+        sections = []
+        for name, vtype in POLY_SECTIONS:
+            ca = getattr(ds, f"Get{name}")()
             if ca is None or ca.GetNumberOfCells() == 0:
                 continue
             off = np.asarray(_np(ca.GetOffsetsArray()), np.int64)
-            con = np.asarray(_np(ca.GetConnectivityArray()), np.int64)
-            size = np.diff(off)
-            t = np.full(len(size), vtype, np.uint8)
-            if vtype == 7:
-                t[size == 3] = 5
-                t[size == 4] = 9
-            elif vtype == 3:
-                t[size != 2] = 4
-            elif vtype == 1:
-                t[size != 1] = 2
-            parts.append((t, off, con))
-        if not parts:
-            return np.empty(0, np.uint8), np.zeros(1, np.int64), np.empty(0, np.int64)
-        types = np.concatenate([p[0] for p in parts])
-        cons, offs, base = [], [np.zeros(1, np.int64)], 0
-        for _, off, con in parts:
-            offs.append(off[1:] + base)
-            cons.append(con)
-            base += len(con)
-        return types, np.concatenate(offs), np.concatenate(cons)
+            sections.append((vtype, off, np.asarray(_np(ca.GetConnectivityArray()), np.int64)))
+        return poly_cells(sections)
     cells = ds.GetCells()
     if cells is None or ds.GetNumberOfCells() == 0:
-        return np.empty(0, np.uint8), np.zeros(1, np.int64), np.empty(0, np.int64)
+        return no_cells()
     # GetCellTypes returns the array from VTK 9.6 on (GetCellTypesArray is deprecated there)
     getter = ds.GetCellTypes if _vtk_at_least(9, 6) else ds.GetCellTypesArray
     types = np.asarray(_np(getter()), np.uint8)
@@ -304,88 +277,20 @@ def _cells(ds) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return types, off, con
 
 
-def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
-    pts_parts: list[np.ndarray] = []
-    blocks: list[Block] = []
-    point_pieces: list[dict[str, np.ndarray]] = []
-    sizes: list[int] = []
+def _part(path: Path, leaf) -> Part:
+    """One VTK data set's content as numpy arrays."""
+    ds = _as_unstructured(leaf)
+    n = int(ds.GetNumberOfPoints())
+    pts = np.asarray(_np(ds.GetPoints().GetData()), float).reshape(n, 3)
     components: dict[str, tuple[str, ...]] = {}
-    skipped: dict[str, int] = {}
-    base = 0
-    first_cell = 0
-    conn_size = 0
-    for piece, leaf in enumerate(leaves):
-        ds = _as_unstructured(leaf)
-        n = int(ds.GetNumberOfPoints())
-        pts = np.asarray(_np(ds.GetPoints().GetData()), float).reshape(n, 3)
-        if not np.all(np.isfinite(pts)):
-            bad = int(np.sum(~np.isfinite(pts).all(axis=1)))
-            raise InputFileError(f"{path}: {bad} node coordinates are NaN or infinite")
-        pts_parts.append(pts)
-        point_pieces.append(_data_arrays(path, ds.GetPointData(), n, "point", components))
-        sizes.append(n)
-        types, off, con = _cells(ds)
-        conn_size += len(con)
-        if len(off) != len(types) + 1:
-            raise InputFileError(f"{path}: cell offsets and cell types disagree in length (corrupt file)")
-        if len(types):
-            if off[0] != 0 or np.any(np.diff(off) < 0) or off[-1] != len(con):
-                raise InputFileError(
-                    f"{path}: cell offsets are inconsistent with the connectivity (corrupt file)"
-                )
-            check_connectivity(con, n, str(path))
-        cdata = _data_arrays(path, ds.GetCellData(), len(types), "cell", components)
-        where = f" of piece {piece + 1}" if len(leaves) > 1 else ""
-        present = np.flatnonzero(np.bincount(types, minlength=256)) if len(types) else np.empty(0, np.int64)
-        single = len(present) == 1
-        for t in present:
-            sel: np.ndarray | slice = slice(None) if single else np.flatnonzero(types == t)
-            spec = VTK_TYPES.get(int(t))
-            count = len(types) if isinstance(sel, slice) else len(sel)
-            if spec is None:
-                if int(t) in _PASSED_OVER:
-                    skipped[_PASSED_OVER[int(t)]] = skipped.get(_PASSED_OVER[int(t)], 0) + count
-                    continue
-                what = _UNSUPPORTED.get(int(t), "an unknown type")
-                raise InputFileError(
-                    f"{path}: {count} cell(s) of VTK type {int(t)} ({what}) cannot be read: "
-                    "convert them to triangles or quadrilaterals (or the file is corrupt)"
-                )
-            canon, perm = spec
-            k = SPECS[canon].n_nodes
-            if single and len(con) == k * count:
-                # one cell type throughout: the offsets must step by k, the connectivity is a (m, k) view
-                if np.any(off != np.arange(0, k * count + 1, k)):
-                    raise InputFileError(
-                        f"{path}: cell offsets are inconsistent with {canon} cells (corrupt file)"
-                    )
-                conn = con.reshape(count, k)
-            else:
-                idx = sel if isinstance(sel, np.ndarray) else np.arange(len(types))
-                size = off[idx + 1] - off[idx]
-                if np.any(size != k):
-                    raise InputFileError(
-                        f"{path}: {canon} cells with {int(size[size != k][0])} nodes instead of {k} "
-                        "(corrupt file)"
-                    )
-                conn = con[off[idx][:, None] + np.arange(k)[None, :]]
-            if perm is not None:
-                conn = conn[:, list(perm)]
-            if base:
-                conn = conn + base
-            block = Block(f"{canon.upper()} cells{where} ({count})", canon, conn, first_cell, piece)
-            for name, arr in cdata.items():
-                block.cell_data.add(name, arr[sel])
-            blocks.append(block)
-            first_cell += count
-        base += n
-    points = pts_parts[0] if len(pts_parts) == 1 else np.concatenate(pts_parts)
-    raw = RawMesh(path=str(path), format=fmt, points=points, blocks=blocks, components=components)
-    for name, arr in _join(point_pieces, sizes).items():
-        raw.point_data.add(name, arr)
-    raw.skipped = skipped
-    raw.connectivity_size = conn_size
-    return raw
+    point_data = _data_arrays(path, ds.GetPointData(), n, "point", components)
+    types, off, con = _cells(ds)
+    cell_data = _data_arrays(path, ds.GetCellData(), len(types), "cell", components)
+    return Part(pts, types, off, con, point_data, cell_data, components)
+
+
+def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
+    return assemble(path, [_part(path, leaf) for leaf in leaves], fmt)
 
 
 def _numeric(arr) -> bool:
@@ -415,24 +320,6 @@ def _data_arrays(path, data, n: int, where: str, components) -> dict[str, np.nda
             if any(names):
                 components.setdefault(name, names)
         out[name] = a
-    return out
-
-
-def _join(pieces: list[dict[str, np.ndarray]], sizes: list[int]) -> dict[str, np.ndarray]:
-    """Point arrays of several pieces end to end; a piece without an array gets zeros there."""
-    if len(pieces) == 1:
-        return pieces[0]
-    shapes: dict[str, tuple] = {}
-    for p in pieces:
-        for name, a in p.items():
-            shapes.setdefault(name, a.shape[1:])
-    out = {}
-    for name, tail in shapes.items():
-        parts: list[np.ndarray] = []
-        for p, n in zip(pieces, sizes, strict=True):
-            got = p.get(name)
-            parts.append(got if got is not None and got.shape[1:] == tail else np.zeros((n, *tail)))
-        out[name] = np.concatenate(parts)
     return out
 
 

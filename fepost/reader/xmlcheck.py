@@ -72,7 +72,9 @@ def _int(path: Path, attrs: dict[str, str], key: str, default: int | None = None
 
 
 @dataclass
-class _Array:
+class DataArray:
+    """A ``DataArray`` tag: its attributes, the element it sits in, where its inline content lies."""
+
     attrs: dict[str, str]
     section: str
     start: int  # inline content (ascii numbers or base64): data[start:end]
@@ -80,9 +82,11 @@ class _Array:
 
 
 @dataclass
-class _Piece:
+class Piece:
+    """A ``Piece`` tag: its attributes and its data arrays in file order."""
+
     attrs: dict[str, str]
-    arrays: list[_Array] = field(default_factory=list)
+    arrays: list[DataArray] = field(default_factory=list)
 
 
 class Xml:
@@ -101,6 +105,7 @@ class Xml:
                 path, "refused: XML with DOCTYPE/ENTITY declarations (not a VTK file; entity expansion)"
             )
         root, pieces, refs = self._scan(limit)
+        self.root, self.pieces = root, pieces  # the structure, for the direct decoder (`vtkdirect`)
         want = _ROOT.get(suffix)
         if root.get("type") != want:
             raise bad_file(path, f"not a VTK XML {want} file: VTKFile type={root.get('type')!r}")
@@ -144,7 +149,7 @@ class Xml:
         data = self.data
         stack: list[bytes] = []
         root: dict[str, str] | None = None
-        pieces: list[_Piece] = []
+        pieces: list[Piece] = []
         refs: list[str] = []
         section = ""
         for m in self._tags(limit):
@@ -168,13 +173,13 @@ class Xml:
                     raise bad_file(self.path, "no VTKFile element: not a VTK XML file")
                 root = attrs
             if name == b"Piece":
-                pieces.append(_Piece(attrs))
+                pieces.append(Piece(attrs))
             elif name in _SECTIONS or name == b"FieldData":
                 section = name.decode()
             elif name == b"DataArray" and pieces:
                 end = data.find(b"<", m.end(), limit)
                 end = m.end() if selfclose else (end if end >= 0 else limit)
-                pieces[-1].arrays.append(_Array(attrs, section, m.end(), end))
+                pieces[-1].arrays.append(DataArray(attrs, section, m.end(), end))
             elif name == b"DataSet" and "file" in attrs:
                 refs.append(attrs["file"])
             if not selfclose:
@@ -224,7 +229,7 @@ class Xml:
 
     # -- array lengths --
 
-    def _values(self, arr: _Array) -> int | None:
+    def _values(self, arr: DataArray) -> int | None:
         """Number of values the array holds (None: a string array, not counted)."""
         a = arr.attrs
         dtype = a.get("type", "")
@@ -351,7 +356,7 @@ class Xml:
             raise bad_file(self.path, f"Extent={attrs['Extent']!r} is out of range")
         return dims  # type: ignore[return-value]
 
-    def _piece(self, piece: _Piece, suffix: str) -> int:
+    def _piece(self, piece: Piece, suffix: str) -> int:
         path = self.path
         dims: tuple[int, int, int] | None = None
         if suffix in (".vts", ".vtr"):

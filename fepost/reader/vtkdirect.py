@@ -1,0 +1,508 @@
+"""Serial VTK XML files (``.vtu .vtp``) decoded with numpy, zlib and lzma instead of VTK.
+
+Why fepost decodes these itself
+-------------------------------
+A contact field needs the points, the cells, the pressure and the displacement.
+VTK's XML readers are general: on a 1.08 M-node surface ``.vtu`` (41 MB, zlib,
+inline base64) importing them takes 0.38 s, asking for the arrays' names
+(``UpdateInformation``) parses the whole inline file once (0.26 s) and the read
+parses it again and inflates every block on one thread (0.80 s). The binary
+layout of the format is small and documented ("VTK File Formats", VTK User's
+Guide): a length header or a block table, then raw, zlib or LZMA blocks, inline
+in base64 or appended raw or base64. Decoding only the arrays the field needs,
+inflating the blocks on two threads (zlib and lzma release the GIL), takes
+0.3 s on that file and never imports VTK.
+
+What is decoded here, and what is not
+-------------------------------------
+The structure comes from the pre-read check (`fepost.reader.xmlcheck`), which
+has already compared every array's length with what its piece declares. Taken:
+one ``Piece``; every array binary (inline base64, appended raw or base64);
+uncompressed, zlib or LZMA; ``UInt32``/``UInt64`` headers; either byte order.
+Anything else — ASCII arrays, LZ4, several pieces, arrays that share a name,
+cell types outside 0-255 — returns None and VTK reads the file as before.
+
+The point arrays the field does not need are not decoded: they stay in the
+`fepost.reader.raw.RawMesh` as loaders (the same choice as
+`fepost.reader.vtkselect` makes for VTK). The arrays then go through the
+assembly VTK's path uses (`fepost.reader.vtkassemble`), so both give identical
+meshes (``tests/test_read_direct_vtk.py`` compares them on every writer's file).
+A block that does not inflate to its declared size, bad base64 or a file
+changed under a loader is an `fepost.errors.InputFileError` naming the file and
+the array.
+"""
+
+from __future__ import annotations
+
+import binascii
+import lzma
+import mmap
+import os
+import struct
+import zlib
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FepostError, InputFileError
+from .names import ArrayInfo, pick_displacement, pick_field
+from .raw import LazyArrays, RawMesh
+from .transfer import huge_map
+from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
+from .xmlcheck import DataArray, Xml
+
+#: Suffixes the direct decoder may take (serial unstructured grids and polygonal data).
+DIRECT_SUFFIXES = (".vtu", ".vtp")
+#: Numpy type of each VTK XML ``type`` attribute (byte order applied from the file).
+_TYPES = {
+    "Int8": "i1",
+    "UInt8": "u1",
+    "Int16": "i2",
+    "UInt16": "u2",
+    "Int32": "i4",
+    "UInt32": "u4",
+    "Int64": "i8",
+    "UInt64": "u8",
+    "Float32": "f4",
+    "Float64": "f8",
+}
+_INFLATE: dict[str, Callable[[bytes], bytes]] = {
+    "vtkZLibDataCompressor": zlib.decompress,
+    "vtkLZMADataCompressor": lzma.decompress,
+}
+_FORMATS = {".vtu": "VTK XML (.vtu)", ".vtp": "VTK XML (.vtp)"}
+#: Blocks inflated per thread task (a compressed array of more blocks is shared by two threads).
+_BATCH = 64
+_SPACE = b" \t\r\n"
+#: Buffers from this size (bytes) up are mapped on huge pages.
+_HUGE_FROM = 4 << 20
+_CELL_SECTIONS = ("Cells", *(name for name, _ in POLY_SECTIONS))
+
+
+class _NotHere(Exception):
+    """The file is valid but not one this decoder takes: VTK reads it."""
+
+
+@dataclass(frozen=True)
+class _Format:
+    """What every array of a file shares: header word size, byte order, inflater, appended data."""
+
+    path: Path
+    header: int
+    endian: str
+    inflate: Callable[[bytes], bytes] | None
+    appended: tuple[int, bool] | None  # (first byte, base64?) of the AppendedData
+
+
+def read_direct(path: Path, *, field: str | None = None, displacement: str | None = "auto") -> RawMesh | None:
+    """The `RawMesh` of a serial ``.vtu``/``.vtp`` file, or None where VTK must read it.
+
+    ``field`` and ``displacement`` choose the point arrays decoded now (as in
+    `fepost.reader.read_contact`); the others are decoded when asked for.
+
+    Raises
+    ------
+    InputFileError
+        The file fails the pre-read check or its data does not decode.
+    """
+    suffix = path.suffix.lower()
+    stamp = _stamp(path)
+    with open(path, "rb") as fh:
+        data = _mapped(fh)
+        try:
+            xml = Xml(path, data, 0)
+            try:
+                xml.check()
+            except (OSError, ValueError) as exc:
+                raise InputFileError(f"{path}: cannot read ({exc})") from None
+            try:
+                fmt = _format(xml)
+                piece = _piece(xml)
+                part, lazy = _decode_piece(fmt, data, piece, suffix, field, displacement)
+            except _NotHere:
+                return None
+        finally:
+            _unmap(data)
+    if len(part.points) == 0:
+        raise InputFileError(f"{path}: the file holds no mesh (0 nodes or 0 cells)")
+    raw = assemble(path, [part], _FORMATS[suffix])
+    if lazy:
+        _add_lazy(raw, fmt, piece, lazy, stamp)
+    return raw
+
+
+def _mapped(fh) -> mmap.mmap:
+    """The whole file mapped read-only, its pages mapped at once where Linux allows
+    (``MAP_POPULATE``: one call instead of a page fault per 4 kB as the decoder walks it)."""
+    populate = getattr(mmap, "MAP_POPULATE", 0)
+    if populate and hasattr(mmap, "MAP_SHARED"):
+        try:
+            return mmap.mmap(fh.fileno(), 0, flags=mmap.MAP_SHARED | populate, prot=mmap.PROT_READ)
+        except (OSError, ValueError):
+            pass
+    return mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+
+
+def _unmap(data: mmap.mmap) -> None:
+    """Close the map; while an error's traceback still holds views of it, leave that to the
+    garbage collector (every decoded array is a copy: nothing returned views the map)."""
+    try:
+        data.close()
+    except BufferError:
+        pass
+
+
+def _stamp(path: Path) -> tuple[int, int]:
+    st = os.stat(path)
+    return st.st_size, st.st_mtime_ns
+
+
+def _format(xml: Xml) -> _Format:
+    compressor = xml.root.get("compressor", "")
+    if compressor and compressor not in _INFLATE:
+        raise _NotHere  # LZ4 and unknown compressors: VTK's
+    return _Format(xml.path, xml.header_size, xml.endian, _INFLATE.get(compressor), xml.appended)
+
+
+def _piece(xml: Xml):
+    if len(xml.pieces) != 1:
+        raise _NotHere
+    piece = xml.pieces[0]
+    for arr in piece.arrays:
+        if arr.section != "FieldData" and arr.attrs.get("format", "ascii") not in ("binary", "appended"):
+            raise _NotHere  # ASCII arrays: VTK's
+    return piece
+
+
+def _named(piece, section: str) -> dict[str, DataArray]:
+    """The numeric arrays of ``section`` by name, in file order (strings and unnamed ones passed over)."""
+    out: dict[str, DataArray] = {}
+    for arr in piece.arrays:
+        if arr.section != section:
+            continue
+        name = arr.attrs.get("Name", "")
+        if not name or arr.attrs.get("type") == "String":
+            continue
+        if name in out:
+            raise _NotHere  # two arrays of one name: VTK's rule decides
+        out[name] = arr
+    return out
+
+
+def _components(arr: DataArray) -> tuple[int, tuple[str, ...]]:
+    """(component count, component names as VTK gives them: none unless some are set)."""
+    ncomp = int(arr.attrs.get("NumberOfComponents", "1") or 1)
+    names = [arr.attrs.get(f"ComponentName{k}", "") for k in range(ncomp)] if ncomp > 1 else []
+    return ncomp, tuple(names) if any(names) else ()
+
+
+def _decode_piece(fmt, data, piece, suffix, field, displacement) -> tuple[Part, dict]:
+    points_arrays = [a for a in piece.arrays if a.section == "Points"]
+    npts = int(piece.attrs.get("NumberOfPoints", "0") or 0)
+    if len(points_arrays) != (1 if npts else 0):
+        raise _NotHere
+    point_arrays, cell_arrays = _named(piece, "PointData"), _named(piece, "CellData")
+    keep = _chosen(fmt.path, point_arrays, cell_arrays, field, displacement)
+    with ThreadPoolExecutor(2) as pool:
+        wanted = [a for a in piece.arrays if a.section in _CELL_SECTIONS or a.section == "Points"]
+        wanted += [a for n, a in point_arrays.items() if keep is None or n in keep]
+        wanted += list(cell_arrays.values())
+        jobs = {id(a): _Job(fmt, data, a) for a in wanted}
+        for job in sorted(jobs.values(), key=lambda j: -len(j.out)):
+            job.start(pool)  # the largest first: the two threads finish together
+
+        def decode(arr: DataArray) -> np.ndarray:
+            return jobs[id(arr)].result() if id(arr) in jobs else _values(fmt, data, arr)
+
+        points = decode(points_arrays[0]) if npts else np.empty(0)
+        points = np.asarray(points, float).reshape(npts, 3)
+        types, off, con = _vtu_cells(piece, decode) if suffix == ".vtu" else _vtp_cells(piece, decode)
+        components: dict[str, tuple[str, ...]] = {}
+        point_data = _arrays(point_arrays, npts, decode, components, keep)
+        cell_data = _arrays(cell_arrays, len(types), decode, components, None)
+    lazy = {name: arr for name, arr in point_arrays.items() if name not in point_data}
+    return Part(points, types, off, con, point_data, cell_data, components), lazy
+
+
+def _chosen(path, point_arrays, cell_arrays, field, displacement) -> set[str] | None:
+    """The point arrays to decode now (None: all of them, as when the choice needs the data)."""
+    catalogue = [ArrayInfo(n, "point", *_components(a)) for n, a in point_arrays.items()]
+    catalogue += [
+        ArrayInfo(n, "cell", *_components(a)) for n, a in cell_arrays.items() if n not in point_arrays
+    ]
+    try:
+        choice = pick_field(str(path), catalogue, field)
+        disp = pick_displacement(str(path), catalogue, displacement)
+    except FepostError:
+        return None  # the contact field raises the same error on the same catalogue
+    return {disp} | ({choice.name} if choice.location == "point" else set())
+
+
+def _arrays(arrays, n, decode, components, keep) -> dict[str, np.ndarray]:
+    out = {}
+    for name, arr in arrays.items():
+        ncomp, names = _components(arr)
+        if names:
+            components.setdefault(name, names)
+        if keep is not None and name not in keep:
+            continue
+        values = decode(arr)
+        out[name] = values if ncomp == 1 else values.reshape(n, ncomp)
+    return out
+
+
+def _section(piece, section: str) -> dict[str, DataArray]:
+    return {a.attrs.get("Name", ""): a for a in piece.arrays if a.section == section}
+
+
+def _cell_arrays(piece, section: str, decode, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """(offsets (count + 1), connectivity) of one cell section."""
+    arrays = _section(piece, section)
+    if "offsets" not in arrays or "connectivity" not in arrays:
+        raise _NotHere
+    ends = np.asarray(decode(arrays["offsets"]), np.int64)
+    off = np.empty(count + 1, np.int64)
+    off[0] = 0
+    off[1:] = ends
+    return off, np.asarray(decode(arrays["connectivity"]), np.int64)
+
+
+def _vtu_cells(piece, decode):
+    count = int(piece.attrs.get("NumberOfCells", "0") or 0)
+    if count == 0:
+        return no_cells()
+    arrays = _section(piece, "Cells")
+    if "types" not in arrays:
+        raise _NotHere
+    types = decode(arrays["types"])
+    if types.dtype != np.uint8 and len(types) and (types.min() < 0 or types.max() > 255):
+        raise _NotHere  # VTK would wrap them to unsigned char
+    off, con = _cell_arrays(piece, "Cells", decode, count)
+    return types.astype(np.uint8, copy=False), off, con
+
+
+def _vtp_cells(piece, decode):
+    sections = []
+    for name, vtype in POLY_SECTIONS:
+        count = int(piece.attrs.get(f"NumberOf{name}", "0") or 0)
+        if count:
+            sections.append((vtype, *_cell_arrays(piece, name, decode, count)))
+    return poly_cells(sections)
+
+
+# ----------------------------------------------------------------------------- decoding one array
+
+
+class _Job:
+    """One binary array being decoded: the header read and the base64 decoded when made, the
+    blocks inflated by `start` (on a thread pool or at once), `result` waits for them.
+
+    The base64 of every array is decoded before any block is inflated: ``a2b_base64`` holds
+    the GIL for its whole call, and an inflating thread needs the GIL between blocks.
+    """
+
+    def __init__(self, fmt: _Format, data, arr: DataArray):
+        self.fmt, self.name = fmt, arr.attrs.get("Name") or arr.section or "?"
+        self.dtype = np.dtype(_TYPES[arr.attrs["type"]]).newbyteorder(fmt.endian)
+        words, body = self._payload(data, arr)
+        self.tasks: list = []
+        self.runs: list = []
+        if fmt.inflate is None:
+            self.out = _plain(fmt, words, body, self.name)
+        else:
+            self.out, self.runs = _inflation(fmt, words, body, self.name)
+
+    def start(self, pool: ThreadPoolExecutor | None = None) -> _Job:
+        """Inflate the blocks: on ``pool``, or here and now without one."""
+        runs, self.runs = self.runs, []
+        if pool is None:
+            for run in runs:
+                run()
+        else:
+            self.tasks = [pool.submit(run) for run in runs]
+        return self
+
+    def _payload(self, data, arr: DataArray) -> tuple[tuple[int, ...], memoryview]:
+        fmt = self.fmt
+        if arr.attrs.get("format") != "appended":
+            start, end = arr.start, arr.end
+        elif fmt.appended is None:
+            raise InputFileError(
+                f"{fmt.path}: array {self.name!r} is appended but the file has no AppendedData"
+            )
+        else:
+            base, b64 = fmt.appended
+            start = base + int(arr.attrs["offset"])
+            if not b64:
+                return _raw_payload(fmt, data, start, self.name)
+            end = data.find(b"<", base)
+            end = end if end >= 0 else len(data)
+        while start < end and data[start] in _SPACE:
+            start += 1
+        while end > start and data[end - 1] in _SPACE:
+            end -= 1
+        text: bytes | memoryview = memoryview(data)[start:end]
+        if any(data.find(c, start, end) >= 0 for c in (b"\n", b" ", b"\r", b"\t")):
+            text = bytes(text).translate(None, _SPACE)  # base64 broken into lines
+        return _base64_payload(fmt, text, self.name)
+
+    def result(self) -> np.ndarray:
+        """The values, 1-D, native byte order, writable."""
+        for task in self.tasks:
+            task.result()
+        out = self.out
+        if len(out) % self.dtype.itemsize:
+            raise InputFileError(
+                f"{self.fmt.path}: array {self.name!r}: {len(out)} bytes is not a whole number of values"
+            )
+        values = out.view(self.dtype)
+        return values if self.dtype.isnative else values.astype(self.dtype.newbyteorder("="))
+
+
+def _values(fmt: _Format, data, arr: DataArray) -> np.ndarray:
+    """The values of one binary array (decoded on the calling thread)."""
+    return _Job(fmt, data, arr).start().result()
+
+
+def _words(fmt: _Format, raw, n: int) -> tuple[int, ...]:
+    return struct.unpack(fmt.endian + ("Q" if fmt.header == 8 else "I") * n, bytes(raw[: fmt.header * n]))
+
+
+def _b64(fmt: _Format, text, name: str) -> bytes:
+    try:
+        return binascii.a2b_base64(text)
+    except (binascii.Error, ValueError):
+        raise InputFileError(f"{fmt.path}: array {name!r}: invalid base64 data") from None
+
+
+def _chars(nbytes: int) -> int:
+    """Base64 characters that encode ``nbytes`` bytes (padding included)."""
+    return -(-nbytes // 3) * 4
+
+
+def _base64_payload(fmt: _Format, text: bytes, name: str) -> tuple[tuple[int, ...], memoryview]:
+    """(header words, the bytes after the header) of a base64 array, whitespace removed.
+
+    Compressed: the block table is encoded on its own, the blocks follow in one stream.
+    Not compressed: the length word and the values are one stream (as VTK reads them).
+    """
+    h = fmt.header
+    if fmt.inflate is None:
+        nbytes = _words(fmt, _b64(fmt, text[: _chars(h)], name), 1)[0] if len(text) >= _chars(h) else 0
+        decoded = _b64(fmt, text[: _chars(h + nbytes)], name)
+        if len(decoded) < h + nbytes:
+            # padding inside the stream (the length encoded on its own): VTK's reading decides
+            raise _NotHere
+        return (nbytes,), memoryview(decoded)[h : h + nbytes]
+    first = _b64(fmt, text[: _chars(3 * h)], name)
+    if len(first) < 3 * h:
+        raise InputFileError(f"{fmt.path}: array {name!r}: truncated block header")
+    nblocks = _words(fmt, first, 1)[0]
+    chars = _chars((3 + nblocks) * h)
+    words = _words(fmt, _b64(fmt, text[:chars], name), 3 + nblocks)
+    body = _b64(fmt, text[chars : chars + _chars(sum(words[3:]))], name)
+    return words, memoryview(body)
+
+
+def _raw_payload(fmt: _Format, data, start: int, name: str) -> tuple[tuple[int, ...], memoryview]:
+    """(header words, the bytes after the header) of an appended raw array."""
+    h = fmt.header
+    nblocks = _words(fmt, data[start : start + h], 1)[0]
+    if fmt.inflate is None:
+        return (nblocks,), memoryview(data)[start + h : start + h + nblocks]
+    words = _words(fmt, data[start : start + (3 + nblocks) * h], 3 + nblocks)
+    body = start + (3 + nblocks) * h
+    return words, memoryview(data)[body : body + sum(words[3:])]
+
+
+def _plain(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str) -> np.ndarray:
+    if len(body) < words[0]:
+        raise InputFileError(f"{fmt.path}: array {name!r}: truncated data")
+    out = _buffer(words[0])
+    out[:] = np.frombuffer(body, np.uint8, count=words[0])
+    return out
+
+
+def _buffer(nbytes: int) -> np.ndarray:
+    """A writable byte buffer; large ones on huge pages (a forked reader's pages are all new)."""
+    if nbytes < _HUGE_FROM:
+        return np.empty(nbytes, np.uint8)
+    return np.frombuffer(huge_map(nbytes), np.uint8, count=nbytes)
+
+
+def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str):
+    """(the output buffer, the functions that inflate the blocks into it, `_BATCH` blocks each)."""
+    nblocks, block, last = words[0], words[1], words[2]
+    sizes = words[3:]
+    total = 0 if nblocks == 0 else (nblocks - 1) * block + (last or block)
+    out = _buffer(total)
+    starts = np.concatenate(([0], np.cumsum(sizes, dtype=np.int64))).tolist()
+    if starts[-1] > len(body):
+        raise InputFileError(f"{fmt.path}: array {name!r}: compressed data shorter than its header says")
+    inflate = fmt.inflate
+    assert inflate is not None
+
+    def run(first: int, stop: int) -> None:
+        for i in range(first, stop):
+            want = block if i < nblocks - 1 or not last else last
+            try:
+                got = inflate(body[starts[i] : starts[i + 1]])
+            except (zlib.error, lzma.LZMAError, ValueError):
+                raise InputFileError(
+                    f"{fmt.path}: array {name!r}: block {i + 1} does not decompress"
+                ) from None
+            if len(got) != want:
+                raise InputFileError(
+                    f"{fmt.path}: array {name!r}: block {i + 1} holds {len(got)} bytes, "
+                    f"its header says {want}"
+                )
+            out[i * block : i * block + want] = np.frombuffer(got, np.uint8)
+
+    return out, [partial(run, i, min(i + _BATCH, nblocks)) for i in range(0, nblocks, _BATCH)]
+
+
+# ----------------------------------------------------------------------------- arrays decoded later
+
+
+def _add_lazy(raw: RawMesh, fmt: _Format, piece, lazy: dict[str, DataArray], stamp) -> None:
+    """Put the point arrays not decoded back into ``raw``, in file order, as loaders."""
+    data = LazyArrays()
+    n = len(raw.points)
+    for name, arr in _named(piece, "PointData").items():
+        if name in lazy:
+            ncomp, names = _components(arr)
+            data.add(name, partial(_load, fmt, arr, n, ncomp, stamp))
+            raw.ncomp[name] = ncomp
+            if names:
+                raw.components.setdefault(name, names)
+        else:
+            data.add(name, raw.point_data[name])
+    raw.point_data = data
+
+
+def _load(fmt: _Format, arr: DataArray, n: int, ncomp: int, stamp) -> np.ndarray:
+    """One point array decoded on demand (refused if the file changed since it was read)."""
+    name = arr.attrs.get("Name", "?")
+    try:
+        if _stamp(fmt.path) != stamp:
+            raise InputFileError(f"{fmt.path}: point array {name!r}: the file changed after it was read")
+        with open(fmt.path, "rb") as fh:
+            data = _mapped(fh)
+            try:
+                values = _values(fmt, data, arr)
+            finally:
+                _unmap(data)
+    except OSError as exc:
+        raise InputFileError(
+            f"{fmt.path}: cannot read point array {name!r} ({exc.strerror or exc})"
+        ) from None
+    except _NotHere:
+        raise InputFileError(f"{fmt.path}: cannot decode point array {name!r}") from None
+    return values if ncomp == 1 else values.reshape(n, ncomp)
+
+
+__all__ = ["DIRECT_SUFFIXES", "read_direct"]

@@ -1,0 +1,327 @@
+"""The direct decoder of serial VTK XML files gives what VTK's readers give, bit for bit.
+
+Every file is read in-process twice, by `fepost.reader.vtkdirect` and by VTK's own
+readers (the direct path switched off), and the two contact fields must be identical
+in every field; the raw meshes too (points, blocks, every point array, loaded or left
+for later). Files the decoder does not take (ASCII arrays, LZ4) must go to VTK, files it
+takes must not import VTK at all. Corrupt data is one `InputFileError` naming the file
+and the array. The answer of the reading child travels through a shared memory file;
+the same arrays must arrive with the file and without it (`fepost.reader.transfer`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import subprocess
+import sys
+import zlib
+from collections.abc import Mapping
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+import pyvista as pv
+
+from fepost.errors import FepostError, InputFileError
+from fepost.reader import contact, isolate, read_contact, transfer, vtkdirect
+from fepost.reader.vtkfile import read_vtk
+
+pv.OFF_SCREEN = True
+
+SAMPLE = Path(__file__).resolve().parents[1] / "meshes" / "aircraft" / "static_100.vtu"
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def grids():
+    grid = pv.read(SAMPLE)
+    rng = np.random.default_rng(5)
+    grid.point_data["S"] = rng.normal(size=(grid.n_points, 6))
+    grid.point_data["T"] = rng.normal(size=grid.n_points).astype(np.float32)
+    grid.cell_data["ID"] = np.arange(grid.n_cells, dtype=np.int32)
+    return {"ug": grid, "pd": grid.extract_surface(algorithm=None)}
+
+
+def _write(grids, out: Path, kind: str, mode: str, encode: bool, compressor: str, **extra) -> Path:
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter, vtkXMLUnstructuredGridWriter
+
+    w = vtkXMLUnstructuredGridWriter() if kind == "ug" else vtkXMLPolyDataWriter()
+    w.SetInputData(grids[kind])
+    w.SetFileName(str(out))
+    {"ascii": w.SetDataModeToAscii, "binary": w.SetDataModeToBinary, "appended": w.SetDataModeToAppended}[
+        mode
+    ]()
+    w.SetEncodeAppendedData(encode)
+    {
+        "none": w.SetCompressorTypeToNone,
+        "zlib": w.SetCompressorTypeToZLib,
+        "lz4": w.SetCompressorTypeToLZ4,
+        "lzma": w.SetCompressorTypeToLZMA,
+    }[compressor]()
+    if extra.get("big_endian"):
+        w.SetByteOrderToBigEndian()
+    if extra.get("uint64"):
+        w.SetHeaderTypeToUInt64()
+    if extra.get("block"):
+        w.SetBlockSize(extra["block"])
+    w.Write()
+    return out
+
+
+def _both(path: Path, **kw):
+    """(direct, VTK) results of `read_here`: the field, or an error's (type, message)."""
+
+    def one():
+        try:
+            return contact.read_here(path, **kw)
+        except FepostError as exc:
+            return (type(exc), str(exc))
+
+    direct = one()
+    saved = vtkdirect.DIRECT_SUFFIXES
+    vtkdirect.DIRECT_SUFFIXES = ()
+    try:
+        general = one()
+    finally:
+        vtkdirect.DIRECT_SUFFIXES = saved
+    return direct, general
+
+
+def _same(a, b) -> None:
+    assert type(a) is type(b)
+    if isinstance(b, tuple):
+        assert a == b
+        return
+    for f in dataclasses.fields(b):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(y, np.ndarray):
+            assert x.dtype == y.dtype and np.array_equal(x, y), f.name
+        elif isinstance(y, Mapping) and y and isinstance(next(iter(y.values())), np.ndarray):
+            assert x.keys() == y.keys(), f.name
+            assert all(x[k].dtype == y[k].dtype and np.array_equal(x[k], y[k]) for k in y), f.name
+        else:
+            assert x == y, f.name
+
+
+def _same_raw(path: Path, **kw) -> None:
+    """The raw meshes of both paths: points, blocks, cell data and every point array."""
+    direct = vtkdirect.read_direct(path, **kw)
+    assert direct is not None
+    general = read_vtk(path, select=False, **kw)
+    assert np.array_equal(direct.points, general.points) and direct.points.dtype == general.points.dtype
+    assert [(b.label, b.cell_type, b.first_cell, b.body) for b in direct.blocks] == [
+        (b.label, b.cell_type, b.first_cell, b.body) for b in general.blocks
+    ]
+    for bd, bg in zip(direct.blocks, general.blocks, strict=True):
+        assert np.array_equal(bd.conn, bg.conn)
+        assert list(bd.cell_data) == list(bg.cell_data)
+        for name in bg.cell_data:
+            assert bd.cell_data[name].dtype == bg.cell_data[name].dtype
+            assert np.array_equal(bd.cell_data[name], bg.cell_data[name]), name
+    assert list(direct.point_data) == list(general.point_data)
+    for name in general.point_data:  # the lazy ones are decoded here
+        assert direct.point_data[name].dtype == general.point_data[name].dtype, name
+        assert np.array_equal(direct.point_data[name], general.point_data[name]), name
+    assert direct.components == general.components
+    assert direct.format == general.format and direct.skipped == general.skipped
+    assert direct.connectivity_size == general.connectivity_size
+
+
+TAKEN = [
+    (kind, mode, encode, comp)
+    for kind, (mode, encode), comp in itertools.product(
+        ("ug", "pd"),
+        (("binary", True), ("appended", True), ("appended", False)),
+        ("none", "zlib", "lzma"),
+    )
+]
+
+
+@pytest.mark.parametrize(("kind", "mode", "encode", "compressor"), TAKEN)
+def test_every_binary_layout_decodes_as_vtk_reads_it(grids, tmp_path, kind, mode, encode, compressor):
+    suffix = ".vtu" if kind == "ug" else ".vtp"
+    path = _write(grids, tmp_path / f"map{suffix}", kind, mode, encode, compressor, block=4096)
+    assert vtkdirect.read_direct(path) is not None  # the direct path takes it
+    _same(*_both(path))
+    _same_raw(path)
+
+
+@pytest.mark.parametrize(
+    "extra", [{"big_endian": True}, {"uint64": True}, {"big_endian": True, "uint64": True}], ids=str
+)
+@pytest.mark.parametrize("compressor", ["none", "zlib"])
+def test_byte_order_and_header_words(grids, tmp_path, extra, compressor):
+    path = _write(grids, tmp_path / "map.vtu", "ug", "appended", False, compressor, **extra)
+    text = path.read_bytes()[:400]
+    assert (b"BigEndian" in text) == bool(extra.get("big_endian"))
+    _same(*_both(path))
+    _same_raw(path)
+
+
+@pytest.mark.parametrize(
+    "options",
+    [{}, {"field": "S"}, {"field": "S[2]"}, {"displacement": None}, {"displacement": "S"}, {"field": "ID"}],
+    ids=str,
+)
+def test_reader_options_choose_the_same_arrays(grids, tmp_path, options):
+    path = _write(grids, tmp_path / "map.vtu", "ug", "binary", True, "zlib")
+    _same(*_both(path, **options))
+
+
+@pytest.mark.parametrize(("mode", "compressor"), [("ascii", "none"), ("binary", "lz4"), ("appended", "lz4")])
+def test_files_the_decoder_does_not_take_go_to_vtk(grids, tmp_path, mode, compressor):
+    path = _write(grids, tmp_path / "map.vtu", "ug", mode, True, compressor)
+    assert vtkdirect.read_direct(path) is None
+    _same(*_both(path))
+
+
+@pytest.mark.parametrize("binary", [True, False], ids=["binary", "ascii"])
+@pytest.mark.parametrize("compression", ["zlib", "lzma", None])
+def test_meshio_files(tmp_path, binary, compression):
+    m = meshio.read(SAMPLE)
+    path = tmp_path / "m.vtu"
+    meshio.write(path, m, binary=binary, compression=compression if binary else None)
+    if binary:
+        _same_raw(path)
+    _same(*_both(path))
+
+
+def test_the_lazy_arrays_are_decoded_on_demand_and_refused_after_a_change(grids, tmp_path):
+    path = _write(grids, tmp_path / "map.vtu", "ug", "appended", False, "zlib")
+    raw = vtkdirect.read_direct(path)
+    assert set(raw.ncomp) == {"S", "T"}  # the pressure and the displacement only were decoded
+    assert raw.point_data["S"].shape == (grids["ug"].n_points, 6)
+    np.testing.assert_array_equal(raw.point_data["S"], grids["ug"].point_data["S"])
+    again = vtkdirect.read_direct(path)
+    path.write_bytes(path.read_bytes() + b"\n")  # the file changes after the read
+    with pytest.raises(InputFileError, match=r"map\.vtu: point array 'T': the file changed"):
+        again.point_data["T"]
+
+
+def _corrupt_first_block(path: Path) -> None:
+    data = bytearray(path.read_bytes())
+    mark = data.index(b"_", data.index(b"<AppendedData")) + 1
+    first = data.index(b"x\x9c", mark)  # the zlib stream of the first array's first block
+    data[first + 2 : first + 40] = b"\xff" * 38
+    path.write_bytes(bytes(data))
+
+
+def test_a_corrupt_block_is_one_line_naming_the_file_and_the_array(grids, tmp_path):
+    path = _write(grids, tmp_path / "bad.vtu", "ug", "appended", False, "zlib")
+    _corrupt_first_block(path)
+    with pytest.raises(InputFileError) as err:
+        read_contact(path)
+    msg = str(err.value)
+    assert msg.startswith(f"{path}: ") and "\n" not in msg
+    assert "array" in msg and "decompress" in msg
+
+
+def test_a_block_of_the_wrong_size_is_refused(tmp_path):
+    pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    good = zlib.compress(pts.tobytes())
+    short = zlib.compress(pts.tobytes()[:-8])
+    for name, block in (("good", good), ("short", short)):
+        head = np.array([1, pts.nbytes, pts.nbytes, len(block)], "<u4").tobytes()
+        conn = np.array([0, 1, 2], "<i8").tobytes()
+        body = b""
+        offsets = {}
+        for key, raw in (
+            ("Points", head + block),
+            ("connectivity", _zblock(conn)),
+            ("offsets", _zblock(np.array([3], "<i8").tobytes())),
+            ("types", _zblock(np.array([5], "u1").tobytes())),
+            ("CPRESS", _zblock(np.array([1.0, 2.0, 3.0]).tobytes())),
+        ):
+            offsets[key] = len(body)
+            body += raw
+        xml = (
+            (
+                '<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="0.1" '
+                'byte_order="LittleEndian" header_type="UInt32" compressor="vtkZLibDataCompressor">\n'
+                '<UnstructuredGrid><Piece NumberOfPoints="3" NumberOfCells="1">\n'
+                '<PointData><DataArray type="Float64" Name="CPRESS" format="appended" '
+                f'offset="{offsets["CPRESS"]}"/></PointData>\n'
+                '<Points><DataArray type="Float64" NumberOfComponents="3" format="appended" '
+                f'offset="{offsets["Points"]}"/></Points>\n<Cells>'
+                '<DataArray type="Int64" Name="connectivity" format="appended" '
+                f'offset="{offsets["connectivity"]}"/>'
+                f'<DataArray type="Int64" Name="offsets" format="appended" offset="{offsets["offsets"]}"/>'
+                f'<DataArray type="UInt8" Name="types" format="appended" offset="{offsets["types"]}"/>'
+                "</Cells>\n</Piece></UnstructuredGrid>\n"
+            ).encode()
+            + b'<AppendedData encoding="raw">\n_'
+            + body
+            + b"\n</AppendedData>\n</VTKFile>\n"
+        )
+        path = tmp_path / f"{name}.vtu"
+        path.write_bytes(xml)
+        if name == "good":
+            raw = vtkdirect.read_direct(path)
+            np.testing.assert_array_equal(raw.points, pts)
+            _same(*_both(path))
+        else:
+            with pytest.raises(InputFileError, match=r"short\.vtu: array 'Points'"):
+                vtkdirect.read_direct(path)
+
+
+def _zblock(raw: bytes) -> bytes:
+    packed = zlib.compress(raw)
+    return np.array([1, len(raw), len(raw), len(packed)], "<u4").tobytes() + packed
+
+
+def test_reading_an_xml_file_imports_no_vtk(grids, tmp_path):
+    path = _write(grids, tmp_path / "map.vtu", "ug", "binary", True, "zlib")
+    code = (
+        "import sys\nfrom fepost.reader import read_contact\n"
+        f"f = read_contact({str(path)!r})\n"
+        "print(f.field, sorted(m for m in sys.modules if m.startswith(('vtkmodules', 'pyvista'))))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.split() == ["CPRESS", "[]"]
+
+
+def _arrays(n: int) -> dict:
+    rng = np.random.default_rng(n)
+    return {
+        "a": rng.normal(size=(n, 3)),
+        "b": np.arange(n, dtype=np.int64),
+        "c": rng.normal(size=7).astype(np.float32),
+        "d": np.empty((0, 3)),
+    }
+
+
+@pytest.mark.parametrize("shared", [True, False], ids=["memory-file", "copied"])
+def test_the_answer_arrives_whole_with_and_without_the_shared_file(monkeypatch, shared):
+    if not shared:
+        monkeypatch.setattr(transfer, "shared_file", lambda: None)
+    elif transfer.shared_file() is None:
+        pytest.skip("no memfd_create on this system: the answer is always copied")
+    got = isolate.call(_arrays, 300_001, what="test")
+    want = _arrays(300_001)
+    assert got.keys() == want.keys()
+    for k in want:
+        assert got[k].dtype == want[k].dtype and np.array_equal(got[k], want[k])
+        assert got[k].flags.writeable
+    got["a"][0, 0] = 1.0  # the caller owns its arrays
+
+
+def test_the_memory_file_is_closed_after_the_answer(monkeypatch):
+    made: list[int] = []
+    real = transfer.shared_file
+
+    def spy():
+        fd = real()
+        if fd is not None:
+            made.append(fd)
+        return fd
+
+    monkeypatch.setattr(transfer, "shared_file", spy)
+    isolate.call(_arrays, 1000, what="test")
+    if not made:
+        pytest.skip("no memfd_create on this system")
+    import os
+
+    with pytest.raises(OSError):
+        os.fstat(made[0])
