@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FepostError, InputFileError
+from .checks import release
 from .names import ArrayInfo, pick_displacement, pick_field
 from .raw import LazyArrays, RawMesh
 from .transfer import huge_map
@@ -136,14 +137,9 @@ def read_direct(path: Path, *, field: str | None = None, displacement: str | Non
 
 
 def _mapped(fh) -> mmap.mmap:
-    """The whole file mapped read-only, its pages mapped at once where Linux allows
-    (``MAP_POPULATE``: one call instead of a page fault per 4 kB as the decoder walks it)."""
-    populate = getattr(mmap, "MAP_POPULATE", 0)
-    if populate and hasattr(mmap, "MAP_SHARED"):
-        try:
-            return mmap.mmap(fh.fileno(), 0, flags=mmap.MAP_SHARED | populate, prot=mmap.PROT_READ)
-        except (OSError, ValueError):
-            pass
+    """The whole file mapped read-only. Its pages are not mapped ahead (``MAP_POPULATE``):
+    a solver's file is mostly arrays that are never decoded, and mapped pages count in the
+    process's memory."""
     return mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
 
 
@@ -348,7 +344,11 @@ class _Job:
         text: bytes | memoryview = memoryview(data)[start:end]
         if any(data.find(c, start, end) >= 0 for c in (b"\n", b" ", b"\r", b"\t")):
             text = bytes(text).translate(None, _SPACE)  # base64 broken into lines
-        return _base64_payload(fmt, text, self.name)
+        try:
+            return _base64_payload(fmt, text, self.name)
+        finally:
+            del text
+            release(data, start, end)  # decoded: the text's pages are not needed again
 
     def result(self) -> np.ndarray:
         """The values, 1-D, native byte order, writable."""

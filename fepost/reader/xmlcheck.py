@@ -17,7 +17,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputFileError
-from .checks import MAX_COUNT, MAX_DEPTH, MAX_VTM_DEPTH, Counts, bad_file, inside_folder
+from .checks import (
+    MAX_COUNT,
+    MAX_DEPTH,
+    MAX_VTM_DEPTH,
+    RELEASE_STEP,
+    Counts,
+    bad_file,
+    find_releasing,
+    inside_folder,
+    release,
+)
 
 _SIZES = {
     "Int8": 1,
@@ -96,7 +106,7 @@ class Xml:
     def check(self) -> Counts:
         path, data = self.path, self.data
         suffix = path.suffix.lower()
-        cut = data.find(b"<AppendedData")
+        cut = find_releasing(data, b"<AppendedData")
         limit = len(data) if cut < 0 else cut
         first = data.find(b"<VTKFile", 0, limit)
         prologue = data[: first if first >= 0 else min(limit, 1 << 16)]
@@ -135,10 +145,15 @@ class Xml:
     def _tags(self, limit: int):
         """The tags before ``limit``, found with bytes.find (array contents hold no '<')."""
         data, pos = self.data, 0
+        behind = 0  # the pages before this were let go
         while True:
             pos = data.find(b"<", pos, limit)
             if pos < 0:
+                release(data, behind, limit)
                 return
+            if pos - behind > RELEASE_STEP:
+                release(data, behind, pos)
+                behind = pos
             m = _TAG.match(data, pos, limit)
             if m is None:
                 raise bad_file(self.path, "a '<' that opens no XML tag")
