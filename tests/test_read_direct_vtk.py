@@ -325,3 +325,30 @@ def test_the_memory_file_is_closed_after_the_answer(monkeypatch):
 
     with pytest.raises(OSError):
         os.fstat(made[0])
+
+
+@pytest.mark.parametrize("compressor", ["none", "zlib"])
+def test_base64_broken_into_lines(grids, tmp_path, compressor):
+    """Base64 text wrapped at 76 characters a line decodes as one stream: the same field as
+    the file unwrapped. (VTK's reader misreads such files: uncompressed, the connectivity
+    comes out wrong and the file is refused; the direct decoder reads them right.)"""
+    import re
+
+    plain = _write(grids, tmp_path / "plain.vtu", "ug", "binary", True, compressor)
+    text = plain.read_bytes()
+    path = tmp_path / "map.vtu"
+
+    def wrap(m: re.Match) -> bytes:
+        body = m.group(2).strip()
+        lines = b"\n          ".join(body[i : i + 76] for i in range(0, len(body), 76))
+        return m.group(1) + b"\n          " + lines + b"\n        "
+
+    wrapped = re.sub(rb"(<DataArray[^>]*format=\"binary\"[^>]*>)([A-Za-z0-9+/=\s]+)", wrap, text)
+    assert wrapped.count(b"\n") > text.count(b"\n") + 100
+    path.write_bytes(wrapped)
+    raw = vtkdirect.read_direct(path)
+    assert raw is not None
+    np.testing.assert_array_equal(raw.points, np.asarray(grids["ug"].points, float))
+    wrapped_field = contact.read_here(path)
+    plain_field = contact.read_here(plain)
+    _same(dataclasses.replace(wrapped_field, source=plain_field.source), plain_field)

@@ -341,11 +341,9 @@ class _Job:
             start += 1
         while end > start and data[end - 1] in _SPACE:
             end -= 1
-        text: bytes | memoryview = memoryview(data)[start:end]
-        if any(data.find(c, start, end) >= 0 for c in (b"\n", b" ", b"\r", b"\t")):
-            text = bytes(text).translate(None, _SPACE)  # base64 broken into lines
+        text = memoryview(data)[start:end]
         try:
-            return _base64_payload(fmt, text, self.name)
+            return _base64_payload(fmt, text, self.name, inline=arr.attrs.get("format") != "appended")
         finally:
             del text
             release(data, start, end)  # decoded: the text's pages are not needed again
@@ -384,27 +382,44 @@ def _chars(nbytes: int) -> int:
     return -(-nbytes // 3) * 4
 
 
-def _base64_payload(fmt: _Format, text: bytes, name: str) -> tuple[tuple[int, ...], memoryview]:
-    """(header words, the bytes after the header) of a base64 array, whitespace removed.
+def _spaced(text) -> bool:
+    """True when the (short) base64 text holds whitespace."""
+    chunk = bytes(text)
+    return len(chunk.translate(None, _SPACE)) != len(chunk)
+
+
+def _base64_payload(fmt: _Format, text, name: str, inline: bool) -> tuple[tuple[int, ...], memoryview]:
+    """(header words, the bytes after the header) of a base64 array.
 
     Compressed: the block table is encoded on its own, the blocks follow in one stream.
     Not compressed: the length word and the values are one stream (as VTK reads them).
+    The header is found by counting characters, so text broken into lines before its
+    end is first joined; after it, ``a2b_base64`` passes whitespace over (inline arrays
+    run to the end of their element; appended ones by count).
     """
     h = fmt.header
+    head = _chars(h if fmt.inflate is None else 3 * h)
+    if _spaced(text[:head]):
+        text = bytes(text).translate(None, _SPACE)
     if fmt.inflate is None:
-        nbytes = _words(fmt, _b64(fmt, text[: _chars(h)], name), 1)[0] if len(text) >= _chars(h) else 0
-        decoded = _b64(fmt, text[: _chars(h + nbytes)], name)
+        nbytes = _words(fmt, _b64(fmt, text[:head], name), 1)[0] if len(text) >= head else 0
+        decoded = _b64(fmt, text if inline else text[: _chars(h + nbytes)], name)
         if len(decoded) < h + nbytes:
             # padding inside the stream (the length encoded on its own): VTK's reading decides
             raise _NotHere
         return (nbytes,), memoryview(decoded)[h : h + nbytes]
-    first = _b64(fmt, text[: _chars(3 * h)], name)
+    first = _b64(fmt, text[:head], name)
     if len(first) < 3 * h:
         raise InputFileError(f"{fmt.path}: array {name!r}: truncated block header")
     nblocks = _words(fmt, first, 1)[0]
     chars = _chars((3 + nblocks) * h)
+    if _spaced(text[:chars]):
+        text = bytes(text).translate(None, _SPACE)
     words = _words(fmt, _b64(fmt, text[:chars], name), 3 + nblocks)
-    body = _b64(fmt, text[chars : chars + _chars(sum(words[3:]))], name)
+    need = sum(words[3:])
+    body = _b64(fmt, text[chars:] if inline else text[chars : chars + _chars(need)], name)
+    if len(body) < need:
+        raise _NotHere  # padding or breaks VTK's stream reading may read otherwise
     return words, memoryview(body)
 
 
