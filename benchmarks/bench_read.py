@@ -6,7 +6,8 @@ Three files of about a million nodes each, built once into ``--dir`` (reused whe
   (zlib-compressed inline arrays, as meshio writes them; one point array);
 * ``solver.vtu``: a hexahedral volume (250 x 250 x 16 cells, 1.07 M nodes) whose bottom face
   carries a Hertz pressure, with the displacement and 12 extra point arrays as a solver
-  writes them (4 tensors, 4 vectors, 4 scalars; VTK's XML writer, zlib, appended);
+  writes them (4 tensors, 4 vectors, 4 scalars; VTK's XML writer through pyvista's
+  ``save``: zlib, inline base64);
 * ``series.e``: the same volume as Exodus II (netCDF 64-bit offset, 8-byte words) with 50 time
   steps and 10 nodal variables (contact pressure, displacement and velocity components,
   temperature, von Mises, hydrostatic).

@@ -1,13 +1,20 @@
 """Read FE contact results into a `fepost.field.ContactField`.
 
 Formats are chosen by suffix; every format is read by a well-kept library, except
-CalculiX `.frd`, which has none that reads binary files (see `frd`):
+CalculiX `.frd`, which has none that reads binary files (see `frd`), and the binary
+arrays of serial VTK XML files, decoded directly for speed (see `vtkdirect`; VTK
+reads the same files to the same bits, and everything else of the format):
 
 =============================== =============================================
 suffix                          reader
 =============================== =============================================
-``.vtu .vtp .vtk .vtm``         VTK's XML / legacy readers (`vtkfile`),
-                                after the checks of `vtkcheck`
+``.vtu .vtp`` (binary arrays)   fepost's decoder of the documented binary
+                                layout (`vtkdirect`, numpy + zlib/lzma:
+                                only the arrays needed, no VTK import),
+                                after the checks of `xmlcheck`
+``.vtu .vtp .vtk .vtm``         VTK's XML / legacy readers (`vtkfile`; XML
+                                files with ASCII arrays, LZ4 or several
+                                pieces), after the checks of `vtkcheck`
                                 (`xmlcheck`, `legacycheck`)
 ``.vts .vtr``                   VTK's structured-grid readers (`vtkfile`),
                                 the boundary taken as for volume meshes
@@ -23,7 +30,9 @@ Every file is read in a forked child process (`isolate`): a file that
 crashes or hangs a C library becomes a one-line
 `fepost.errors.InputFileError`, never a dead process.
 
-Modules, one concern each: `cells` (element types, faces, boundary),
+Modules, one concern each: `vtkassemble` (a VTK data set's arrays into
+element blocks, for both VTK paths), `transfer` (the child's answer to the
+caller), `cells` (element types, faces, boundary),
 `surface` (which body's faces carry the pressure), `names`
 (which array is the pressure), `units` (unit systems, scale checks),
 `sidecar` (the ``<stem>.json`` beside a file), `quadratic`

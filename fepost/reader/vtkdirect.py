@@ -45,6 +45,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
 
@@ -71,7 +72,7 @@ _TYPES = {
     "Float32": "f4",
     "Float64": "f8",
 }
-_INFLATE: dict[str, Callable[[bytes], bytes]] = {
+_INFLATE: dict[str, Callable[[Any], bytes]] = {
     "vtkZLibDataCompressor": zlib.decompress,
     "vtkLZMADataCompressor": lzma.decompress,
 }
@@ -94,8 +95,8 @@ class _Format:
 
     path: Path
     header: int
-    endian: str
-    inflate: Callable[[bytes], bytes] | None
+    endian: Literal["<", ">"]
+    inflate: Callable[[Any], bytes] | None
     appended: tuple[int, bool] | None  # (first byte, base64?) of the AppendedData
 
 
@@ -161,7 +162,8 @@ def _format(xml: Xml) -> _Format:
     compressor = xml.root.get("compressor", "")
     if compressor and compressor not in _INFLATE:
         raise _NotHere  # LZ4 and unknown compressors: VTK's
-    return _Format(xml.path, xml.header_size, xml.endian, _INFLATE.get(compressor), xml.appended)
+    endian: Literal["<", ">"] = ">" if xml.endian == ">" else "<"
+    return _Format(xml.path, xml.header_size, endian, _INFLATE.get(compressor), xml.appended)
 
 
 def _piece(xml: Xml):
@@ -235,7 +237,10 @@ def _chosen(path, point_arrays, cell_arrays, field, displacement) -> set[str] | 
         disp = pick_displacement(str(path), catalogue, displacement)
     except FepostError:
         return None  # the contact field raises the same error on the same catalogue
-    return {disp} | ({choice.name} if choice.location == "point" else set())
+    keep = {choice.name} if choice.location == "point" else set()
+    if disp is not None:
+        keep.add(disp)
+    return keep
 
 
 def _arrays(arrays, n, decode, components, keep) -> dict[str, np.ndarray]:
