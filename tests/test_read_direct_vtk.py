@@ -219,10 +219,16 @@ def test_a_corrupt_block_is_one_line_naming_the_file_and_the_array(grids, tmp_pa
 
 
 def test_a_block_of_the_wrong_size_is_refused(tmp_path):
+    """A block that inflates to less than its header says, or to more (a zip bomb: 64 MB
+    of zeros in 64 kB), is refused naming the array; the bomb is never inflated whole."""
+    import tracemalloc
+
     pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
     good = zlib.compress(pts.tobytes())
     short = zlib.compress(pts.tobytes()[:-8])
-    for name, block in (("good", good), ("short", short)):
+    bomb = zlib.compress(bytes(64 << 20), 9)
+    assert len(bomb) < 100_000
+    for name, block in (("good", good), ("short", short), ("bomb", bomb)):
         head = np.array([1, pts.nbytes, pts.nbytes, len(block)], "<u4").tobytes()
         conn = np.array([0, 1, 2], "<i8").tobytes()
         body = b""
@@ -262,8 +268,15 @@ def test_a_block_of_the_wrong_size_is_refused(tmp_path):
             np.testing.assert_array_equal(raw.points, pts)
             _same(*_both(path))
         else:
-            with pytest.raises(InputFileError, match=r"short\.vtu: array 'Points'"):
-                vtkdirect.read_direct(path)
+            tracemalloc.start()
+            try:
+                with pytest.raises(InputFileError, match=rf"{name}\.vtu: array 'Points': block 1") as err:
+                    vtkdirect.read_direct(path)
+                peak = tracemalloc.get_traced_memory()[1]
+            finally:
+                tracemalloc.stop()
+            assert ("more than 72 bytes" in str(err.value)) == (name == "bomb")
+            assert peak < 8 << 20  # the 64 MB were never held
 
 
 def _zblock(raw: bytes) -> bytes:
@@ -352,3 +365,14 @@ def test_base64_broken_into_lines(grids, tmp_path, compressor):
     wrapped_field = contact.read_here(path)
     plain_field = contact.read_here(plain)
     _same(dataclasses.replace(wrapped_field, source=plain_field.source), plain_field)
+
+
+def test_a_file_refused_by_the_check_is_named_once(grids, tmp_path):
+    """The pre-read check's refusal passes through as it is (one file name, one reason)."""
+    whole = _write(grids, tmp_path / "whole.vtu", "ug", "binary", True, "zlib").read_bytes()
+    path = tmp_path / "cut.vtu"
+    path.write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(InputFileError) as err:
+        vtkdirect.read_direct(path)
+    assert str(err.value).count(str(path)) == 1
+    assert str(err.value).startswith(f"{path}: corrupt or truncated .vtu file")

@@ -72,9 +72,22 @@ _TYPES = {
     "Float32": "f4",
     "Float64": "f8",
 }
-_INFLATE: dict[str, Callable[[Any], bytes]] = {
-    "vtkZLibDataCompressor": zlib.decompress,
-    "vtkLZMADataCompressor": lzma.decompress,
+
+
+def _zlib(block, limit: int) -> bytes:
+    """A zlib block inflated to at most ``limit`` + 1 bytes (a block that inflates to more
+    than its header says is refused without inflating it all: no zip bomb)."""
+    return zlib.decompressobj().decompress(block, limit + 1)
+
+
+def _lzma(block, limit: int) -> bytes:
+    """An LZMA (xz) block inflated to at most ``limit`` + 1 bytes (see `_zlib`)."""
+    return lzma.LZMADecompressor().decompress(block, max_length=limit + 1)
+
+
+_INFLATE: dict[str, Callable[[Any, int], bytes]] = {
+    "vtkZLibDataCompressor": _zlib,
+    "vtkLZMADataCompressor": _lzma,
 }
 _FORMATS = {".vtu": "VTK XML (.vtu)", ".vtp": "VTK XML (.vtp)"}
 #: Blocks inflated per thread task (a compressed array of more blocks is shared by two threads).
@@ -96,7 +109,7 @@ class _Format:
     path: Path
     header: int
     endian: Literal["<", ">"]
-    inflate: Callable[[Any], bytes] | None
+    inflate: Callable[[Any, int], bytes] | None
     appended: tuple[int, bool] | None  # (first byte, base64?) of the AppendedData
 
 
@@ -119,6 +132,8 @@ def read_direct(path: Path, *, field: str | None = None, displacement: str | Non
             xml = Xml(path, data, 0)
             try:
                 xml.check()
+            except InputFileError:
+                raise
             except (OSError, ValueError) as exc:
                 raise InputFileError(f"{path}: cannot read ({exc})") from None
             try:
@@ -470,14 +485,15 @@ def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str
         for i in range(first, stop):
             want = block if i < nblocks - 1 or not last else last
             try:
-                got = inflate(body[starts[i] : starts[i + 1]])
-            except (zlib.error, lzma.LZMAError, ValueError):
+                got = inflate(body[starts[i] : starts[i + 1]], want)
+            except (zlib.error, lzma.LZMAError, ValueError, EOFError):
                 raise InputFileError(
                     f"{fmt.path}: array {name!r}: block {i + 1} does not decompress"
                 ) from None
             if len(got) != want:
+                held = f"more than {want}" if len(got) > want else f"{len(got)}"
                 raise InputFileError(
-                    f"{fmt.path}: array {name!r}: block {i + 1} holds {len(got)} bytes, "
+                    f"{fmt.path}: array {name!r}: block {i + 1} inflates to {held} bytes, "
                     f"its header says {want}"
                 )
             out[i * block : i * block + want] = np.frombuffer(got, np.uint8)
