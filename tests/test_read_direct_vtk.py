@@ -16,15 +16,15 @@ import itertools
 import subprocess
 import sys
 import zlib
-from collections.abc import Mapping
 from pathlib import Path
 
 import meshio
 import numpy as np
 import pytest
 import pyvista as pv
+from vtk_writers import both_ways, same_fields, xml_file
 
-from fepost.errors import FepostError, InputFileError
+from fepost.errors import InputFileError
 from fepost.reader import contact, isolate, read_contact, transfer, vtkdirect
 from fepost.reader.vtkfile import read_vtk
 
@@ -45,64 +45,15 @@ def grids():
 
 
 def _write(grids, out: Path, kind: str, mode: str, encode: bool, compressor: str, **extra) -> Path:
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter, vtkXMLUnstructuredGridWriter
-
-    w = vtkXMLUnstructuredGridWriter() if kind == "ug" else vtkXMLPolyDataWriter()
-    w.SetInputData(grids[kind])
-    w.SetFileName(str(out))
-    {"ascii": w.SetDataModeToAscii, "binary": w.SetDataModeToBinary, "appended": w.SetDataModeToAppended}[
-        mode
-    ]()
-    w.SetEncodeAppendedData(encode)
-    {
-        "none": w.SetCompressorTypeToNone,
-        "zlib": w.SetCompressorTypeToZLib,
-        "lz4": w.SetCompressorTypeToLZ4,
-        "lzma": w.SetCompressorTypeToLZMA,
-    }[compressor]()
-    if extra.get("big_endian"):
-        w.SetByteOrderToBigEndian()
-    if extra.get("uint64"):
-        w.SetHeaderTypeToUInt64()
-    if extra.get("block"):
-        w.SetBlockSize(extra["block"])
-    w.Write()
-    return out
+    return xml_file(grids[kind], out, mode, encode, compressor, **extra)
 
 
 def _both(path: Path, **kw):
     """(direct, VTK) results of `read_here`: the field, or an error's (type, message)."""
-
-    def one():
-        try:
-            return contact.read_here(path, **kw)
-        except FepostError as exc:
-            return (type(exc), str(exc))
-
-    direct = one()
-    saved = vtkdirect.DIRECT_SUFFIXES
-    vtkdirect.DIRECT_SUFFIXES = ()
-    try:
-        general = one()
-    finally:
-        vtkdirect.DIRECT_SUFFIXES = saved
-    return direct, general
+    return both_ways(lambda: contact.read_here(path, **kw), vtkdirect, "DIRECT_SUFFIXES")
 
 
-def _same(a, b) -> None:
-    assert type(a) is type(b)
-    if isinstance(b, tuple):
-        assert a == b
-        return
-    for f in dataclasses.fields(b):
-        x, y = getattr(a, f.name), getattr(b, f.name)
-        if isinstance(y, np.ndarray):
-            assert x.dtype == y.dtype and np.array_equal(x, y), f.name
-        elif isinstance(y, Mapping) and y and isinstance(next(iter(y.values())), np.ndarray):
-            assert x.keys() == y.keys(), f.name
-            assert all(x[k].dtype == y[k].dtype and np.array_equal(x[k], y[k]) for k in y), f.name
-        else:
-            assert x == y, f.name
+_same = same_fields
 
 
 def _same_raw(path: Path, **kw) -> None:

@@ -5,15 +5,12 @@ and with it switched off (every array decoded, as before); the contact fields mu
 identical, every field of them, and errors must carry the same message.
 """
 
-import dataclasses
-from collections.abc import Mapping
-
 import meshio
 import numpy as np
 import pytest
 import pyvista as pv
+from vtk_writers import both_ways, same_fields
 
-from fepost.errors import FepostError
 from fepost.reader import contact, vtkselect
 from fepost.reader.vtkfile import read_vtk
 
@@ -42,21 +39,7 @@ def _extras(mesh, n_arrays: int = 4) -> None:
 
 def _read(path, **kw):
     """(fast, general) results of `read_here`; each an exception's (type, message) when it raised."""
-
-    def one():
-        try:
-            return contact.read_here(path, **kw)
-        except FepostError as exc:
-            return (type(exc), str(exc))
-
-    fast = one()
-    saved = vtkselect.SELECTABLE
-    vtkselect.SELECTABLE = ()
-    try:
-        general = one()
-    finally:
-        vtkselect.SELECTABLE = saved
-    return fast, general
+    return both_ways(lambda: contact.read_here(path, **kw), vtkselect, "SELECTABLE")
 
 
 def _skipped(path, field=None, displacement="auto") -> set[str]:
@@ -64,20 +47,7 @@ def _skipped(path, field=None, displacement="auto") -> set[str]:
     return set(read_vtk(path, field=field, displacement=displacement).ncomp)
 
 
-def _same(fast, general) -> None:
-    assert type(fast) is type(general)
-    if isinstance(general, tuple):
-        assert fast == general
-        return
-    for f in dataclasses.fields(general):
-        a, b = getattr(fast, f.name), getattr(general, f.name)
-        if isinstance(b, np.ndarray):
-            assert a.dtype == b.dtype and np.array_equal(a, b), f.name
-        elif isinstance(b, Mapping) and b and isinstance(next(iter(b.values())), np.ndarray):
-            assert a.keys() == b.keys(), f.name
-            assert all(np.array_equal(a[k], b[k]) for k in b), f.name
-        else:
-            assert a == b, f.name
+_same = same_fields
 
 
 @pytest.fixture

@@ -38,6 +38,7 @@ import meshio
 import numpy as np
 import pytest
 import pyvista as pv
+from vtk_writers import xml_file
 
 from fepost import analyse
 from fepost.polar import PolarGrid
@@ -78,23 +79,7 @@ def _legacy(grids, out: Path, kind: str, version: int, binary: bool) -> Path:
 
 
 def _xml(grids, out: Path, kind: str, mode: str, encode: bool, compressor: str) -> Path:
-    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter, vtkXMLUnstructuredGridWriter
-
-    w = vtkXMLUnstructuredGridWriter() if kind == "ug" else vtkXMLPolyDataWriter()
-    w.SetInputData(grids[kind])
-    w.SetFileName(str(out))
-    {"ascii": w.SetDataModeToAscii, "binary": w.SetDataModeToBinary, "appended": w.SetDataModeToAppended}[
-        mode
-    ]()
-    w.SetEncodeAppendedData(encode)
-    {
-        "none": w.SetCompressorTypeToNone,
-        "zlib": w.SetCompressorTypeToZLib,
-        "lz4": w.SetCompressorTypeToLZ4,
-        "lzma": w.SetCompressorTypeToLZMA,
-    }[compressor]()
-    w.Write()
-    return out
+    return xml_file(grids[kind], out, mode, encode, compressor)
 
 
 LEGACY = [

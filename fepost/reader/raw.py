@@ -106,3 +106,21 @@ class RawMesh:
     @property
     def time(self) -> float | None:
         return None if self.step is None or not self.steps else float(self.steps[self.step])
+
+
+def defer_point_arrays(raw: RawMesh, order, deferred: dict) -> None:
+    """Give ``raw`` the point arrays of ``order`` (names, in file order) that were not
+    decoded as loaders: ``deferred`` maps such a name to (loader, component count,
+    component names); the others are ``raw``'s own. Their component counts go into
+    ``raw.ncomp``, so that choosing among the arrays never loads them."""
+    data = LazyArrays()
+    for name in order:
+        if name in deferred:
+            loader, ncomp, names = deferred[name]
+            data.add(name, loader)
+            raw.ncomp[name] = ncomp
+            if names:
+                raw.components.setdefault(name, names)
+        else:
+            data.add(name, raw.point_data[name])
+    raw.point_data = data

@@ -52,26 +52,13 @@ import numpy as np
 from ..errors import FepostError, InputFileError
 from .checks import release
 from .names import ArrayInfo, pick_displacement, pick_field
-from .raw import LazyArrays, RawMesh
+from .raw import RawMesh, defer_point_arrays
 from .transfer import huge_map
 from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
-from .xmlcheck import DataArray, Xml
+from .xmlcheck import NUMPY_TYPES, DataArray, Xml
 
 #: Suffixes the direct decoder may take (serial unstructured grids and polygonal data).
 DIRECT_SUFFIXES = (".vtu", ".vtp")
-#: Numpy type of each VTK XML ``type`` attribute (byte order applied from the file).
-_TYPES = {
-    "Int8": "i1",
-    "UInt8": "u1",
-    "Int16": "i2",
-    "UInt16": "u2",
-    "Int32": "i4",
-    "UInt32": "u4",
-    "Int64": "i8",
-    "UInt64": "u8",
-    "Float32": "f4",
-    "Float64": "f8",
-}
 
 
 def _zlib(block, limit: int) -> bytes:
@@ -323,7 +310,7 @@ class _Job:
 
     def __init__(self, fmt: _Format, data, arr: DataArray):
         self.fmt, self.name = fmt, arr.attrs.get("Name") or arr.section or "?"
-        self.dtype = np.dtype(_TYPES[arr.attrs["type"]]).newbyteorder(fmt.endian)
+        self.dtype = np.dtype(NUMPY_TYPES[arr.attrs["type"]]).newbyteorder(fmt.endian)
         words, body = self._payload(data, arr)
         self.tasks: list = []
         self.runs: list = []
@@ -506,18 +493,12 @@ def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str
 
 def _add_lazy(raw: RawMesh, fmt: _Format, piece, lazy: dict[str, DataArray], stamp) -> None:
     """Put the point arrays not decoded back into ``raw``, in file order, as loaders."""
-    data = LazyArrays()
     n = len(raw.points)
-    for name, arr in _named(piece, "PointData").items():
-        if name in lazy:
-            ncomp, names = _components(arr)
-            data.add(name, partial(_load, fmt, arr, n, ncomp, stamp))
-            raw.ncomp[name] = ncomp
-            if names:
-                raw.components.setdefault(name, names)
-        else:
-            data.add(name, raw.point_data[name])
-    raw.point_data = data
+    deferred = {}
+    for name, arr in lazy.items():
+        ncomp, names = _components(arr)
+        deferred[name] = (partial(_load, fmt, arr, n, ncomp, stamp), ncomp, names)
+    defer_point_arrays(raw, list(_named(piece, "PointData")), deferred)
 
 
 def _load(fmt: _Format, arr: DataArray, n: int, ncomp: int, stamp) -> np.ndarray:

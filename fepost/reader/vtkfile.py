@@ -193,19 +193,14 @@ def _add_skipped(raw: RawMesh, path: Path, chosen) -> None:
     """Put the point arrays left out of the read back into ``raw``, in file order, as loaders."""
     from functools import partial
 
-    from .raw import LazyArrays
+    from .raw import defer_point_arrays
 
-    data = LazyArrays()
-    for name in chosen.order:
-        if name in chosen.skipped:
-            ncomp, names = chosen.skipped[name]
-            data.add(name, partial(_read_one, path, name, len(raw.points)))
-            raw.ncomp[name] = ncomp
-            if names:
-                raw.components.setdefault(name, names)
-        else:
-            data.add(name, raw.point_data[name])
-    raw.point_data = data
+    n = len(raw.points)
+    deferred = {
+        name: (partial(_read_one, path, name, n), ncomp, names)
+        for name, (ncomp, names) in chosen.skipped.items()
+    }
+    defer_point_arrays(raw, chosen.order, deferred)
 
 
 def _read_one(path: Path, name: str, n: int) -> np.ndarray:

@@ -29,18 +29,21 @@ from .checks import (
     release,
 )
 
-_SIZES = {
-    "Int8": 1,
-    "UInt8": 1,
-    "Int16": 2,
-    "UInt16": 2,
-    "Int32": 4,
-    "UInt32": 4,
-    "Int64": 8,
-    "UInt64": 8,
-    "Float32": 4,
-    "Float64": 8,
+#: The numpy type code of each numeric ``type`` attribute (`vtkdirect` decodes with it) ...
+NUMPY_TYPES = {
+    "Int8": "i1",
+    "UInt8": "u1",
+    "Int16": "i2",
+    "UInt16": "u2",
+    "Int32": "i4",
+    "UInt32": "u4",
+    "Int64": "i8",
+    "UInt64": "u8",
+    "Float32": "f4",
+    "Float64": "f8",
 }
+#: ... and its size in bytes.
+_SIZES = {name: int(code[1]) for name, code in NUMPY_TYPES.items()}
 _ROOT = {
     ".vtu": "UnstructuredGrid",
     ".vtp": "PolyData",
