@@ -298,13 +298,20 @@ def friction_resultants(
     big = vx.size * quad.x.size >= KERNEL_MIN_ELEMENTS
     centres = _centres(setting, vx=vx, vy=vy, wz=wz)
     with ThreadPoolExecutor(max_workers=1) as side:
-        # the polar moments about the centres need no node sums: they are computed meanwhile
-        rays = side.submit(ray_integrals, quad.domain, centres[1], centres[2]) if centres[0].size else None
+        # the polar moments about the centres need no node sums: with more than one worker
+        # they are computed meanwhile, on a thread of their own
+        rays = None
+        if centres[0].size and workers > 1:
+            rays = side.submit(ray_integrals, quad.domain, centres[1], centres[2])
         if backend == "numpy" or (backend == "auto" and not (nodesums.AVAILABLE and big)):
             sx, sy = _numpy_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
         else:
             sx, sy = _compiled_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
-        r = rays.result() if rays is not None else None
+        r: np.ndarray | None = None
+        if rays is not None:
+            r = rays.result()
+        elif centres[0].size:
+            r = ray_integrals(quad.domain, centres[1], centres[2])
     with threadpool_limits(limits=1, user_api="blas"):
         fx, fy, mz = _finish(setting, vx=vx, vy=vy, wz=wz, sx=sx, sy=sy, centres=centres, rays=r)
     return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))

@@ -216,7 +216,7 @@ def _decode_piece(fmt, data, piece, suffix, field, displacement) -> tuple[Part, 
             job.start(pool)  # the largest first: the two threads finish together
 
         def decode(arr: DataArray) -> np.ndarray:
-            return jobs[id(arr)].result() if id(arr) in jobs else _values(fmt, data, arr)
+            return jobs[id(arr)].result()
 
         points = decode(points_arrays[0]) if npts else np.empty(0)
         points = np.asarray(points, float).reshape(npts, 3)
