@@ -251,18 +251,6 @@ def heavy():
     return analyse(HEAVY)
 
 
-AIRCRAFT = Path(__file__).resolve().parents[1] / "meshes" / "aircraft"
-
-
-@pytest.fixture(scope="module")
-def aircraft():
-    """The demo's case: the aircraft tire at its rated load, static and rolling."""
-    static, rolling = AIRCRAFT / "static_100.vtu", AIRCRAFT / "rolling_100.vtu"
-    if not (static.is_file() and rolling.is_file()):
-        pytest.skip(f"{AIRCRAFT} not shipped")
-    return analyse(static, rolling)
-
-
 def _projected(points, renderer):
     out = []
     for p in points:

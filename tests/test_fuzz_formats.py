@@ -51,6 +51,20 @@ def _refused(path: Path, capsys, pattern: str) -> None:
     assert re.search(pattern, err), err
 
 
+def _mutated_copies(path: Path, seed: int, capsys, reference) -> dict[str, int]:
+    """Read `MUTATIONS` mutated copies of ``path`` beside it: how many were read right
+    ("ok") and how many refused (`_ok_or_refused` fails the test on anything else)."""
+    text = path.read_bytes()
+    rng = random.Random(seed)
+    seen = {"ok": 0, "refused": 0}
+    for k in range(MUTATIONS):
+        _, data = _mutate(text, rng)
+        bad = path.with_name(f"mut{k}{path.suffix}")
+        bad.write_bytes(data)
+        seen[_ok_or_refused(bad, capsys, reference)] += 1
+    return seen
+
+
 def _ok_or_refused(path: Path, capsys, expected: float) -> str:
     code, lines, result = _run(path, capsys)
     if code != 0:
@@ -123,15 +137,7 @@ def test_mutated_parallel_headers(base, tmp_path, capsys):
 
     path = _parallel(base, tmp_path / "p")
     reference = analyse(path).static_patch.N_fe  # the pieces hold float32 coordinates
-    text = path.read_bytes()
-    rng = random.Random(SEED)
-    seen = {"ok": 0, "refused": 0}
-    for k in range(MUTATIONS):
-        _, data = _mutate(text, rng)
-        bad = path.with_name(f"mut{k}.pvtu")
-        bad.write_bytes(data)
-        seen[_ok_or_refused(bad, capsys, reference)] += 1
-    assert seen["refused"] > 0
+    assert _mutated_copies(path, SEED, capsys, reference)["refused"] > 0
 
 
 # ------------------------------------------------------------------------------ structured grids
@@ -240,15 +246,7 @@ def test_xdmf_structure(base, tmp_path, capsys):
 
 def test_mutated_xdmf_text(base, reference, tmp_path, capsys):
     path = _xdmf(base, tmp_path / "x")
-    text = path.read_bytes()
-    rng = random.Random(SEED + 1)
-    seen = {"ok": 0, "refused": 0}
-    for k in range(MUTATIONS):
-        _, data = _mutate(text, rng)
-        bad = path.with_name(f"mut{k}.xdmf")
-        bad.write_bytes(data)
-        seen[_ok_or_refused(bad, capsys, reference)] += 1
-    assert seen["refused"] > 0
+    assert _mutated_copies(path, SEED + 1, capsys, reference)["refused"] > 0
 
 
 def _converted(path: Path) -> Path:

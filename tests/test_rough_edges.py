@@ -15,13 +15,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from fepost.analysis import analyse  # noqa: E402
 from fepost.figures.errormap import plot_error_map  # noqa: E402
 from fepost.figures.section import diameter_sections, plot_sections  # noqa: E402
 from fepost.friction.sphere import ErrorMap  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
-AIRCRAFT = REPO / "meshes" / "aircraft"
 #: Smallest text (pixels on screen) the report may show.
 READABLE_PX = 12.0
 
@@ -102,14 +100,6 @@ def test_load_trend_legends_are_readable_in_the_report(tmp_path):
     shown = min(1.0, _report_image_width() / width_px)
     px_per_pt = width_px / width_in / 72.0
     assert min(sizes) * px_per_pt * shown >= READABLE_PX, (min(sizes), width_px)
-
-
-@pytest.fixture(scope="module")
-def aircraft():
-    static, rolling = AIRCRAFT / "static_100.vtu", AIRCRAFT / "rolling_100.vtu"
-    if not (static.is_file() and rolling.is_file()):
-        pytest.skip(f"{AIRCRAFT} not shipped")
-    return analyse(static, rolling)
 
 
 def test_figure3_draws_the_rolling_radius_the_rolling_curve_reaches(aircraft):

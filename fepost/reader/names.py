@@ -23,7 +23,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, replace
 
-from ..errors import FieldError
+from ..errors import FepostError, FieldError
 
 #: Normalised (lower-case, alphanumerics only) names taken as contact pressure.
 PRESSURE_NAMES = (
@@ -199,3 +199,21 @@ def pick_displacement(source: str, catalogue: list[ArrayInfo], displacement: str
     if hit.ncomp < 2:
         raise FieldError(f"{source}: displacement array {displacement!r} is not a vector per node")
     return hit.name
+
+
+def needed_point_arrays(
+    source: str, catalogue: list[ArrayInfo], field: str | None, displacement: str | None
+) -> set[str] | None:
+    """The point arrays a contact field reads from ``catalogue``: the pressure (when it is
+    nodal) and the displacement, chosen as `pick_field` and `pick_displacement` choose them;
+    None when the choice fails (the reader then decodes every array and raises the same
+    error on the same catalogue). Lets a reader leave the other arrays undecoded."""
+    try:
+        choice = pick_field(source, catalogue, field)
+        disp = pick_displacement(source, catalogue, displacement)
+    except FepostError:
+        return None
+    keep = {choice.name} if choice.location == "point" else set()
+    if disp is not None:
+        keep.add(disp)
+    return keep

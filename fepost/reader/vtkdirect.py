@@ -49,9 +49,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from ..errors import FepostError, InputFileError
+from ..errors import InputFileError
 from .checks import release
-from .names import ArrayInfo, pick_displacement, pick_field
+from .names import ArrayInfo, needed_point_arrays
 from .raw import RawMesh, defer_point_arrays
 from .transfer import huge_map
 from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
@@ -234,15 +234,7 @@ def _chosen(path, point_arrays, cell_arrays, field, displacement) -> set[str] | 
     catalogue += [
         ArrayInfo(n, "cell", *_components(a)) for n, a in cell_arrays.items() if n not in point_arrays
     ]
-    try:
-        choice = pick_field(str(path), catalogue, field)
-        disp = pick_displacement(str(path), catalogue, displacement)
-    except FepostError:
-        return None  # the contact field raises the same error on the same catalogue
-    keep = {choice.name} if choice.location == "point" else set()
-    if disp is not None:
-        keep.add(disp)
-    return keep
+    return needed_point_arrays(str(path), catalogue, field, displacement)
 
 
 def _arrays(arrays, n, decode, components, keep) -> dict[str, np.ndarray]:

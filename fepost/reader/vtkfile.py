@@ -174,7 +174,8 @@ def read_vtk(
     leaves = [leaf for leaf in leaves if leaf is not None and leaf.GetNumberOfPoints() > 0]
     if not leaves:
         raise InputFileError(f"{path}: the file holds no mesh (0 nodes or 0 cells)")
-    raw = _assemble(path, leaves, f"{_FORMAT_NAMES.get(suffix, 'VTK XML')} ({suffix})")
+    fmt = f"{_FORMAT_NAMES.get(suffix, 'VTK XML')} ({suffix})"
+    raw = assemble(path, [_part(path, leaf) for leaf in leaves], fmt)
     declared = sum(counts.connectivity)
     if declared and suffix != ".vtm" and not ghosts and declared != raw.connectivity_size:
         raise InputFileError(
@@ -282,10 +283,6 @@ def _part(path: Path, leaf) -> Part:
     types, off, con = _cells(ds)
     cell_data = _data_arrays(path, ds.GetCellData(), len(types), "cell", components)
     return Part(pts, types, off, con, point_data, cell_data, components)
-
-
-def _assemble(path: Path, leaves: list, fmt: str) -> RawMesh:
-    return assemble(path, [_part(path, leaf) for leaf in leaves], fmt)
 
 
 def _numeric(arr) -> bool:

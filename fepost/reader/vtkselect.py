@@ -29,8 +29,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import FepostError
-from .names import ArrayInfo, pick_displacement, pick_field
+from .names import ArrayInfo, needed_point_arrays
 
 #: Serial XML suffixes whose point arrays are selected before the read. Structured grids
 #: (``.vts .vtr``) are not: their conversion to cells (VTK's append filter) reorders the
@@ -133,12 +132,9 @@ def plan(path: Path, reader, field: str | None, displacement: str | None) -> Pla
         if n not in seen:
             seen.add(n)
             catalogue.append(ArrayInfo(n, "cell", k, _padded(comps.get(("CellData", n)), k)))
-    try:
-        choice = pick_field(str(path), catalogue, field)
-        disp = pick_displacement(str(path), catalogue, displacement)
-    except FepostError:
+    keep = needed_point_arrays(str(path), catalogue, field, displacement)
+    if keep is None:
         return None  # the general path raises the same error, with the same catalogue
-    keep = {disp} | ({choice.name} if choice.location == "point" else set())
     sel = reader.GetPointDataArraySelection()
     skipped = {}
     for a in catalogue[: len(points)]:
