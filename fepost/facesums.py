@@ -11,18 +11,23 @@ corner pressures s_k and area A:
 
 The pass runs over chunks of faces with the corners laid out as (3, chunk)
 rows: the temporaries stay in cache and their memory stays bounded on
-million-node meshes. (A thread pool over the chunks was measured slower on a
-2-core machine: the many short numpy calls contend for the GIL.)
+million-node meshes. From `_SPLIT` chunks on, two threads take half the chunks
+each; every chunk's totals are kept and added in chunk order afterwards, so the
+result does not depend on the number of threads, bit for bit.
 """
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
 #: Faces per chunk: (3, chunk) float temporaries of 384 kB each (they stay in cache).
 CHUNK = 1 << 14
+#: From this many chunks on, two threads share them (numpy lets go of the GIL in each call).
+_SPLIT = 16
 
 # 7-point degree-5 rule on the triangle (barycentric coordinates; weights sum to 1)
 _A1, _B1 = 0.059715871789770, 0.470142064105115
@@ -111,51 +116,73 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
     X = np.ascontiguousarray(x, dtype=float)
     Y = np.ascontiguousarray(y, dtype=float)
     V = np.ascontiguousarray(values, dtype=float)
-    # running totals of 2A·(3σ̄, 12σ̄x̄ terms …): the constant factors are applied once at the end
+    chunks = _chunks(len(tri))
+    # per chunk: 2A·(3σ̄, 12σ̄x̄ terms …) and the longest edge²; the constant factors are applied once
+    parts = np.zeros((len(chunks), 10))
+
+    def run(first: int, stop: int) -> None:
+        for i in range(first, stop):
+            parts[i] = _chunk_sums(X, Y, V, tri[chunks[i]], V[chunks[i]], location)
+
+    half = len(chunks) // 2 if len(chunks) >= _SPLIT and (os.cpu_count() or 1) > 1 else 0
+    if half:
+        with ThreadPoolExecutor(max_workers=1) as side:
+            other = side.submit(run, half, len(chunks))
+            run(0, half)
+            other.result()
+    else:
+        run(0, len(chunks))
     tot = np.zeros(9)
-    e2 = 0.0
-    for sl in _chunks(len(tri)):
-        t = np.ascontiguousarray(tri[sl].T)
-        px, py = X.take(t), Y.take(t)  # corner coordinates, (3, chunk)
-        x0, x1, x2 = px
-        y0, y1, y2 = py
-        ax, ay = x1 - x0, y1 - y0
-        bx, by = x2 - x0, y2 - y0
-        a = ax * by
-        a -= ay * bx
-        np.abs(a, out=a)  # twice the area
-        e = ax * ax
-        e += ay * ay
-        e2 = max(e2, float(e.max()))
-        np.multiply(bx, bx, out=e)
-        e += by * by
-        e2 = max(e2, float(e.max()))
-        bx -= ax
-        by -= ay
-        np.multiply(bx, bx, out=e)
-        e += by * by
-        e2 = max(e2, float(e.max()))
-        sx, sy = _rows(px), _rows(py)
-        if location == "point":
-            ps = V.take(t)  # corner pressures, (3, chunk)
-            ss = _rows(ps)
-            tot[0] += _dot(a, ss)
-            tot[1] += _dot(a, _corner_products(ps, px, ss, sx))
-            tot[2] += _dot(a, _corner_products(ps, py, ss, sy))
-        else:
-            ld = a * V[sl]
-            tot[0] += 3.0 * float(ld.sum())
-            tot[1] += 4.0 * _dot(ld, sx)
-            tot[2] += 4.0 * _dot(ld, sy)
-        tot[3] += float(a.sum())
-        tot[4] += _dot(a, sx)
-        tot[5] += _dot(a, sy)
-        tot[6] += _dot(a, _corner_products(px, px, sx, sx))
-        tot[7] += _dot(a, _corner_products(py, py, sy, sy))
-        tot[8] += _dot(a, _corner_products(px, py, sx, sy))
+    for part in parts:  # the chunks' totals in their order: the same sums on one thread or two
+        tot += part[:9]
+    e2 = float(parts[:, 9].max()) if len(chunks) else 0.0
     # 2A → A, with the 1/3, 1/12 of the closed forms
     N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy = (float(v) for v in tot * _SCALE)
     return FaceSums(N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy, float(np.sqrt(e2)))
+
+
+def _chunk_sums(X, Y, V, tri: np.ndarray, face_values: np.ndarray, location: str) -> np.ndarray:
+    """The running totals' terms of one chunk of faces and its longest edge², a (10,) array."""
+    out = np.empty(10)
+    t = np.ascontiguousarray(tri.T)
+    px, py = X.take(t), Y.take(t)  # corner coordinates, (3, chunk)
+    x0, x1, x2 = px
+    y0, y1, y2 = py
+    ax, ay = x1 - x0, y1 - y0
+    bx, by = x2 - x0, y2 - y0
+    a = ax * by
+    a -= ay * bx
+    np.abs(a, out=a)  # twice the area
+    e = ax * ax
+    e += ay * ay
+    e2 = float(e.max())
+    np.multiply(bx, bx, out=e)
+    e += by * by
+    e2 = max(e2, float(e.max()))
+    bx -= ax
+    by -= ay
+    np.multiply(bx, bx, out=e)
+    e += by * by
+    out[9] = max(e2, float(e.max()))
+    sx, sy = _rows(px), _rows(py)
+    if location == "point":
+        ps = V.take(t)  # corner pressures, (3, chunk)
+        ss = _rows(ps)
+        out[0] = _dot(a, ss)
+        out[1] = _dot(a, _corner_products(ps, px, ss, sx))
+        out[2] = _dot(a, _corner_products(ps, py, ss, sy))
+    else:
+        ld = a * face_values
+        out[0] = 3.0 * float(ld.sum())
+        out[1] = 4.0 * _dot(ld, sx)
+        out[2] = 4.0 * _dot(ld, sy)
+    out[3] = float(a.sum())
+    out[4] = _dot(a, sx)
+    out[5] = _dot(a, sy)
+    out[6] = _dot(a, _corner_products(px, px, sx, sx))
+    out[7] = _dot(a, _corner_products(py, py, sy, sy))
+    out[8] = _dot(a, _corner_products(px, py, sx, sy))
+    return out
 
 
 #: From the running totals (2A times the corner sums) to the integrals.

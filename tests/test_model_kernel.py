@@ -99,6 +99,25 @@ def test_kernel_equals_numpy_on_random_and_singular_kinematics(models, name):
     assert_same(model, got, ref)
 
 
+@pytest.mark.parametrize("name", ["hertz 72", "tire-like 204", "anisotropic", "odd order (3, 5)"])
+def test_a_point_gets_the_same_bits_wherever_it_sits(models, name):
+    """The kernel contracts multiply-adds into FMAs: the vectorised body of each block loop
+    and its scalar remainder must round alike, so that a point's forces do not depend
+    on its position in the array (nor on the length of the array), bit for bit."""
+    model = models[name]
+    vx, vy, wz = random_kinematics(700, seed=11)
+    svx, svy, swz = singular_kinematics()
+    vx, vy, wz = (np.concatenate([a, b]) for a, b in ((vx, svx), (vy, svy), (wz, swz)))
+    ref = model.evaluate(vx, vy, wz, backend="numba")
+    for shift in (*range(1, 17), kernel.BLOCK - 1, kernel.BLOCK + 3):
+        got = model.evaluate(vx[shift:], vy[shift:], wz[shift:], backend="numba")
+        for a, b in zip(got, ref, strict=True):
+            np.testing.assert_array_equal(a, b[shift:])
+    for i in range(0, vx.size, 37):  # one point alone: the scalar remainder only
+        got = model.evaluate(vx[i : i + 1], vy[i : i + 1], wz[i : i + 1], backend="numba")
+        assert [float(a[0]) for a in got] == [float(b[i]) for b in ref]
+
+
 def test_singular_points_have_their_exact_limits(models):
     """Independent of the numpy path (module docstring of fepost.friction.model): zero
     velocity gives zero, pure spin the torque −sgn(ω_z) M0, pure sliding along x the
@@ -199,3 +218,50 @@ def test_short_jobs_do_not_import_numba():
         "assert 'numba' not in sys.modules, 'numba was imported'\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=300)
+
+
+@pytest.mark.parametrize("backend", ["numba", "numpy"])
+def test_outputs_into_given_arrays(models, backend):
+    """``out=``: a simulation loop reuses its arrays; the numbers are those of a fresh call,
+    bit for bit, also when the outputs are the inputs themselves."""
+    model = models["anisotropic"]
+    vx, vy, wz = (a.reshape(40, 50) for a in random_kinematics(2000, seed=8))
+    ref = model.evaluate(vx, vy, wz, backend=backend)
+    out = tuple(np.full((40, 50), np.nan) for _ in range(3))
+    got = model.evaluate(vx, vy, wz, backend=backend, out=out)
+    assert all(g is o for g, o in zip(got, out, strict=True))
+    for a, b in zip(got, ref, strict=True):
+        np.testing.assert_array_equal(a, b)
+    same = (vx.copy(), vy.copy(), wz.copy())
+    got = model.evaluate(*same, backend=backend, out=same)
+    for a, b in zip(got, ref, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize(
+    ("out", "message"),
+    [
+        ((np.empty(5),) * 2, "out must be three arrays (F_x, F_y, M_z)"),
+        (
+            (np.empty(5), np.empty(4), np.empty(5)),
+            "out[1] must be a writeable C-contiguous float64 array of shape (5,), got float64 (4,)",
+        ),
+        (
+            (np.empty(5), np.empty(5), np.empty(5, np.float32)),
+            "out[2] must be a writeable C-contiguous float64 array of shape (5,), got float32 (5,)",
+        ),
+        (
+            (np.empty(10)[::2], np.empty(5), np.empty(5)),
+            "out[0] must be a writeable C-contiguous float64 array of shape (5,), got float64 (5,)",
+        ),
+        (
+            (np.empty(5), [0.0] * 5, np.empty(5)),
+            "out[1] must be a writeable C-contiguous float64 array of shape (5,), got list",
+        ),
+        ((lambda a: (a, a, np.empty(5)))(np.empty(5)), "out: the three arrays must not overlap"),
+    ],
+)
+def test_bad_out_arrays_are_named(models, out, message):
+    for backend in ("numba", "numpy"):
+        with pytest.raises(ArgumentError, match=re.escape(message)):
+            models["hertz 72"].evaluate(np.ones(5), 0.0, 1.0, backend=backend, out=out)

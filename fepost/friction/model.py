@@ -205,11 +205,17 @@ class GeneralisedModel:
         """
         return self.evaluate(vx, vy, wz)
 
-    def evaluate(self, vx, vy, wz, *, backend: str = "auto") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def evaluate(
+        self, vx, vy, wz, *, backend: str = "auto", out=None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """`__call__` with a choice of ``backend``: ``"numba"`` the compiled kernel
         (`fepost.friction.kernel`, the optional numba dependency), ``"numpy"`` whole-array
         numpy, ``"auto"`` (default) the kernel from `KERNEL_MIN_POINTS` points on when
         numba is installed, numpy otherwise. All give the same numbers to round-off.
+
+        ``out``: three writeable, C-contiguous float64 arrays of the broadcast shape that
+        receive F_x, F_y, M_z and are returned (a simulation loop then allocates nothing
+        per call; they may be the inputs themselves).
         """
         if backend not in BACKENDS:
             raise ArgumentError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
@@ -221,13 +227,16 @@ class GeneralisedModel:
         shape = vx.shape
         fvx, fvy, fwz = (np.ascontiguousarray(a.ravel()) for a in (vx, vy, wz))
         n = fvx.size
+        flat = None if out is None else tuple(a.reshape(n) for a in _checked_out(out, shape))
         if backend == "numba" or (backend == "auto" and kernel.AVAILABLE and n >= KERNEL_MIN_POINTS):
-            fx, fy, mz = kernel.evaluate(self.kernel_coefficients, fvx, fvy, fwz)
+            fx, fy, mz = kernel.evaluate(self.kernel_coefficients, fvx, fvy, fwz, out=flat)
         else:
-            fx, fy, mz = np.empty(n), np.empty(n), np.empty(n)
+            fx, fy, mz = (np.empty(n), np.empty(n), np.empty(n)) if flat is None else flat
             for start in range(0, n, CHUNK):
                 sl = slice(start, start + CHUNK)
                 fx[sl], fy[sl], mz[sl] = self._evaluate(fvx[sl], fvy[sl], fwz[sl])
+        if out is not None:
+            return out[0], out[1], out[2]
         return fx.reshape(shape), fy.reshape(shape), mz.reshape(shape)
 
     @cached_property
@@ -464,3 +473,19 @@ def _sphere_coordinates(vx, vy, u):
     cos1 = np.divide(-vy * sgn, v, out=np.ones_like(v), where=moving)
     sin1 = np.divide(vx * sgn, v, out=np.zeros_like(v), where=moving)
     return t, cos1, sin1, sgn, c, sn
+
+
+def _checked_out(out, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``out`` of `GeneralisedModel.evaluate`, or a one-line `ArgumentError` naming what is wrong."""
+    if not isinstance(out, (tuple, list)) or len(out) != 3:
+        raise ArgumentError("out must be three arrays (F_x, F_y, M_z)")
+    for k, a in enumerate(out):
+        ok = isinstance(a, np.ndarray) and a.dtype == np.float64 and a.shape == shape
+        if not (ok and a.flags.c_contiguous and a.flags.writeable):
+            got = f"{a.dtype} {a.shape}" if isinstance(a, np.ndarray) else type(a).__name__
+            raise ArgumentError(
+                f"out[{k}] must be a writeable C-contiguous float64 array of shape {shape}, got {got}"
+            )
+    if any(np.may_share_memory(out[i], out[j]) for i, j in ((0, 1), (0, 2), (1, 2))):
+        raise ArgumentError("out: the three arrays must not overlap")
+    return out[0], out[1], out[2]
