@@ -1,5 +1,6 @@
 """Reading in a forked child: crashes, hangs, memory, chatter, warnings and daemonic processes."""
 
+import mmap
 import multiprocessing as mp
 import os
 import signal
@@ -369,3 +370,21 @@ def test_streams_another_thread_is_writing_do_not_block_the_child(monkeypatch):
         assert isolate.call(_print_and_answer, what="probe", timeout=15) == 7
     finally:
         lock.release()
+
+
+@pytest.mark.parametrize(("shape", "dtype"), [((7, 3), float), ((1 << 20, 3), float), ((1 << 21,), np.int64)])
+def test_fresh_arrays_are_zero_filled_and_writable(shape, dtype):
+    """A reader's output arrays: zeros of the shape and type asked for, on huge pages from
+    `HUGE_FROM` bytes up (their buffer is then a map, kept alive by the array)."""
+    a = transfer.fresh_array(shape, dtype)
+    assert a.shape == shape and a.dtype == np.dtype(dtype) and a.flags.writeable and a.flags.c_contiguous
+    assert not a.any()
+    root = a
+    while isinstance(root, np.ndarray) and root.base is not None:
+        root = root.base
+    if a.nbytes >= transfer.HUGE_FROM:
+        assert isinstance(root, memoryview) and isinstance(root.obj, mmap.mmap)
+    else:
+        assert root is a
+    a[...] = 5
+    assert int(a.sum()) == 5 * a.size

@@ -183,13 +183,15 @@ def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.
     speed += wy * wy
     np.sqrt(speed, out=speed)
     # two reductions decide whether any square could have under- or overflowed (rare)
-    if not (speed.min(initial=np.inf) > 1e-150 and speed.max(initial=0.0) < 1e150):
+    low = speed.min(initial=np.inf)
+    if not (low > 1e-150 and speed.max(initial=0.0) < 1e150):
         odd = ~((speed > 1e-150) & (speed < 1e150))
         speed[odd] = np.hypot(wx[odd], wy[odd])
+        low = speed.min(initial=np.inf)
     if law.depends_on_speed:
         inv = np.divide(1.0, speed, out=np.zeros_like(speed), where=speed > 0)
     else:  # |w| is not needed after this: 1/|w| in its place (0 at the centre of rotation)
-        where = True if speed.min(initial=np.inf) > 0 else speed > 0  # 0 stays 0
+        where = True if low > 0 else speed > 0  # 0 stays 0
         inv = np.divide(1.0, speed, out=speed, where=where)
     wx *= inv
     wy *= inv

@@ -29,6 +29,7 @@ import numpy as np
 from ..errors import InputFileError
 from .cells import SPECS, check_connectivity, exodus_type
 from .raw import Block, RawMesh, SideSet
+from .transfer import fresh_array
 
 #: Largest node or element count accepted from a header (beyond any contact model).
 MAX_ENTITIES = 1 << 31
@@ -115,7 +116,7 @@ def _indices(ds, name: str, shape: tuple[int, ...]) -> np.ndarray:
     a = np.asarray(v[:])
     if a.shape != shape:
         raise ValueError(f"variable {name} has shape {a.shape}, expected {shape}")
-    return np.subtract(a, 1, dtype=np.int64, casting="unsafe")
+    return np.subtract(a, 1, out=fresh_array(shape, np.int64), casting="unsafe")
 
 
 def _steps(ds, path: Path | str) -> np.ndarray:
@@ -214,7 +215,7 @@ def _read_exodus(ds, path: Path, step: int | None) -> RawMesh:
         cols = [np.empty(0)] * ndim
     else:
         raise KeyError("coordx")
-    points = np.zeros((n_nodes, 3))
+    points = fresh_array((n_nodes, 3), float)
     for k, c in enumerate(cols):
         points[:, k] = c
     if not np.all(np.isfinite(points)):

@@ -53,7 +53,7 @@ from ..errors import InputFileError
 from .checks import release
 from .names import ArrayInfo, needed_point_arrays
 from .raw import RawMesh, defer_point_arrays
-from .transfer import huge_map
+from .transfer import fresh_array
 from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
 from .xmlcheck import NUMPY_TYPES, DataArray, Xml
 
@@ -80,8 +80,6 @@ _FORMATS = {".vtu": "VTK XML (.vtu)", ".vtp": "VTK XML (.vtp)"}
 #: Blocks inflated per thread task (a compressed array of more blocks is shared by two threads).
 _BATCH = 64
 _SPACE = b" \t\r\n"
-#: Buffers from this size (bytes) up are mapped on huge pages.
-_HUGE_FROM = 4 << 20
 _CELL_SECTIONS = ("Cells", *(name for name, _ in POLY_SECTIONS))
 
 
@@ -442,10 +440,8 @@ def _plain(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str) ->
 
 
 def _buffer(nbytes: int) -> np.ndarray:
-    """A writable byte buffer; large ones on huge pages (a forked reader's pages are all new)."""
-    if nbytes < _HUGE_FROM:
-        return np.empty(nbytes, np.uint8)
-    return np.frombuffer(huge_map(nbytes), np.uint8, count=nbytes)
+    """A writable byte buffer (large ones on huge pages: a forked reader's pages are all new)."""
+    return fresh_array(nbytes, np.uint8)
 
 
 def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str):
