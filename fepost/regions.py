@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .components import item_parts
 from .errors import PatchError
 from .facegroups import FaceGroup
 from .facesums import FaceSums
@@ -155,9 +156,6 @@ def check_single_surface(fld: ContactField, groups: list[FaceGroup], hot: np.nda
     patches. Faces are connected when they share a node loaded above the threshold, so a
     side face touching two patches at its unloaded middle does not join them.
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     rows, cols, loads = [], [], []
     start = 0
     for g in groups:
@@ -170,12 +168,7 @@ def check_single_surface(fld: ContactField, groups: list[FaceGroup], hot: np.nda
         vals = np.nan_to_num(fld.values if fld.location == "point" else np.asarray(g.values))
         loads.append(face_surface_loads(g.ftype, points, g.conn, vals, fld.location))
         start += m
-    nf = start
-    r, c = np.concatenate(rows), np.concatenate(cols)
-    g = coo_matrix((np.ones(len(r), np.int8), (r, nf + c)), shape=(nf + len(points), nf + len(points)))
-    count, labels = connected_components(g, directed=False)
-    lab = labels[:nf]
-    _, lab = np.unique(lab, return_inverse=True)
+    _, lab = item_parts(np.concatenate(rows), np.concatenate(cols), start)
     share = np.bincount(lab, weights=np.concatenate(loads))
     share = share / share.sum()
     big = np.sort(share[share > FRAGMENT_SHARE])[::-1]

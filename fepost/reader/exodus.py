@@ -386,7 +386,11 @@ def _nodal(ds, raw: RawMesh, n_nodes: int, chosen: int | None) -> None:
     for base, comps in vector_groups(list(index)).items():
 
         def vec(comps=comps) -> np.ndarray:
-            return np.column_stack([raw.point_data[c] for c in comps])
+            cols = [np.asarray(raw.point_data[c], float) for c in comps]
+            out = fresh_array((len(cols[0]), len(cols)), float)
+            for k, c in enumerate(cols):
+                out[:, k] = c
+            return out
 
         raw.point_data.add(base, vec)
         raw.components[base] = comps

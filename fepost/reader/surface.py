@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..components import item_parts
 from ..errors import FieldError
 from .cells import FACE_TYPES, SPECS, Faces, boundary_faces, pack_key, side_faces
 from .raw import RawMesh
@@ -207,22 +208,12 @@ def _side_set_note(raw: RawMesh, surf: Surface, point_values: np.ndarray) -> str
 
 def _parts(cand_blocks: list[tuple[str, np.ndarray]], n_points: int) -> np.ndarray:
     """Connected part of each candidate element (elements sharing a node are connected)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     conns = [c for _, c in cand_blocks]
-    m = sum(len(c) for c in conns)
     nodes = np.concatenate([c.ravel() for c in conns])
     elem = np.concatenate([np.repeat(np.arange(len(c)), c.shape[1]) for c in conns])
     offsets = np.cumsum([0] + [len(c) for c in conns])[:-1]
     elem = elem + np.repeat(offsets, [c.size for c in conns])
-    used, local = np.unique(nodes, return_inverse=True)
-    g = coo_matrix(
-        (np.ones(len(elem), np.int8), (elem, m + local.ravel())), shape=(m + len(used), m + len(used))
-    )
-    _, labels = connected_components(g, directed=False)
-    _, part = np.unique(labels[:m], return_inverse=True)
-    return part
+    return item_parts(elem, nodes, sum(len(c) for c in conns))[1]
 
 
 def _choose_parts(
