@@ -195,6 +195,8 @@ def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.
         inv = np.divide(1.0, speed, out=speed, where=where)
     wx *= inv
     wy *= inv
+    if not law.depends_on_speed:  # one product per component: ŵ read once
+        return wx @ nodes.bx, wy @ nodes.by
     ncol = nodes.bx.shape[1]
     sx = np.empty((vx.size, ncol))
     sy = np.empty((vx.size, ncol))
