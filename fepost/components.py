@@ -5,14 +5,16 @@ Why not always ``scipy.sparse.csgraph.connected_components``: importing it takes
 and ``scipy.linalg`` through the package's ``__init__``), about what reading a
 million-node Exodus file takes otherwise, and the reader needs it for every volume
 mesh, usually on a small graph (the elements that touch the loaded nodes). Up to
-`SCIPY_FROM` pairs the parts are found here; on larger graphs scipy's labelling
-is faster than its import costs. The graph here is always bipartite (items and the nodes they list), which
-whole-array union–find handles in a few passes: every pair (item, node) that
-joins two roots hooks the larger onto the smaller (a root only ever points to a
-smaller index, so no cycle forms), then pointers jump to their roots, until no
-pair joins two roots. A root is therefore the smallest index of its part, and the
-parts are numbered in the order of their smallest index — the numbering of scipy's
-breadth-first labelling, which `tests/test_components.py` checks on random graphs.
+`SCIPY_FROM` pairs the parts are found here; on larger graphs scipy's labelling is
+faster than its import costs.
+
+The graph is bipartite (items and the nodes they list), which whole-array
+union–find handles in a few passes: every pair (item, node) that joins two roots
+hooks the larger onto the smaller (a root only ever points to a smaller index, so no
+cycle forms), then pointers jump to their roots, until no pair joins two roots. A
+root is therefore the smallest index of its part, and the parts are numbered in the
+order of their smallest index — the numbering of scipy's breadth-first labelling,
+which `tests/test_components.py` checks on random graphs.
 """
 
 from __future__ import annotations
