@@ -434,14 +434,9 @@ def _raw_payload(fmt: _Format, data, start: int, name: str) -> tuple[tuple[int, 
 def _plain(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str) -> np.ndarray:
     if len(body) < words[0]:
         raise InputFileError(f"{fmt.path}: array {name!r}: truncated data")
-    out = _buffer(words[0])
+    out = fresh_array(words[0], np.uint8)
     out[:] = np.frombuffer(body, np.uint8, count=words[0])
     return out
-
-
-def _buffer(nbytes: int) -> np.ndarray:
-    """A writable byte buffer (large ones on huge pages: a forked reader's pages are all new)."""
-    return fresh_array(nbytes, np.uint8)
 
 
 def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str):
@@ -449,7 +444,7 @@ def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str
     nblocks, block, last = words[0], words[1], words[2]
     sizes = words[3:]
     total = 0 if nblocks == 0 else (nblocks - 1) * block + (last or block)
-    out = _buffer(total)
+    out = fresh_array(total, np.uint8)  # a forked reader's pages are all new: huge pages
     starts = np.concatenate(([0], np.cumsum(sizes, dtype=np.int64))).tolist()
     if starts[-1] > len(body):
         raise InputFileError(f"{fmt.path}: array {name!r}: compressed data shorter than its header says")
