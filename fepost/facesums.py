@@ -122,7 +122,7 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
 
     def run(first: int, stop: int) -> None:
         for i in range(first, stop):
-            parts[i] = _chunk_sums(X, Y, V, tri[chunks[i]], V[chunks[i]], location)
+            parts[i] = _chunk_sums(X, Y, V, tri, chunks[i], location)
 
     half = len(chunks) // 2 if len(chunks) >= _SPLIT and (os.cpu_count() or 1) > 1 else 0
     if half:
@@ -141,10 +141,10 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
     return FaceSums(N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy, float(np.sqrt(e2)))
 
 
-def _chunk_sums(X, Y, V, tri: np.ndarray, face_values: np.ndarray, location: str) -> np.ndarray:
-    """The running totals' terms of one chunk of faces and its longest edge², a (10,) array."""
+def _chunk_sums(X, Y, V, tri: np.ndarray, sl: slice, location: str) -> np.ndarray:
+    """The running totals' terms of the faces ``tri[sl]`` and their longest edge², a (10,) array."""
     out = np.empty(10)
-    t = np.ascontiguousarray(tri.T)
+    t = np.ascontiguousarray(tri[sl].T)
     px, py = X.take(t), Y.take(t)  # corner coordinates, (3, chunk)
     x0, x1, x2 = px
     y0, y1, y2 = py
@@ -172,7 +172,7 @@ def _chunk_sums(X, Y, V, tri: np.ndarray, face_values: np.ndarray, location: str
         out[1] = _dot(a, _corner_products(ps, px, ss, sx))
         out[2] = _dot(a, _corner_products(ps, py, ss, sy))
     else:
-        ld = a * face_values
+        ld = a * V[sl]
         out[0] = 3.0 * float(ld.sum())
         out[1] = 4.0 * _dot(ld, sx)
         out[2] = 4.0 * _dot(ld, sy)
