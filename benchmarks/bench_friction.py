@@ -10,6 +10,12 @@ a fine grid. Errors are relative to the natural scales: |ΔF|/(fN) for Fx, Fy an
 |ΔM_z|/M0 with M0 = f∬σ r dA, the pure-spin torque; ``numpy-numba`` is the
 largest difference between the two paths on the same grid (round-off).
 
+A second table times what ``fepost coefficients`` spends on friction, the build of the
+generalised model of one map (fit grid 32 x 24 and check grid 32 x 33 of exact values,
+`fepost.friction.build.build_model`), with the turned sums of `fepost.friction.turns`
+and with every point summed directly (the code before), alternating, and gives the
+largest difference of the two paths' exact values on the check grid (round-off).
+
 Run: ``.venv/bin/python benchmarks/bench_friction.py [--points 1000] [--nr 32 --nphi 64] [--threads 1]``
 """
 
@@ -22,7 +28,7 @@ import time
 import numpy as np
 
 from fepost.analytic import pressure_function
-from fepost.friction import nodesums
+from fepost.friction import build, nodesums, turns
 from fepost.friction.exact import friction_resultants
 from fepost.friction.law import FrictionLaw
 from fepost.friction.quadrature import FRICTION_NPHI, FRICTION_NR, PressureQuadrature, edge_grid
@@ -112,6 +118,40 @@ def main(argv: list[str] | None = None) -> None:
         name = f"{profile} k={k_x:g}"
         print(f"{name:<16}{cells}{up:>10.1f}{dF:>13.2e}{dM:>13.2e}{same:>13.1e}{inside:>8d}")
     print(f"load average before/after: {load:.2f} / {os.getloadavg()[0]:.2f} ({os.cpu_count()} CPUs)")
+    print()
+    model_builds(args)
+
+
+def model_builds(args: argparse.Namespace) -> None:
+    """Model builds with the turned sums and with direct sums, alternating (second table)."""
+    load = os.getloadavg()[0]
+    law = FrictionLaw(f=0.3)
+    layout = turns.polar_layout
+    print(f"model build, order (4, 8): grid {args.nr}x{args.nphi}; medians of {args.runs} alternating runs")
+    print(f"{'map':<16}{'turned s':>10}{'direct s':>10}{'speed-up':>10}{'turned-direct':>15}")
+    for profile, k_x in (("hertz", 0.0), ("hertz", 0.13), ("tire", 0.0)):
+        quad = quadrature(profile, args.nr, args.nphi, k_x)
+        times: dict[str, list[float]] = {"turned": [], "direct": []}
+        for _ in range(args.runs):
+            for name in ("turned", "direct"):
+                turns.polar_layout = layout if name == "turned" else (lambda q, n: None)
+                t0 = time.perf_counter()
+                build.build_model(quad, law, order=(4, 8))
+                times[name].append(time.perf_counter() - t0)
+        turns.polar_layout = layout
+        nodes, _ = np.polynomial.legendre.leggauss(build.CHECK_GRID[1])
+        vx, vy, u, _, _ = build.sphere_nodes(build.CHECK_GRID[0], 0.5 * (nodes + 1.0))
+        wz = u / quad.radius
+        a = friction_resultants(quad, vx, vy, wz, law, turns=build.CHECK_GRID[0])
+        b = friction_resultants(quad, vx, vy, wz, law)
+        m0 = law.f * float(quad.sigma @ (np.hypot(quad.x, quad.y) * quad.dA))
+        diff = max(
+            float(np.max(np.hypot(a.Fx - b.Fx, a.Fy - b.Fy))) / (law.f * quad.load),
+            float(np.max(np.abs(a.Mz - b.Mz))) / m0,
+        )
+        t, d = float(np.median(times["turned"])), float(np.median(times["direct"]))
+        print(f"{profile + f' k={k_x:g}':<16}{t:>10.3f}{d:>10.3f}{d / t:>10.1f}{diff:>15.1e}")
+    print(f"load average before/after: {load:.2f} / {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

@@ -159,7 +159,7 @@ def build_model(
     nodes, _ = np.polynomial.legendre.leggauss(n_t)
     vx, vy, u, th, t = sphere_nodes(n_theta, 0.5 * (nodes + 1.0))
     wz = u / R
-    exact = friction_resultants(eq, vx, vy, wz, iso)
+    exact = friction_resultants(eq, vx, vy, wz, iso, turns=n_theta)
     b = replace(base, anisotropy=1.0, correction_g=None)
     bx, by, bm = b(vx, vy, wz)
     cos1, sin1 = np.cos(th), np.sin(th)
@@ -186,7 +186,7 @@ def build_model(
 
     correction_g = None
     if law.anisotropy != 1.0:
-        exact2 = friction_resultants(eq, vx, vy, wz, FrictionLaw(f=law.f, anisotropy=2.0))
+        exact2 = friction_resultants(eq, vx, vy, wz, FrictionLaw(f=law.f, anisotropy=2.0), turns=n_theta)
         g_exact = exact2.Mz - exact.Mz
         g_base = base.lateral_moment(vx, vy, wz)
         w2, _ = basis.weight(t, *DIRECT_WEIGHT)
@@ -214,7 +214,7 @@ def measure_accuracy(
     c, s = np.cos(th_shift), np.sin(th_shift)
     vx, vy = c * vx - s * vy, s * vx + c * vy
     wz = u / model.R
-    exact = friction_resultants(quad, vx, vy, wz, law)
+    exact = friction_resultants(quad, vx, vy, wz, law, turns=n_theta)
     out: dict[str, object] = {
         "grid": f"{n_theta} directions x {n_t} t-nodes (Chebyshev, ends included), staggered"
     }

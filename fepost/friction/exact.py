@@ -34,6 +34,7 @@ from __future__ import annotations
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -41,6 +42,7 @@ from threadpoolctl import threadpool_limits
 from .._arrays import frozen
 from ..errors import ArgumentError
 from . import nodesums
+from . import turns as turns_mod
 from .law import FrictionLaw
 from .quadrature import Ellipse, PressureQuadrature
 
@@ -145,6 +147,37 @@ def ray_integrals(domain: Ellipse, px: np.ndarray, py: np.ndarray) -> np.ndarray
     return out
 
 
+def _rays(domain: Ellipse, idx: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+    """`ray_integrals` about the centres of the points ``idx`` (all integrated)."""
+    return ray_integrals(domain, px, py)
+
+
+def _turned_rays(
+    domain: Ellipse, idx: np.ndarray, px: np.ndarray, py: np.ndarray, *, n0: int, turns: int
+) -> np.ndarray:
+    """`ray_integrals` about the centres of points ``idx`` in ``turns`` groups of ``n0``
+    (`friction_resultants`' ``turns``) on a disc about the origin: a centre whose first-group
+    twin has the same trapezoid, turned onto itself, takes the twin's moments turned
+    (`fepost.friction.turns`); the others (a level on the edge of a node count) are integrated."""
+    group, twin = np.divmod(idx, n0)
+    first = np.flatnonzero(group == 0)
+    out = np.empty((idx.size, 9))
+    out[first] = ray_integrals(domain, px[first], py[first])
+    where = np.full(n0, -1)  # row of each first-group point among the centres
+    where[twin[first]] = first
+    counts = _theta_nodes(domain, domain.level(px, py))
+    src = where[twin]
+    ok = (group > 0) & (src >= 0)
+    ok[ok] = (counts[ok] == counts[src[ok]]) & (counts[ok] * group[ok] % turns == 0)
+    rows = np.flatnonzero(ok)
+    c, s = turns_mod.angles(turns)
+    out[rows] = turns_mod.turn_rays(out[src[rows]], c[group[rows]], s[group[rows]])
+    rest = np.flatnonzero((group > 0) & ~ok)
+    if rest.size:
+        out[rest] = ray_integrals(domain, px[rest], py[rest])
+    return out
+
+
 @dataclass(frozen=True)
 class _Nodes:
     """Per-node matrices the chunks share (read-only).
@@ -168,11 +201,11 @@ def _nodes(quad: PressureQuadrature, law: FrictionLaw, sigma_ref: float) -> _Nod
     return _Nodes(x, y, bx, by)
 
 
-def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.ndarray]:
-    """Sums over the nodes for one chunk of kinematic points: ŵ_x @ bx and ŵ_y @ by.
-
-    Columns 0, 1 carry the speed factor of μ; the others (plain dA) do not.
-    """
+def _directions(
+    nodes: _Nodes, law: FrictionLaw, vx, vy, wz
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """ŵ_x, ŵ_y (points, nodes) of the sliding velocity at every node (0 at the centre of
+    rotation), and |w| when μ depends on the sliding speed (else None)."""
     wx = np.multiply(wz[:, None], nodes.y[None, :])
     np.subtract(vx[:, None], wx, out=wx)
     wy = np.multiply(wz[:, None], nodes.x[None, :])
@@ -195,20 +228,42 @@ def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.
         inv = np.divide(1.0, speed, out=speed, where=where)
     wx *= inv
     wy *= inv
-    if not law.depends_on_speed:  # one product per component: ŵ read once
+    return wx, wy, (speed if law.depends_on_speed else None)
+
+
+def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.ndarray]:
+    """Sums over the nodes for one chunk of kinematic points: ŵ_x @ bx and ŵ_y @ by.
+
+    Columns 0, 1 carry the speed factor of μ; the others (plain dA) do not.
+    """
+    wx, wy, speed = _directions(nodes, law, vx, vy, wz)
+    if speed is None:  # one product per component: ŵ read once
         return wx @ nodes.bx, wy @ nodes.by
     ncol = nodes.bx.shape[1]
     sx = np.empty((vx.size, ncol))
     sy = np.empty((vx.size, ncol))
     sx[:, 2:] = wx @ nodes.bx[:, 2:]
     sy[:, 2:] = wy @ nodes.by[:, 2:]
-    if law.depends_on_speed:
-        factor = law.speed_factor(speed)
-        wx *= factor
-        wy *= factor
+    factor = law.speed_factor(speed)
+    wx *= factor
+    wy *= factor
     sx[:, :2] = wx @ nodes.bx[:, :2]
     sy[:, :2] = wy @ nodes.by[:, :2]
     return sx, sy
+
+
+def _turned_sums(setting: _Setting, *, vx, vy, wz, layout, turns: int) -> tuple[np.ndarray, np.ndarray]:
+    """The node sums of ``turns`` groups of points from the first group's (`fepost.friction.turns`):
+    ``vx``, ``vy``, ``wz`` are the first group's kinematics."""
+    law = setting.law
+    nodes = _nodes(setting.quad, law, setting.sigma_ref)
+    with threadpool_limits(limits=1, user_api="blas"):
+        wx, wy, speed = _directions(nodes, law, vx, vy, wz)
+        fields: tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]] = ((wx,), (wy,))
+        if speed is not None:  # columns 0, 1 with the speed factor, the others without
+            factor = law.speed_factor(speed)
+            fields = ((wx * factor, wx), (wy * factor, wy))
+        return turns_mod.correlated_sums(*fields, nodes.bx, nodes.by, layout, turns)
 
 
 def _g_and_gradient(quad, law, sigma_ref, px, py) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -266,6 +321,7 @@ def friction_resultants(
     subtract: bool | int = True,
     threads: int | None = None,
     backend: str = "auto",
+    turns: int = 1,
 ) -> Resultants:
     """Exact friction force (N) and torque (N·m) on the tire for each kinematic point.
 
@@ -280,6 +336,12 @@ def friction_resultants(
     the optional numba dependency; ~10x faster), ``"numpy"``, or ``"auto"`` (default:
     numba when installed and the job has `KERNEL_MIN_ELEMENTS` points × nodes or
     more); the same numbers to round-off.
+    ``turns``: the points are ``turns`` equal groups in order, group k being the first
+    turned by 2πk/turns about the patch origin (as `fepost.friction.build.sphere_nodes`
+    lays them out; `ArgumentError` when they are not). On a polar quadrature about the
+    origin whose angle count ``turns`` divides, the groups' node sums and polar moments
+    are then the first group's, turned (`fepost.friction.turns`: the same numbers to
+    round-off, about ``turns`` times less work); otherwise the hint changes nothing.
     """
     if not isinstance(quad, PressureQuadrature):
         raise ArgumentError(f"quad must be a PressureQuadrature, got {type(quad).__name__}")
@@ -296,6 +358,9 @@ def friction_resultants(
     if backend == "numba" and not nodesums.AVAILABLE:
         raise ArgumentError("backend 'numba' needs numba (pip install fepost[fast]), which is not installed")
     vx, vy, wz, shape = checked_kinematics(vx, vy, wz)
+    d = quad.domain
+    n0 = turns_mod.check_groups(vx, vy, wz, turns, scale=float(np.hypot(abs(d.cx) + d.ax, abs(d.cy) + d.ay)))
+    layout = turns_mod.polar_layout(quad, int(turns)) if backend != "numba" and n0 else None
     sigma_ref = law.reference_pressure(quad.mean_pressure) if law.pressure_coef else 1.0
     setting = _Setting(quad=quad, law=law, sigma_ref=sigma_ref, order=order)
     workers = threads or os.cpu_count() or 1
@@ -305,9 +370,14 @@ def friction_resultants(
         # the polar moments about the centres need no node sums: with more than one worker
         # they are computed meanwhile, on a thread of their own
         rays = None
+        moments = _rays if layout is None else partial(_turned_rays, n0=n0, turns=int(turns))
         if centres[0].size and workers > 1:
-            rays = side.submit(ray_integrals, quad.domain, centres[1], centres[2])
-        if backend == "numpy" or (backend == "auto" and not (nodesums.AVAILABLE and big)):
+            rays = side.submit(moments, quad.domain, centres[0], centres[1], centres[2])
+        if layout is not None:
+            sx, sy = _turned_sums(
+                setting, vx=vx[:n0], vy=vy[:n0], wz=wz[:n0], layout=layout, turns=int(turns)
+            )
+        elif backend == "numpy" or (backend == "auto" and not (nodesums.AVAILABLE and big)):
             sx, sy = _numpy_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
         else:
             sx, sy = _compiled_sums(setting, vx=vx, vy=vy, wz=wz, workers=workers)
@@ -315,7 +385,7 @@ def friction_resultants(
         if rays is not None:
             r = rays.result()
         elif centres[0].size:
-            r = ray_integrals(quad.domain, centres[1], centres[2])
+            r = moments(quad.domain, centres[0], centres[1], centres[2])
     with threadpool_limits(limits=1, user_api="blas"):
         fx, fy, mz = _finish(setting, vx=vx, vy=vy, wz=wz, sx=sx, sy=sy, centres=centres, rays=r)
     return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))

@@ -123,7 +123,9 @@ class PressureQuadrature:
     ``sigma``: pressure at the nodes (Pa); ``domain``: the `Ellipse` the
     weights integrate over (it holds the whole support); ``sigma_at(x, y)``: the
     pressure (Pa) at arbitrary points (m), 0 outside the support. Arrays are flat
-    and read-only.
+    and read-only. ``polar``: (n_r, n_φ) when the nodes are a polar grid about the
+    domain's centre, ring by ring, node (i, j) at angle φ_0 + 2πj/n_φ (as `from_polar`
+    makes them; the exact integrals use its rotation symmetry, `fepost.friction.turns`).
     """
 
     x: np.ndarray
@@ -133,6 +135,7 @@ class PressureQuadrature:
     domain: Ellipse
     sigma_at: SigmaFunction
     source: str = ""
+    polar: tuple[int, int] | None = None
 
     def __post_init__(self) -> None:
         arrays = {}
@@ -152,6 +155,14 @@ class PressureQuadrature:
             raise ArgumentError(f"domain must be an Ellipse, got {type(self.domain).__name__}")
         if not callable(self.sigma_at):
             raise ArgumentError(f"sigma_at must be callable, got {type(self.sigma_at).__name__}")
+        if self.polar is not None:
+            try:
+                nr, nphi = (int(v) for v in self.polar)
+            except (TypeError, ValueError):
+                raise ArgumentError(f"polar must be (n_r, n_phi) or None, got {self.polar!r}") from None
+            if nr < 1 or nphi < 1 or nr * nphi != n:
+                raise ArgumentError(f"polar {self.polar!r} does not lay out the {n} nodes")
+            object.__setattr__(self, "polar", (nr, nphi))
 
     # -- constructors -------------------------------------------------------------
     @classmethod
@@ -177,6 +188,7 @@ class PressureQuadrature:
             domain=Ellipse(cx, cy, pmap.radius, pmap.radius),
             sigma_at=sigma_at,
             source=pmap.source,
+            polar=pmap.sigma.shape,
         )
 
     # -- transforms ---------------------------------------------------------------

@@ -139,6 +139,7 @@ def effective_quadrature(quad: PressureQuadrature, law: FrictionLaw) -> Pressure
         domain=quad.domain,
         sigma_at=sigma_at,
         source=f"{quad.source} mu(sigma)".strip(),
+        polar=quad.polar,
     )
 
 
