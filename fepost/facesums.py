@@ -11,23 +11,21 @@ corner pressures s_k and area A:
 
 The pass runs over chunks of faces with the corners laid out as (3, chunk)
 rows: the temporaries stay in cache and their memory stays bounded on
-million-node meshes. From `_SPLIT` chunks on, two threads take half the chunks
-each; every chunk's totals are kept and added in chunk order afterwards, so the
+million-node meshes. Many chunks are shared by two threads (`fepost._chunks`);
+every chunk's totals are kept and added in chunk order afterwards, so the
 result does not depend on the number of threads, bit for bit.
 """
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
+from ._chunks import map_chunks, slices
+
 #: Faces per chunk: (3, chunk) float temporaries of 384 kB each (they stay in cache).
 CHUNK = 1 << 14
-#: From this many chunks on, two threads share them (numpy lets go of the GIL in each call).
-_SPLIT = 16
 
 # 7-point degree-5 rule on the triangle (barycentric coordinates; weights sum to 1)
 _A1, _B1 = 0.059715871789770, 0.470142064105115
@@ -76,10 +74,6 @@ class FaceSums:
         return raw - np.outer(c, c)
 
 
-def _chunks(m: int):
-    return [slice(i, min(i + CHUNK, m)) for i in range(0, m, CHUNK)]
-
-
 def _rows(a: np.ndarray) -> np.ndarray:
     """Sum of the three corner rows of a (3, c) array."""
     s = a[0] + a[1]
@@ -116,26 +110,12 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
     X = np.ascontiguousarray(x, dtype=float)
     Y = np.ascontiguousarray(y, dtype=float)
     V = np.ascontiguousarray(values, dtype=float)
-    chunks = _chunks(len(tri))
     # per chunk: 2A·(3σ̄, 12σ̄x̄ terms …) and the longest edge²; the constant factors are applied once
-    parts = np.zeros((len(chunks), 10))
-
-    def run(first: int, stop: int) -> None:
-        for i in range(first, stop):
-            parts[i] = _chunk_sums(X, Y, V, tri, chunks[i], location)
-
-    half = len(chunks) // 2 if len(chunks) >= _SPLIT and (os.cpu_count() or 1) > 1 else 0
-    if half:
-        with ThreadPoolExecutor(max_workers=1) as side:
-            other = side.submit(run, half, len(chunks))
-            run(0, half)
-            other.result()
-    else:
-        run(0, len(chunks))
+    parts = map_chunks(lambda sl: _chunk_sums(X, Y, V, tri, sl, location), slices(len(tri), CHUNK))
     tot = np.zeros(9)
     for part in parts:  # the chunks' totals in their order: the same sums on one thread or two
         tot += part[:9]
-    e2 = float(parts[:, 9].max()) if len(chunks) else 0.0
+    e2 = max((float(part[9]) for part in parts), default=0.0)
     # 2A → A, with the 1/3, 1/12 of the closed forms
     N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy = (float(v) for v in tot * _SCALE)
     return FaceSums(N, Mx, My, A, Sx, Sy, Sxx, Syy, Sxy, float(np.sqrt(e2)))
@@ -229,14 +209,14 @@ def load_outside(
     if not far.any():
         return 0.0
     reach = []
-    for sl in _chunks(len(tri)):
+    for sl in slices(len(tri), CHUNK):
         f = far[tri[sl]]
         hit = np.flatnonzero(f[:, 0] | f[:, 1] | f[:, 2])
         if hit.size:
             reach.append(hit + sl.start)
     faces = np.concatenate(reach)
     out = 0.0
-    for part in _chunks(len(faces)):
+    for part in slices(len(faces), CHUNK):
         idx = faces[part]
         tc = tri[idx]
         xc, yc = X[tc], Y[tc]

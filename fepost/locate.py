@@ -13,10 +13,11 @@ Method (exact, no nearest-neighbour step):
 
 1. The query points are binned on a raster of square cells, and a summed-area
    table counts the queries in any block of cells.
-2. One pass over the triangles, in chunks, takes each triangle's bounding box
-   in raster cells (the cell indices are computed per node, then gathered per
-   triangle, as small integers) and keeps the triangles whose box holds a
-   query point: a few per query point, whatever the mesh size.
+2. One pass over the triangles, in chunks (two threads share them,
+   `fepost._chunks`), takes each triangle's bounding box in raster cells (the
+   cell indices are computed per node, then gathered per triangle, as small
+   integers) and keeps the triangles whose box holds a query point: a few per
+   query point, whatever the mesh size.
 3. Those candidates are registered in every cell their box covers; each query
    point is tested against the candidates of its own cell with barycentric
    coordinates, and the triangle that holds it most deeply is kept (points on
@@ -30,14 +31,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._arrays import frozen
+from ._chunks import map_chunks, slices
 from .errors import ArgumentError
 
 #: Largest raster side (cells); the raster holds the query points' bounding box.
 RASTER_MAX = 2048
 #: Raster cell size in typical mesh edges: a cell holds a few triangles.
 CELL_EDGES = 1.0
-#: Triangles per chunk of the candidate pass.
-CHUNK = 1 << 14
+#: Triangles per chunk of the candidate pass (two threads share the chunks: fewer, larger
+#: ones keep them from waiting on each other between numpy calls).
+CHUNK = 1 << 15
 #: Cells per batch when the candidates' boxes are expanded (bounds their arrays).
 EXPAND_MAX = 1 << 22
 #: Query points per block of the exact test (bounds the pair arrays).
@@ -90,9 +93,9 @@ def _candidates(X, Y, tri, origin, h, shape, sat) -> tuple[np.ndarray, np.ndarra
     packed = (_cells(X, origin[0], inv_h, shape[0]) << 16) | _cells(Y, origin[1], inv_h, shape[1])
     flat = sat.ravel()
     width = sat.shape[1]
-    found, boxes = [], []
-    for start in range(0, len(tri), CHUNK):
-        k = packed.take(np.ascontiguousarray(tri[start : start + CHUNK].T))
+
+    def chunk(sl: slice) -> tuple[np.ndarray, np.ndarray]:
+        k = packed.take(np.ascontiguousarray(tri[sl].T))
         i, j = k >> 16, k & 0xFFFF
         i0 = np.minimum(np.minimum(i[0], i[1]), i[2])
         i1 = np.maximum(np.maximum(i[0], i[1]), i[2])
@@ -103,12 +106,12 @@ def _candidates(X, Y, tri, origin, h, shape, sat) -> tuple[np.ndarray, np.ndarra
         b = (i1 + 1) * width
         count = flat.take(b + j1) - flat.take(a + j1) - flat.take(b + j0) + flat.take(a + j0)
         hit = np.flatnonzero(count)
-        if hit.size:
-            found.append(hit + start)
-            boxes.append(np.column_stack([i0[hit], i1[hit] + 1, j0[hit], j1[hit]]))
-    if not found:
+        return hit + sl.start, np.column_stack([i0[hit], i1[hit] + 1, j0[hit], j1[hit]])
+
+    parts = [p for p in map_chunks(chunk, slices(len(tri), CHUNK)) if p[0].size]
+    if not parts:
         return np.empty(0, np.int64), np.empty((0, 4), np.int32)
-    return np.concatenate(found), np.concatenate(boxes)
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
 
 def _register(cand: np.ndarray, boxes: np.ndarray, occupied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -7,10 +7,12 @@ barycentric corners (the integrands are of degree ≤ 2 on a triangle: exact up 
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 import pytest
 
-from fepost import facesums
+from fepost import _chunks, facesums
 
 _A1, _B1 = 0.059715871789770, 0.470142064105115
 _A2, _B2 = 0.797426985353087, 0.101286507323456
@@ -75,15 +77,26 @@ def test_face_sums_equal_a_quadrature(location):
 @pytest.mark.parametrize("location", ["point", "face"])
 def test_two_threads_give_the_bits_of_one(monkeypatch, location):
     """Chunks small enough that the faces make many of them: split over two threads (the
-    default from `_SPLIT` chunks on) and on one, the totals are identical."""
+    default from `fepost._chunks.SPLIT` chunks on) and on one, the totals are identical."""
     x, y, tri, p = mesh()
     values = p if location == "point" else p[tri].mean(axis=1)
     monkeypatch.setattr(facesums, "CHUNK", 97)
-    assert len(tri) > facesums._SPLIT * 97
-    monkeypatch.setattr(facesums.os, "cpu_count", lambda: 2)
+    assert len(tri) > _chunks.SPLIT * 97
+    monkeypatch.setattr(_chunks.os, "cpu_count", lambda: 2)
+    threads = set()
+    real = facesums._chunk_sums
+
+    def spy(*args):
+        threads.add(threading.get_ident())
+        return real(*args)
+
+    monkeypatch.setattr(facesums, "_chunk_sums", spy)
     two = facesums.face_sums(x, y, tri, values, location)
-    monkeypatch.setattr(facesums, "_SPLIT", 10**9)
+    assert len(threads) == 2
+    monkeypatch.setattr(_chunks, "SPLIT", 10**9)
+    threads.clear()
     one = facesums.face_sums(x, y, tri, values, location)
+    assert threads == {threading.get_ident()}
     assert two == one
 
 
