@@ -160,5 +160,12 @@ def test_polar_layout_is_kept_only_where_the_nodes_stay_polar():
     assert quad.stretched(1.2).polar is None
     with pytest.raises(ArgumentError, match=r"^polar \(16, 16\) does not lay out the 512 nodes$"):
         PressureQuadrature(quad.x, quad.y, quad.dA, quad.sigma, quad.domain, quad.sigma_at, polar=(16, 16))
+    with pytest.raises(ArgumentError, match=r"^polar \(32, 16\): the nodes are not a polar grid about the"):
+        PressureQuadrature(quad.x, quad.y, quad.dA, quad.sigma, quad.domain, quad.sigma_at, polar=(32, 16))
+    swapped = np.arange(512).reshape(16, 32)[:, ::-1].ravel()  # each ring turning the other way
+    with pytest.raises(ArgumentError, match=r"^polar \(16, 32\): the nodes are not a polar grid about the"):
+        PressureQuadrature(
+            quad.x[swapped], quad.y[swapped], quad.dA, quad.sigma, quad.domain, quad.sigma_at, polar=(16, 32)
+        )
     with pytest.raises(ArgumentError, match=r"^polar must be \(n_r, n_phi\) or None, got 'ab'$"):
         PressureQuadrature(quad.x, quad.y, quad.dA, quad.sigma, quad.domain, quad.sigma_at, polar="ab")

@@ -114,6 +114,19 @@ class Ellipse:
 
 SigmaFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
+#: Largest distance of a node from its place on a polar grid (relative to the domain's
+#: larger semi-axis) for a ``polar`` layout to be accepted: round-off of the coordinates.
+POLAR_TOL = 1e-12
+
+
+def _polar_misfit(x: np.ndarray, y: np.ndarray, nr: int, nphi: int) -> float:
+    """Largest distance (m) of node (i, j) from ring i's first node turned by 2πj/nphi."""
+    a = np.arange(nphi) * (2.0 * np.pi / nphi)
+    c, s = np.cos(a), np.sin(a)
+    x, y = x.reshape(nr, nphi), y.reshape(nr, nphi)
+    x0, y0 = x[:, :1], y[:, :1]
+    return float(np.max(np.hypot(c * x0 - s * y0 - x, s * x0 + c * y0 - y), initial=0.0))
+
 
 @dataclass(frozen=True)
 class PressureQuadrature:
@@ -162,6 +175,12 @@ class PressureQuadrature:
                 raise ArgumentError(f"polar must be (n_r, n_phi) or None, got {self.polar!r}") from None
             if nr < 1 or nphi < 1 or nr * nphi != n:
                 raise ArgumentError(f"polar {self.polar!r} does not lay out the {n} nodes")
+            off = _polar_misfit(arrays["x"] - self.domain.cx, arrays["y"] - self.domain.cy, nr, nphi)
+            if not off <= POLAR_TOL * max(self.domain.ax, self.domain.ay):
+                raise ArgumentError(
+                    f"polar {self.polar!r}: the nodes are not a polar grid about the domain centre, "
+                    f"ring by ring (off by {off:.3g} m)"
+                )
             object.__setattr__(self, "polar", (nr, nphi))
 
     # -- constructors -------------------------------------------------------------
