@@ -148,7 +148,11 @@ def test_points_that_are_not_turned_groups_refused():
     vx, vy, wz = sphere(8, 4)
     vx = vx.copy()
     vx[9] += 1e-3
-    with pytest.raises(ArgumentError, match=r"^turns=8: the kinematic points are not 8 groups of 4, each"):
+    with pytest.raises(
+        ArgumentError,
+        match=r"^turns=8: the kinematic points are not 8 groups of 4, group k the first turned by "
+        r"2pi k/8 \(off by 0.001\)$",
+    ):
         friction_resultants(oblong_quad(8, 16), vx, vy, wz, turns=8)
 
 

@@ -81,8 +81,8 @@ def check_groups(vx: np.ndarray, vy: np.ndarray, wz: np.ndarray, turns: int, sca
     )
     if not off <= tol:
         raise ArgumentError(
-            f"turns={turns}: the kinematic points are not {turns} groups of {n0}, each the first "
-            f"turned by 2pi/{turns} (off by {off:.3g})"
+            f"turns={turns}: the kinematic points are not {turns} groups of {n0}, group k the "
+            f"first turned by 2pi k/{turns} (off by {off:.3g})"
         )
     return n0
 
