@@ -44,7 +44,7 @@ from ..errors import ArgumentError
 from . import nodesums
 from . import turns as turns_mod
 from .law import FrictionLaw
-from .quadrature import Ellipse, PressureQuadrature
+from .quadrature import Ellipse, PressureQuadrature, turn_angles
 
 #: Elements (kinematic points × nodes) per chunk: 2^17 doubles = 1 MB per array, a
 #: handful of arrays per worker thread that stay in cache (8 MB arrays ran 1.4x slower).
@@ -170,7 +170,7 @@ def _turned_rays(
     ok = (group > 0) & (src >= 0)
     ok[ok] = (counts[ok] == counts[src[ok]]) & (counts[ok] * group[ok] % turns == 0)
     rows = np.flatnonzero(ok)
-    c, s = turns_mod.angles(turns)
+    c, s = turn_angles(turns)
     out[rows] = turns_mod.turn_rays(out[src[rows]], c[group[rows]], s[group[rows]])
     rest = np.flatnonzero((group > 0) & ~ok)
     if rest.size:

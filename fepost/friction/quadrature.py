@@ -119,13 +119,21 @@ SigmaFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
 POLAR_TOL = 1e-12
 
 
-def _polar_misfit(x: np.ndarray, y: np.ndarray, nr: int, nphi: int) -> float:
-    """Largest distance (m) of node (i, j) from ring i's first node turned by 2πj/nphi."""
-    a = np.arange(nphi) * (2.0 * np.pi / nphi)
-    c, s = np.cos(a), np.sin(a)
-    x, y = x.reshape(nr, nphi), y.reshape(nr, nphi)
-    x0, y0 = x[:, :1], y[:, :1]
-    return float(np.max(np.hypot(c * x0 - s * y0 - x, s * x0 + c * y0 - y), initial=0.0))
+def turn_angles(turns: int) -> tuple[np.ndarray, np.ndarray]:
+    """cos and sin of 2πk/turns, k = 0..turns−1."""
+    a = np.arange(turns) * (2.0 * np.pi / turns)
+    return np.cos(a), np.sin(a)
+
+
+def turn_misfit(x: np.ndarray, y: np.ndarray) -> float:
+    """Largest distance of the in-plane vectors (``x``, ``y``)[k] (each (T, n)) from row 0's
+    turned by 2πk/T: 0 to round-off when every row is the first turned (a polar grid's
+    angles, ring by ring; the groups of turned kinematics of `fepost.friction.turns`)."""
+    c, s = turn_angles(x.shape[0])
+    x0, y0 = x[:1], y[:1]
+    gx = c[:, None] * x0 - s[:, None] * y0
+    gy = s[:, None] * x0 + c[:, None] * y0
+    return float(np.max(np.hypot(gx - x, gy - y), initial=0.0))
 
 
 @dataclass(frozen=True)
@@ -175,7 +183,11 @@ class PressureQuadrature:
                 raise ArgumentError(f"polar must be (n_r, n_phi) or None, got {self.polar!r}") from None
             if nr < 1 or nphi < 1 or nr * nphi != n:
                 raise ArgumentError(f"polar {self.polar!r} does not lay out the {n} nodes")
-            off = _polar_misfit(arrays["x"] - self.domain.cx, arrays["y"] - self.domain.cy, nr, nphi)
+            # node (i, j) of ring i is its node (i, 0) turned by 2πj/nphi
+            off = turn_misfit(
+                (arrays["x"] - self.domain.cx).reshape(nr, nphi).T,
+                (arrays["y"] - self.domain.cy).reshape(nr, nphi).T,
+            )
             if not off <= POLAR_TOL * max(self.domain.ax, self.domain.ay):
                 raise ArgumentError(
                     f"polar {self.polar!r}: the nodes are not a polar grid about the domain centre, "

@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ArgumentError
-from .quadrature import PressureQuadrature
+from .quadrature import PressureQuadrature, turn_angles, turn_misfit
 
 #: Largest distance of a point of group k from group 0's turned, relative to the
 #: largest speed scale of the kinematics, accepted as "the same point turned".
@@ -70,14 +70,9 @@ def check_groups(vx: np.ndarray, vy: np.ndarray, wz: np.ndarray, turns: int, sca
     if turns == 1 or n0 == 0:
         return n0
     tol = GROUP_TOL * max(float(np.abs(vx).max()), float(np.abs(vy).max()), float(np.abs(wz).max()) * scale)
-    c, s = angles(turns)
-    v0x, v0y, w0 = vx[:n0], vy[:n0], wz[:n0]
-    gx = c[:, None] * v0x - s[:, None] * v0y
-    gy = s[:, None] * v0x + c[:, None] * v0y
+    w = wz.reshape(turns, n0)
     off = max(
-        float(np.abs(gx.ravel() - vx).max()),
-        float(np.abs(gy.ravel() - vy).max()),
-        float(np.abs(np.tile(w0, turns) - wz).max()) * scale,
+        turn_misfit(vx.reshape(turns, n0), vy.reshape(turns, n0)), float(np.abs(w - w[:1]).max()) * scale
     )
     if not off <= tol:
         raise ArgumentError(
@@ -85,12 +80,6 @@ def check_groups(vx: np.ndarray, vy: np.ndarray, wz: np.ndarray, turns: int, sca
             f"first turned by 2pi k/{turns} (off by {off:.3g})"
         )
     return n0
-
-
-def angles(turns: int) -> tuple[np.ndarray, np.ndarray]:
-    """cos and sin of 2πk/turns, k = 0..turns−1."""
-    a = np.arange(turns) * (2.0 * np.pi / turns)
-    return np.cos(a), np.sin(a)
 
 
 def correlated_sums(
@@ -111,7 +100,7 @@ def correlated_sums(
     """
     nr, nphi = layout
     n0 = kx[0].shape[0]
-    c, s = angles(turns)
+    c, s = turn_angles(turns)
     step = nphi // turns
     ncol = columns_x.shape[1]
     sx = np.empty((turns, n0, ncol))
