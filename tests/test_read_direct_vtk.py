@@ -327,3 +327,56 @@ def test_a_file_refused_by_the_check_is_named_once(grids, tmp_path):
         vtkdirect.read_direct(path)
     assert str(err.value).count(str(path)) == 1
     assert str(err.value).startswith(f"{path}: corrupt or truncated .vtu file")
+
+
+def test_strict_base64_goes_to_the_fast_decoder_and_the_rest_to_binascii(grids, tmp_path, monkeypatch):
+    """Strict base64 (every writer's inline arrays) is decoded by pybase64, without binascii;
+    text broken into lines falls back to binascii's lenient decoding. Both give VTK's field."""
+    import binascii
+    from types import SimpleNamespace
+
+    lenient = []
+
+    def counted(text):
+        lenient.append(len(text))
+        return binascii.a2b_base64(text)
+
+    monkeypatch.setattr(vtkdirect, "binascii", SimpleNamespace(a2b_base64=counted, Error=binascii.Error))
+    plain = _write(grids, tmp_path / "plain.vtu", "ug", "binary", True, "zlib")
+    assert vtkdirect.read_direct(plain) is not None
+    _same(*_both(plain))
+    assert lenient == []
+    wrapped = tmp_path / "wrapped.vtu"
+    body = plain.read_bytes()
+    start = body.index(b'format="binary"')
+    start = body.index(b">", start) + 1
+    wrapped.write_bytes(body[: start + 40] + b"\n" + body[start + 40 :])
+    assert vtkdirect.read_direct(wrapped) is not None
+    assert lenient  # the broken array went to binascii
+    _same(dataclasses.replace(contact.read_here(wrapped), source=str(plain)), contact.read_here(plain))
+
+
+@pytest.mark.parametrize(
+    "text",
+    [b"QUJDREVG", b"QUJDREU=", b"QUJDRA==", b"QUJD\nREVG", b"  QUJDREVG\n", b"QQ==QkM=", b"", b"+/+/"],
+)
+def test_both_base64_decoders_give_the_same_bytes(text):
+    import binascii
+
+    assert vtkdirect._b64(_fmt(), memoryview(text), "Points") == binascii.a2b_base64(text)
+
+
+def test_base64_that_no_decoder_takes_is_one_line_naming_the_file_and_the_array():
+    with pytest.raises(InputFileError, match=r"^map\.vtu: array 'Points': invalid base64 data$"):
+        vtkdirect._b64(_fmt(), memoryview(b"QUJDR"), "Points")
+
+
+def _fmt():
+    """A decoding format of a little-endian zlib file named map.vtu (only its path is read by `_b64`)."""
+    return vtkdirect._Format(
+        path=Path("map.vtu"),
+        endian="<",
+        header=4,
+        inflate=vtkdirect._INFLATE["vtkZLibDataCompressor"],
+        appended=None,
+    )

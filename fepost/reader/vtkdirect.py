@@ -10,8 +10,11 @@ parses it again and inflates every block on one thread (0.80 s). The binary
 layout of the format is small and documented ("VTK File Formats", VTK User's
 Guide): a length header or a block table, then raw, zlib or LZMA blocks, inline
 in base64 or appended raw or base64. Decoding only the arrays the field needs,
-inflating the blocks on two threads (zlib and lzma release the GIL), takes
-0.3 s on that file and never imports VTK.
+the base64 with ``pybase64`` (vectorised, it lets go of the GIL: 1.6 GB/s here
+against 0.28 GB/s for ``binascii``) and the blocks inflated on two threads (zlib
+and lzma release the GIL), takes 0.25-0.3 s on that file and never imports VTK.
+Text that is not strict base64 (line breaks, padding inside the stream) is
+decoded by ``binascii``'s lenient decoder, as before: the same bytes either way.
 
 What is decoded here, and what is not
 -------------------------------------
@@ -48,6 +51,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
+import pybase64
 
 from ..errors import InputFileError
 from .checks import release
@@ -294,8 +298,9 @@ class _Job:
     """One binary array being decoded: the header read and the base64 decoded when made, the
     blocks inflated by `start` (on a thread pool or at once), `result` waits for them.
 
-    The base64 of every array is decoded before any block is inflated: ``a2b_base64`` holds
-    the GIL for its whole call, and an inflating thread needs the GIL between blocks.
+    The base64 of every array is decoded before any block is inflated (a small share of the
+    time), then the largest arrays' blocks go first so that the two threads finish together;
+    starting each array's blocks as soon as its base64 was decoded measured no faster.
     """
 
     def __init__(self, fmt: _Format, data, arr: DataArray):
@@ -368,6 +373,12 @@ def _words(fmt: _Format, raw, n: int) -> tuple[int, ...]:
 
 
 def _b64(fmt: _Format, text, name: str) -> bytes:
+    """The bytes of base64 ``text``: strict base64 by pybase64, anything else by binascii's
+    lenient decoder (which skips line breaks and stops at padding)."""
+    try:
+        return pybase64.b64decode(text, validate=True)
+    except ValueError:
+        pass  # not strict base64: decoded leniently below (the same bytes where both decode)
     try:
         return binascii.a2b_base64(text)
     except (binascii.Error, ValueError):
