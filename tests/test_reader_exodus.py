@@ -259,3 +259,130 @@ def test_element_faces_carry_their_element_load(tmp_path, etype, order):
     else:  # the linear interpolant over the triangle: area × mean of the corners
         exact = P * 0.5 * (1 + 2 + 0.5) / 3
     assert patch.N_fe == pytest.approx(exact, rel=1e-12)
+
+
+def _whole(monkeypatch):
+    """Make the reader read every element whatever ``surface`` names (the reference)."""
+    from fepost.reader import contact, exodus
+
+    monkeypatch.setattr(
+        contact, "read_exodus", lambda path, step, surface=None: exodus.read_exodus(path, step)
+    )
+
+
+def _block_on_ground(tmp_path, *, elemental=False):
+    """A 4 × 4 × 3 HEX8 block whose bottom carries a Hertz-like pressure; side set 1 'ground'
+    names the bottom sides of the bottom layer (16 of 48 elements; k runs fastest in the file,
+    so every third element), side set 2 'top' the top sides. Returns (path, bottom layer)."""
+    pts, conn = hex_grid(4, 4, 3, size=(1.0, 1.0, 0.3), origin=(-0.5, -0.5, 0.0))
+    r2 = pts[:, 0] ** 2 + pts[:, 1] ** 2
+    p = np.where(np.isclose(pts[:, 2], 0.0), P * np.clip(1.0 - r2 / 0.6**2, 0.0, None), 0.0)
+    layer = np.flatnonzero(np.isclose(pts[conn[:, 0], 2], 0.0))  # elements of the bottom layer
+    top = np.flatnonzero(np.isclose(pts[conn[:, 4], 2], 0.3))
+    kw = {}
+    if elemental:
+        pe = np.zeros(len(conn))
+        pe[layer] = P
+        kw["elemental"] = {"pressure": [pe[None]]}
+    return write(
+        tmp_path / "block.e",
+        pts,
+        [("HEX8", conn)],
+        nodal={
+            "contact_pressure": p[None],
+            "disp_x": 0 * p[None],
+            "disp_y": 0 * p[None],
+            "disp_z": 0 * p[None],
+        },
+        side_sets=[(layer, np.full(len(layer), 4)), (top, np.full(len(top), 5))],
+        side_set_names=["ground", "top"],
+        **kw,
+    ), layer
+
+
+@pytest.mark.parametrize("surface", ["ground", "GROUND ", "1"])
+def test_a_named_side_set_reads_only_its_elements_and_gives_the_same_field(tmp_path, monkeypatch, surface):
+    from vtk_writers import same_fields
+
+    from fepost.reader.contact import read_here, read_raw
+
+    path, layer = _block_on_ground(tmp_path)
+    raw = read_raw(path, None, surface=surface)
+    try:
+        assert raw.partial
+        assert [len(b.conn) for b in raw.blocks] == [len(layer)]  # 16 of 48 elements read
+        np.testing.assert_array_equal(raw.blocks[0].conn, write_conn(path)[layer])
+        assert [ss.name for ss in raw.side_sets] == ["ground"]
+        np.testing.assert_array_equal(raw.side_sets[0].elements, np.arange(len(layer)))
+    finally:
+        raw.close()
+    part = read_here(path, surface=surface)
+    _whole(monkeypatch)
+    whole = read_here(path, surface=surface)
+    reference = read_raw(path, None, surface=surface)
+    assert not reference.partial
+    reference.close()
+    same_fields(part, whole)
+    assert part.body == "side set 1 'ground'" and part.n_faces == 16
+
+
+def write_conn(path):
+    """The connectivity as written (0-based), read back with netCDF4."""
+    import netCDF4
+
+    with netCDF4.Dataset(str(path)) as ds:
+        return np.asarray(ds.variables["connect1"][:], np.int64) - 1
+
+
+def test_side_sets_of_two_bodies_read_apart(tmp_path, monkeypatch):
+    """Side set 1 names every slab element, side set 2 every cube element: each reads its body's
+    block alone and gives the field of the whole file's reading."""
+    from vtk_writers import same_fields
+
+    from fepost.reader.contact import read_here, read_raw
+
+    path = _two_bodies(tmp_path, both_sides=True)
+    for surface, rows in (("slab_top", [32, 0]), ("2", [0, 27])):
+        raw = read_raw(path, None, surface=surface)
+        assert raw.partial and [len(b.conn) for b in raw.blocks] == rows
+        raw.close()
+    parts = [read_here(path, surface=s) for s in ("slab_top", "2")]
+    _whole(monkeypatch)
+    for got, s in zip(parts, ("slab_top", "2"), strict=True):
+        same_fields(got, read_here(path, surface=s))
+
+
+def test_a_refusal_of_a_named_side_set_is_worded_from_the_whole_mesh(tmp_path, monkeypatch):
+    """The slab carries no pressure: the refusal names where it is (a block among them), as a
+    reading of every element does."""
+    from fepost.reader.contact import read_here
+
+    path = _two_bodies(tmp_path)
+    with pytest.raises(PressureError) as part:
+        read_here(path, surface="slab_top")
+    assert "element block 2" in str(part.value) and "--surface" in str(part.value)
+    _whole(monkeypatch)
+    with pytest.raises(PressureError) as whole:
+        read_here(path, surface="slab_top")
+    assert str(part.value) == str(whole.value)
+
+
+def test_element_values_on_a_named_side_set_are_read_from_the_whole_mesh(tmp_path, monkeypatch):
+    from vtk_writers import same_fields
+
+    from fepost.reader.contact import read_here
+
+    path, layer = _block_on_ground(tmp_path, elemental=True)
+    part = read_here(path, field="pressure", surface="ground")
+    assert part.location == "cell" and part.n_faces == len(layer)
+    _whole(monkeypatch)
+    same_fields(part, read_here(path, field="pressure", surface="ground"))
+
+
+def test_an_element_block_named_as_surface_is_read_whole(tmp_path):
+    from fepost.reader.contact import read_raw
+
+    path = _two_bodies(tmp_path, both_sides=True)
+    raw = read_raw(path, None, surface="element block 2")
+    assert not raw.partial and [len(b.conn) for b in raw.blocks] == [32, 27]
+    raw.close()

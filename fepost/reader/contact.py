@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .._arrays import adopted
-from ..errors import DimensionError, FieldError, InputFileError, PressureError, SentinelWarning
+from ..errors import DimensionError, FepostError, FieldError, InputFileError, PressureError, SentinelWarning
 from ..field import OTHER_FACE_TYPES, ContactField
 from .cells import SPECS
 from .exodus import read_exodus
@@ -62,12 +62,17 @@ def _absurd(source: str, what: str, values: np.ndarray, limit: float) -> None:
 
 
 def read_raw(
-    path: Path, step: int | None, field: str | None = None, displacement: str | None = "auto"
+    path: Path,
+    step: int | None,
+    field: str | None = None,
+    displacement: str | None = "auto",
+    surface: str | None = None,
 ) -> RawMesh:
     """The file's content (Exodus by netCDF4, VTK files by VTK's readers, the arrays
-    ``field`` and ``displacement`` choose decoded first)."""
+    ``field`` and ``displacement`` choose decoded first; of an Exodus file whose side set
+    ``surface`` names, only that side set's elements: `RawMesh.partial`)."""
     if path.suffix.lower() in EXODUS_SUFFIXES:
-        return read_exodus(path, step)
+        return read_exodus(path, step, surface)
     if path.suffix.lower() in XDMF_SUFFIXES:
         return read_xdmf(path, step)
     if path.suffix.lower() in FRD_SUFFIXES:
@@ -86,11 +91,39 @@ def read_here(
     surface: str | None = None,
 ) -> ContactField:
     """`fepost.reader.read_contact` without the child process (see there)."""
-    raw = read_raw(path, step, field, displacement)
+    raw = read_raw(path, step, field, displacement, surface)
+    if raw.partial:
+        got = _from_part(raw, path, field, displacement, units, surface)
+        if got is not None:
+            return got
+        raw = read_raw(path, step, field, displacement)
     try:
         return _contact(raw, path, field, displacement, units, surface)
     finally:
         raw.close()
+
+
+class _WholeMesh(Exception):
+    """The field needs more of the mesh than the side set's elements (element values)."""
+
+
+def _from_part(raw: RawMesh, path, field, displacement, units, surface) -> ContactField | None:
+    """The field from the side set's elements alone (the same field as from the whole mesh:
+    nodal pressure on the side set's faces), or None where it needs the whole mesh: element
+    values, or a refusal, which is then worded from the whole mesh as it always is. Warnings
+    are passed on only with the field."""
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        try:
+            got = _contact(raw, path, field, displacement, units, surface)
+        except (FepostError, _WholeMesh):
+            got = None
+        finally:
+            raw.close()
+    if got is not None:
+        for w in seen:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
+    return got
 
 
 def _catalogue(raw: RawMesh) -> list[ArrayInfo]:
@@ -298,6 +331,8 @@ def _contact(
     _check_mesh(raw, source)
     catalogue = _catalogue(raw)
     choice = pick_field(source, catalogue, field)
+    if raw.partial and choice.location != "point":
+        raise _WholeMesh
     notes = [*raw.notes, choice.note]
     if raw.skipped:
         notes.append("cells not read: " + ", ".join(f"{n} {k}" for k, n in raw.skipped.items()))

@@ -107,13 +107,21 @@ def _read(ds, name: str, shape: tuple[int, ...] | None = None, dtype=float) -> n
     return np.asarray(a, dtype=dtype)
 
 
-def _indices(ds, name: str, shape: tuple[int, ...]) -> np.ndarray:
+def _indices(ds, name: str, shape: tuple[int, ...], rows: np.ndarray | None = None) -> np.ndarray:
     """A 1-based index variable as 0-based int64, converted in one pass (one allocation: a
-    million-element connectivity is 64 MB, and fresh memory is what costs)."""
+    million-element connectivity is 64 MB, and fresh memory is what costs). ``rows`` (sorted):
+    only those rows, read as the one span from the first to the last."""
     v = ds.variables.get(name)
     if v is None:
         raise KeyError(name)
-    a = np.asarray(v[:])
+    if tuple(v.shape) != shape:
+        raise ValueError(f"variable {name} has shape {tuple(v.shape)}, expected {shape}")
+    if rows is None:
+        a = np.asarray(v[:])
+    else:
+        span = _span(rows)
+        a = np.asarray(v[span])[rows - span.start]
+        shape = (len(rows), *shape[1:])
     if a.shape != shape:
         raise ValueError(f"variable {name} has shape {a.shape}, expected {shape}")
     return np.subtract(a, 1, out=fresh_array(shape, np.int64), casting="unsafe")
@@ -185,11 +193,16 @@ def vector_groups(names: list[str]) -> dict[str, tuple[str, ...]]:
     return out
 
 
-def read_exodus(path: Path, step: int | None) -> RawMesh:
-    """Read an Exodus II file into a `fepost.reader.raw.RawMesh` at ``step`` (default: last)."""
+def read_exodus(path: Path, step: int | None, surface: str | None = None) -> RawMesh:
+    """Read an Exodus II file into a `fepost.reader.raw.RawMesh` at ``step`` (default: last).
+
+    ``surface``: when it names a side set (by name or id, as ``--surface`` does), only the
+    connectivity of the elements that side set names is read — on a volume model the
+    rest of the volume stays on disk — and the mesh is marked `RawMesh.partial`.
+    """
     ds = _open(path)
     try:
-        return _read_exodus(ds, path, step)
+        return _read_exodus(ds, path, step, surface)
     except InputFileError:
         ds.close()
         raise
@@ -201,7 +214,7 @@ def read_exodus(path: Path, step: int | None) -> RawMesh:
         raise InputFileError(f"{path}: malformed Exodus II file ({what})") from None
 
 
-def _read_exodus(ds, path: Path, step: int | None) -> RawMesh:
+def _read_exodus(ds, path: Path, step: int | None, surface: str | None) -> RawMesh:
     ndim = _dim(ds, "num_dim")
     if ndim not in (1, 2, 3):
         raise ValueError(f"num_dim = {ndim}")
@@ -228,7 +241,13 @@ def _read_exodus(ds, path: Path, step: int | None) -> RawMesh:
         raise ValueError("time_whole is longer than the time_step dimension")
     chosen = choose_step(path, step, n_steps)
 
-    blocks = _blocks(ds, path, n_nodes, chosen)
+    counts = _element_counts(ds)
+    named = only = None
+    if surface is not None:  # the side sets first: which elements to read
+        side_sets = _side_sets(ds, sum(counts))
+        named = _side_set_named(side_sets, surface)
+        only = None if named is None else np.unique(named.elements)
+    blocks = _blocks(ds, path, n_nodes, chosen, counts, only)
     raw = RawMesh(
         path=str(path),
         format=f"Exodus II ({ds.data_model})",
@@ -246,18 +265,44 @@ def _read_exodus(ds, path: Path, step: int | None) -> RawMesh:
     raw.closer = ds.close
     _bodies(raw)
     _nodal(ds, raw, n_nodes, chosen)
-    raw.side_sets = _side_sets(ds, sum(len(b.conn) for b, _ in blocks))
+    if only is None:
+        raw.side_sets = side_sets if surface is not None else _side_sets(ds, sum(counts))
+    else:  # numbered over the elements read: the side sets' elements in file order
+        raw.partial = True
+        raw.side_sets = [
+            SideSet(ss.label, ss.name, ss.id, np.searchsorted(only, ss.elements), ss.sides)
+            for ss in side_sets
+            if ss is named
+        ]
     raw.globals = _globals(ds, chosen)
     return raw
 
 
-def _blocks(ds, path: Path, n_nodes: int, chosen: int | None) -> list[tuple[Block, str | None]]:
+def _side_set_named(side_sets: list[SideSet], surface: str) -> SideSet | None:
+    """The side set ``surface`` names (by name or id, as `fepost.reader.surface` matches them)."""
+    key = surface.strip().lower()
+    return next((ss for ss in side_sets if key in (ss.name.lower(), str(ss.id))), None)
+
+
+def _element_counts(ds) -> list[int]:
+    """Elements of each block as numbered over the file (an inactive block counts none)."""
     nblk = _dim(ds, "num_el_blk", 0)
-    names = _names(ds, "eb_names", nblk)
-    ids = _ids(ds, "eb_prop1", nblk)
     status = (
         np.asarray(ds.variables["eb_status"][:]).ravel() if "eb_status" in ds.variables else np.ones(nblk)
     )
+    return [
+        0 if status.size == nblk and status[k] == 0 else _dim(ds, f"num_el_in_blk{k + 1}", 0)
+        for k in range(nblk)
+    ]
+
+
+def _blocks(
+    ds, path: Path, n_nodes: int, chosen: int | None, counts: list[int], only: np.ndarray | None
+) -> list[tuple[Block, str | None]]:
+    """The element blocks; ``only`` (sorted global element indices): read just those elements."""
+    nblk = len(counts)
+    names = _names(ds, "eb_names", nblk)
+    ids = _ids(ds, "eb_prop1", nblk)
     n_evar = _dim(ds, "num_elem_var", 0)
     evar_names = _names(ds, "name_elem_var", n_evar)
     table = (
@@ -266,19 +311,23 @@ def _blocks(ds, path: Path, n_nodes: int, chosen: int | None) -> list[tuple[Bloc
         else np.ones((nblk, n_evar), np.int64)
     )
     out: list[tuple[Block, str | None]] = []
-    first = 0
-    for k in range(nblk):
-        m = _dim(ds, f"num_el_in_blk{k + 1}", 0)
+    first = start = 0  # the block's first element as stored (over the elements read) and in the file
+    for k, m in enumerate(counts):
         label = f"element block {ids[k]}" + (f" '{names[k]}'" if names[k] else "")
-        if m == 0 or (status.size == nblk and status[k] == 0):
+        if m == 0:
             out.append((Block(label, "point", np.empty((0, 1), np.int64), first, k), None))
             continue
+        rows = None
+        if only is not None:
+            lo, hi = np.searchsorted(only, (start, start + m))
+            rows = only[lo:hi] - start
+        start += m
         var = ds.variables.get(f"connect{k + 1}")
         if var is None:
             raise KeyError(f"connect{k + 1}")
         npe = _dim(ds, f"num_nod_per_el{k + 1}")
         etype = str(getattr(var, "elem_type", "") or "")
-        conn = _indices(ds, f"connect{k + 1}", (m, npe))
+        conn = _indices(ds, f"connect{k + 1}", (m, npe), rows)
         check_connectivity(conn, n_nodes, f"{path}: {label}")
         canon = exodus_type(etype, npe)
         if canon is None:
@@ -290,20 +339,28 @@ def _blocks(ds, path: Path, n_nodes: int, chosen: int | None) -> list[tuple[Bloc
         for i, name in enumerate(evar_names):
             key = f"vals_elem_var{i + 1}eb{k + 1}"
             if table[k, i] and key in ds.variables and chosen is not None:
-                block.cell_data.add(name, _loader(ds, key, chosen, m))
+                block.cell_data.add(name, _loader(ds, key, chosen, m, rows))
         out.append((block, None))
-        first += m
+        first += len(conn)
     return out
 
 
-def _loader(ds, key: str, chosen: int, size: int) -> Callable[[], np.ndarray]:
+def _span(rows: np.ndarray) -> slice:
+    """The rows from the first to the last of ``rows`` (sorted): one read from the file."""
+    return slice(int(rows[0]), int(rows[-1]) + 1) if rows.size else slice(0, 0)
+
+
+def _loader(ds, key: str, chosen: int, size: int, rows: np.ndarray | None = None) -> Callable[[], np.ndarray]:
     def load() -> np.ndarray:
         v = ds.variables[key]
         if v.ndim != 2 or v.shape[1] != size or v.shape[0] <= chosen:
             raise InputFileError(
                 f"{ds.filepath()}: variable {key} has shape {v.shape}, expected (steps, {size})"
             )
-        return np.asarray(v[chosen, :], float)
+        if rows is None:
+            return np.asarray(v[chosen, :], float)
+        span = _span(rows)
+        return np.asarray(v[chosen, span], float)[rows - span.start]
 
     return load
 

@@ -96,6 +96,9 @@ class RawMesh:
     closer: Callable[[], None] | None = None
     connectivity_size: int = 0  # VTK files: node references of all cells as read
     notes: list[str] = field(default_factory=list)  # what the format reader did, for the result's notes
+    #: Only the elements of one side set were read (Exodus ``surface=``): ``blocks`` hold those
+    #: elements alone, numbered in file order, and ``side_sets`` count over them.
+    partial: bool = False
 
     def close(self) -> None:
         """Release the file (lazy arrays cannot be loaded afterwards)."""
