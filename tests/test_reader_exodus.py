@@ -386,3 +386,26 @@ def test_an_element_block_named_as_surface_is_read_whole(tmp_path):
     raw = read_raw(path, None, surface="element block 2")
     assert not raw.partial and [len(b.conn) for b in raw.blocks] == [32, 27]
     raw.close()
+
+
+def test_warnings_of_a_side_set_reading_arrive_once(tmp_path):
+    """A sentinel value on a node of the other body: the side set's reading warns about it once,
+    through the reading child, as a reading of every element does."""
+    import warnings
+
+    import netCDF4
+
+    from fepost.errors import SentinelWarning
+
+    path = _two_bodies(tmp_path, both_sides=True)
+    with netCDF4.Dataset(str(path), "a") as ds:
+        v = ds.variables["vals_nod_var1"]
+        row = np.asarray(v[1, :])
+        row[0] = -99999.0  # a slab corner, far from the cube
+        v[1, :] = row
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        fld = read_contact(path, surface="cube_bottom")
+    sentinel = [w for w in seen if issubclass(w.category, SentinelWarning)]
+    assert len(sentinel) == 1 and "1 values equal to sentinel -99999" in str(sentinel[0].message)
+    assert fld.body == "side set 2 'cube_bottom'"
