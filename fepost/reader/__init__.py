@@ -50,7 +50,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import InputFileError
 from . import isolate
-from .names import CCX_CONTACT, DISPLACEMENT_NAMES, PRESSURE_NAMES
+from .names import CCX_CONTACT, DISPLACEMENT_NAMES, PRESSURE_NAMES, SENTINELS
 from .units import SYSTEMS, UnitSystem, unit_system
 
 if TYPE_CHECKING:
@@ -60,8 +60,6 @@ VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm", ".vts", ".vtr", ".pvtu", ".pvtp"
 EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
 XDMF_SUFFIXES = (".xdmf", ".xmf")
 FRD_SUFFIXES = (".frd",)
-#: Values that mean "no contact data" rather than a pressure (MOOSE writes −99999).
-SENTINELS = (-99999.0, -999999.0, -9999.0, -1.0e30, -1.0e20)
 
 __all__ = [
     "CCX_CONTACT",

@@ -21,7 +21,7 @@ from ..field import OTHER_FACE_TYPES, ContactField
 from .cells import SPECS
 from .exodus import read_exodus
 from .frd import FRD_SUFFIXES, read_frd
-from .names import ArrayInfo, FieldChoice, norm, pick_displacement, pick_field
+from .names import SENTINELS, ArrayInfo, FieldChoice, norm, pick_displacement, pick_field
 from .raw import RawMesh
 from .sidecar import at_step, read_sidecar
 from .surface import Surface, loaded_surfaces, select_surface
@@ -30,8 +30,6 @@ from .vtkfile import read_vtk
 from .xdmf import XDMF_SUFFIXES, read_xdmf
 
 EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
-#: Values that mean "no contact data" rather than a pressure.
-SENTINELS = (-99999.0, -999999.0, -9999.0, -1.0e30, -1.0e20)
 #: Global variables read as the solver's reaction or contact force (normalised names containing these).
 REACTION_WORDS = ("react", "force")
 #: Largest magnitude accepted for a coordinate or a displacement (file units): beyond it the numbers

@@ -43,6 +43,8 @@ PRESSURE_NAMES = (
 GENERIC_NAMES = ("pressure",)
 #: Normalised names taken as nodal displacement (3 components).
 DISPLACEMENT_NAMES = ("displacement", "displacements", "displ", "disp", "u")
+#: Values that mean "no contact data" rather than a pressure (MOOSE writes −99999).
+SENTINELS = (-99999.0, -999999.0, -9999.0, -1.0e30, -1.0e20)
 #: ccx2paraview's component layout of CalculiX's ``CONTACT`` output (used when a file names none).
 CCX_CONTACT = ("COPEN", "CSLIP1", "CSLIP2", "CPRESS", "CSHEAR1", "CSHEAR2")
 
