@@ -159,7 +159,37 @@ def _corrupt_first_block(path: Path) -> None:
     path.write_bytes(bytes(data))
 
 
-def test_a_corrupt_block_is_one_line_naming_the_file_and_the_array(grids, tmp_path):
+def _inflater(name: str):
+    """The zlib module the direct decoder inflates with: the standard one or ISA-L's."""
+    return zlib if name == "zlib" else pytest.importorskip("isal.isal_zlib")
+
+
+INFLATERS = ["zlib", "isal"]
+
+
+@pytest.mark.parametrize("inflater", INFLATERS)
+def test_both_zlib_inflaters_decode_as_vtk_reads_it(grids, tmp_path, monkeypatch, inflater):
+    monkeypatch.setattr(vtkdirect, "ZLIB", _inflater(inflater))
+    for kind, mode, encode in (("ug", "binary", True), ("ug", "appended", False), ("pd", "appended", True)):
+        suffix = ".vtu" if kind == "ug" else ".vtp"
+        path = _write(grids, tmp_path / f"{kind}-{mode}{suffix}", kind, mode, encode, "zlib", block=4096)
+        _same_raw(path)
+
+
+def test_isal_inflates_where_installed(monkeypatch):
+    pytest.importorskip("isal")
+    assert vtkdirect.ZLIB.__name__ == "isal.isal_zlib"
+
+    def missing(name):
+        raise ImportError(name)
+
+    monkeypatch.setattr(vtkdirect.importlib, "import_module", missing)
+    assert vtkdirect._zlib_module() is zlib
+
+
+@pytest.mark.parametrize("inflater", INFLATERS)
+def test_a_corrupt_block_is_one_line_naming_the_file_and_the_array(grids, tmp_path, monkeypatch, inflater):
+    monkeypatch.setattr(vtkdirect, "ZLIB", _inflater(inflater))
     path = _write(grids, tmp_path / "bad.vtu", "ug", "appended", False, "zlib")
     _corrupt_first_block(path)
     with pytest.raises(InputFileError) as err:
@@ -169,10 +199,13 @@ def test_a_corrupt_block_is_one_line_naming_the_file_and_the_array(grids, tmp_pa
     assert "array" in msg and "decompress" in msg
 
 
-def test_a_block_of_the_wrong_size_is_refused(tmp_path):
+@pytest.mark.parametrize("inflater", INFLATERS)
+def test_a_block_of_the_wrong_size_is_refused(tmp_path, monkeypatch, inflater):
     """A block that inflates to less than its header says, or to more (a zip bomb: 64 MB
     of zeros in 64 kB), is refused naming the array; the bomb is never inflated whole."""
     import tracemalloc
+
+    monkeypatch.setattr(vtkdirect, "ZLIB", _inflater(inflater))
 
     pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
     good = zlib.compress(pts.tobytes())

@@ -12,7 +12,8 @@ Guide): a length header or a block table, then raw, zlib or LZMA blocks, inline
 in base64 or appended raw or base64. Decoding only the arrays the field needs,
 the base64 with ``pybase64`` (vectorised, it lets go of the GIL: 1.6 GB/s here
 against 0.28 GB/s for ``binascii``) and the blocks inflated on two threads (zlib
-and lzma release the GIL), takes 0.25-0.3 s on that file and never imports VTK.
+and lzma release the GIL; zlib by ISA-L where ``isal`` is installed, `ZLIB`),
+takes 0.24 s on that file (0.29 s with the standard zlib) and never imports VTK.
 Text that is not strict base64 (line breaks, padding inside the stream) is
 decoded by ``binascii``'s lenient decoder, as before: the same bytes either way.
 
@@ -38,6 +39,7 @@ the array.
 from __future__ import annotations
 
 import binascii
+import importlib
 import lzma
 import mmap
 import os
@@ -65,10 +67,23 @@ from .xmlcheck import NUMPY_TYPES, DataArray, Xml
 DIRECT_SUFFIXES = (".vtu", ".vtp")
 
 
+def _zlib_module():
+    """ISA-L's zlib-compatible inflate (``isal``, in the ``fast`` extra) where installed: about
+    twice the standard zlib's speed on these blocks and the same bytes; else the standard zlib."""
+    try:
+        return importlib.import_module("isal.isal_zlib")
+    except ImportError:
+        return zlib
+
+
+#: The zlib inflater (`_zlib_module`).
+ZLIB = _zlib_module()
+
+
 def _zlib(block, limit: int) -> bytes:
     """A zlib block inflated to at most ``limit`` + 1 bytes (a block that inflates to more
     than its header says is refused without inflating it all: no zip bomb)."""
-    return zlib.decompressobj().decompress(block, limit + 1)
+    return ZLIB.decompressobj().decompress(block, limit + 1)
 
 
 def _lzma(block, limit: int) -> bytes:
@@ -467,7 +482,7 @@ def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str
             want = block if i < nblocks - 1 or not last else last
             try:
                 got = inflate(body[starts[i] : starts[i + 1]], want)
-            except (zlib.error, lzma.LZMAError, ValueError, EOFError):
+            except (zlib.error, ZLIB.error, lzma.LZMAError, ValueError, EOFError):
                 raise InputFileError(
                     f"{fmt.path}: array {name!r}: block {i + 1} does not decompress"
                 ) from None
