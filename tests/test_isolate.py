@@ -388,3 +388,44 @@ def test_fresh_arrays_are_zero_filled_and_writable(shape, dtype):
         assert root is a
     a[...] = 5
     assert int(a.sum()) == 5 * a.size
+
+
+_CHAINED = """
+import tblib.pickling_support
+
+from fepost.errors import InputFileError
+from fepost.reader import isolate
+
+
+class Unpicklable(Exception):
+    pass
+
+
+Unpicklable.__module__ = "no_such_module"  # as ISA-L's IsalError: its module cannot be imported
+tblib.pickling_support.install()  # after fepost's errors are defined, as dask's distributed does
+
+
+def read():
+    try:
+        raise Unpicklable("inflate failed")
+    except Unpicklable:
+        raise InputFileError("x.vtu: array 'P': block 1 does not decompress") from None
+
+
+try:
+    isolate.call(read, what="x.vtu")
+except InputFileError as exc:
+    print(exc)
+"""
+
+
+def test_an_error_raised_from_an_unpicklable_one_crosses_with_tblib_installed():
+    """The child sends its error without the chain it was raised from: with tblib's pickling
+    installed the chain would travel too, and an exception of a C library whose module cannot
+    be imported would turn the error into 'cannot read the file (PicklingError ...)'."""
+    import subprocess
+    import sys
+
+    pytest.importorskip("tblib")
+    out = subprocess.run([sys.executable, "-c", _CHAINED], capture_output=True, text=True, timeout=120)
+    assert out.stdout.strip() == "x.vtu: array 'P': block 1 does not decompress", out.stdout + out.stderr

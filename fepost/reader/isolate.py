@@ -282,7 +282,7 @@ def _child_main(wfd: int, ack: int, shared: int | None, func, args, kwargs, nbyt
             result = func(*args, **kwargs)
             payload: tuple = ("ok", result)
         except FepostError as exc:
-            payload = ("fepost", exc)
+            payload = ("fepost", _unchained(exc))
         except MemoryError:
             payload = ("memory", None)
         except BaseException as exc:  # reported to the parent as one line
@@ -294,6 +294,16 @@ def _child_main(wfd: int, ack: int, shared: int | None, func, args, kwargs, nbyt
     except Exception as exc:  # the result itself could not be pickled: say so
         other = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
         transfer.send(wfd, (other, caught, text), ack, shared)
+
+
+def _unchained(exc: BaseException) -> BaseException:
+    """``exc`` without the exceptions it was raised from and its traceback: the caller needs its
+    type and message. A chained exception of a C library may not pickle (ISA-L's ``IsalError``
+    names a module that cannot be imported), and with tblib's pickling installed (as dask's
+    distributed installs it) the chain would travel with the error and spoil it."""
+    exc.__cause__ = exc.__context__ = None
+    exc.__traceback__ = None
+    return exc
 
 
 # ----------------------------------------------------------------------------- parent side
