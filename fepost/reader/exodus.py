@@ -121,10 +121,7 @@ def _indices(ds, name: str, shape: tuple[int, ...], rows: np.ndarray | None = No
     else:
         span = _span(rows)
         a = np.asarray(v[span])[rows - span.start]
-        shape = (len(rows), *shape[1:])
-    if a.shape != shape:
-        raise ValueError(f"variable {name} has shape {a.shape}, expected {shape}")
-    return np.subtract(a, 1, out=fresh_array(shape, np.int64), casting="unsafe")
+    return np.subtract(a, 1, out=fresh_array(a.shape, np.int64), casting="unsafe")
 
 
 def _steps(ds, path: Path | str) -> np.ndarray:
@@ -242,11 +239,10 @@ def _read_exodus(ds, path: Path, step: int | None, surface: str | None) -> RawMe
     chosen = choose_step(path, step, n_steps)
 
     counts = _element_counts(ds)
-    named = only = None
-    if surface is not None:  # the side sets first: which elements to read
-        side_sets = _side_sets(ds, sum(counts))
-        named = _side_set_named(side_sets, surface)
-        only = None if named is None else np.unique(named.elements)
+    # with a surface named, the side sets first: which elements to read
+    side_sets = None if surface is None else _side_sets(ds, sum(counts))
+    named = None if side_sets is None or surface is None else _side_set_named(side_sets, surface)
+    only = None if named is None else np.unique(named.elements)
     blocks = _blocks(ds, path, n_nodes, chosen, counts, only)
     raw = RawMesh(
         path=str(path),
@@ -265,14 +261,12 @@ def _read_exodus(ds, path: Path, step: int | None, surface: str | None) -> RawMe
     raw.closer = ds.close
     _bodies(raw)
     _nodal(ds, raw, n_nodes, chosen)
-    if only is None:
-        raw.side_sets = side_sets if surface is not None else _side_sets(ds, sum(counts))
-    else:  # numbered over the elements read: the side sets' elements in file order
+    if named is None or only is None:
+        raw.side_sets = _side_sets(ds, sum(counts)) if side_sets is None else side_sets
+    else:  # the named side set alone, numbered over the elements read (in file order)
         raw.partial = True
         raw.side_sets = [
-            SideSet(ss.label, ss.name, ss.id, np.searchsorted(only, ss.elements), ss.sides)
-            for ss in side_sets
-            if ss is named
+            SideSet(named.label, named.name, named.id, np.searchsorted(only, named.elements), named.sides)
         ]
     raw.globals = _globals(ds, chosen)
     return raw
