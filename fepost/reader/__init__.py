@@ -51,15 +51,12 @@ from typing import TYPE_CHECKING
 from ..errors import InputFileError
 from . import isolate
 from .names import CCX_CONTACT, DISPLACEMENT_NAMES, PRESSURE_NAMES, SENTINELS
+from .suffixes import EXODUS_SUFFIXES, FRD_SUFFIXES, VTK_SUFFIXES, XDMF_SUFFIXES
 from .units import SYSTEMS, UnitSystem, unit_system
 
 if TYPE_CHECKING:
     from ..field import ContactField
 
-VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm", ".vts", ".vtr", ".pvtu", ".pvtp")
-EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
-XDMF_SUFFIXES = (".xdmf", ".xmf")
-FRD_SUFFIXES = (".frd",)
 
 __all__ = [
     "CCX_CONTACT",
@@ -244,9 +241,7 @@ class TimeStep:
 
 
 def _steps_here(path: Path) -> tuple[float, ...] | None:
-    from .contact import EXODUS_SUFFIXES as exo
-
-    if path.suffix.lower() in exo:
+    if path.suffix.lower() in EXODUS_SUFFIXES:
         from .exodus import read_steps
 
         return read_steps(path)

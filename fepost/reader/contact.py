@@ -20,16 +20,16 @@ from ..errors import DimensionError, FepostError, FieldError, InputFileError, Pr
 from ..field import OTHER_FACE_TYPES, ContactField
 from .cells import SPECS
 from .exodus import read_exodus
-from .frd import FRD_SUFFIXES, read_frd
+from .frd import read_frd
 from .names import SENTINELS, ArrayInfo, FieldChoice, norm, pick_displacement, pick_field
 from .raw import RawMesh
 from .sidecar import at_step, read_sidecar
+from .suffixes import EXODUS_SUFFIXES, FRD_SUFFIXES, XDMF_SUFFIXES
 from .surface import Surface, loaded_surfaces, select_surface
 from .units import UnitSystem
 from .vtkfile import read_vtk
-from .xdmf import XDMF_SUFFIXES, read_xdmf
+from .xdmf import read_xdmf
 
-EXODUS_SUFFIXES = (".e", ".exo", ".ex2", ".exii")
 #: Global variables read as the solver's reaction or contact force (normalised names containing these).
 REACTION_WORDS = ("react", "force")
 #: Largest magnitude accepted for a coordinate or a displacement (file units): beyond it the numbers

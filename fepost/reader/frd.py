@@ -50,8 +50,8 @@ from .cells import SPECS
 from .exodus import choose_step
 from .frdparse import FrdFile, ResultBlock, block_values, open_frd, scan
 from .raw import Block, RawMesh
+from .suffixes import FRD_SUFFIXES
 
-FRD_SUFFIXES = (".frd",)
 #: frd element type → canonical type of `fepost.reader.cells` (node orders agree).
 CANONICAL = {
     1: "hex8",

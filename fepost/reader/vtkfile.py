@@ -24,9 +24,9 @@ import numpy as np
 
 from ..errors import InputFileError
 from .raw import RawMesh
+from .suffixes import VTK_SUFFIXES
 from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
 
-VTK_SUFFIXES = (".vtu", ".vtp", ".vtk", ".vtm", ".vts", ".vtr", ".pvtu", ".pvtp")
 #: Parallel files: pieces read one by one and joined.
 PARALLEL_SUFFIXES = (".pvtu", ".pvtp")
 _XML_READERS = {

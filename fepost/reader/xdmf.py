@@ -25,9 +25,9 @@ from ..errors import InputFileError
 from .cells import SPECS, VTK_TYPES, check_connectivity
 from .exodus import choose_step
 from .raw import Block, RawMesh
+from .suffixes import XDMF_SUFFIXES
 from .xdmfcheck import check_xdmf
 
-XDMF_SUFFIXES = (".xdmf", ".xmf")
 #: meshio cell type → VTK cell type (meshio keeps VTK's node order).
 MESHIO_TO_VTK = {
     "vertex": 1,
