@@ -15,9 +15,10 @@ import sys
 
 import numpy as np
 import pytest
+from numpy.polynomial import chebyshev
 
 from fepost.errors import ArgumentError
-from fepost.friction import kernel
+from fepost.friction import basis, kernel, kernelpack
 from fepost.friction import model as model_module
 from fepost.friction.build import build_model
 from fepost.friction.law import FrictionLaw
@@ -265,3 +266,51 @@ def test_bad_out_arrays_are_named(models, out, message):
     for backend in ("numba", "numpy"):
         with pytest.raises(ArgumentError, match=re.escape(message)):
             models["hertz 72"].evaluate(np.ones(5), 0.0, 1.0, backend=backend, out=out)
+
+
+def test_blocks_take_the_unrolled_sums_up_to_their_limit(models):
+    """The type token that makes numba compile the sums unrolled for a shape, and the
+    general loops beyond `UNROLL_MAX` numbers (whose numbers the parametrised test
+    above compares with the numpy path)."""
+    assert models["hertz 72"].kernel_coefficients.shape == ((0,) * 9, (0,) * 8)
+    assert models["odd order (3, 5)"].kernel_coefficients.shape == ((0,) * 7, (0,) * 8)  # columns padded
+    assert 17 * 12 > kernelpack.UNROLL_MAX >= 72
+    assert models["tire-like 204"].kernel_coefficients.shape == ((), ())
+
+
+@pytest.mark.parametrize("name", ["hertz 72", "odd order (3, 5)", "anisotropic"])
+def test_general_and_unrolled_sums_give_the_same_numbers(models, name, monkeypatch):
+    """Every block forced through the general loops and through the unrolled sums: the
+    numpy path's numbers both ways, and each other's to round-off (the same terms,
+    summed in another order)."""
+    model = models[name]
+    vx, vy, wz = random_kinematics(5000, seed=9)
+    monkeypatch.setattr(kernelpack, "UNROLL_MAX", 1000)
+    assert model.kernel_coefficients.shape[0]
+    unrolled = model.evaluate(vx, vy, wz, backend="numba")
+    assert_same(model, unrolled, model.evaluate(vx, vy, wz, backend="numpy"))
+    monkeypatch.setattr(kernelpack, "UNROLL_MAX", 0)
+    assert model.kernel_coefficients.shape == ((), ())
+    general = model.evaluate(vx, vy, wz, backend="numba")
+    assert_same(model, general, model.evaluate(vx, vy, wz, backend="numpy"))
+    assert_same(model, general, unrolled)
+
+
+@pytest.mark.parametrize(("rows", "cols"), [(1, 4), (3, 4), (9, 8), (7, 8), (17, 12)])
+def test_unrolled_source_sums_as_the_basis_does(rows, cols):
+    """The generated sums run as plain Python (no numba) against the basis's own einsum
+    sums (`fepost.friction.basis.sums`, C's t-derivative taken there by the basis)."""
+    rng = np.random.default_rng(rows * cols)
+    C = rng.normal(size=(rows, cols))
+    Cd = np.zeros_like(C)
+    Cd[:, : cols - 1] = chebyshev.chebder(C, scl=2.0, axis=1)
+    n = 64
+    t = np.concatenate([[0.0, 1.0], rng.uniform(size=n - 2)])
+    theta = rng.uniform(0.0, 2.0 * np.pi, n)
+    c1, s1 = np.cos(theta), np.sin(theta)
+    namespace: dict = {}
+    exec(kernel._unrolled_source(rows, cols), namespace)  # noqa: S102 - the kernel's own source
+    acc = np.full((3, n), np.nan)
+    namespace["_sums_unrolled"](None, C, Cd, t, c1, s1, n, None, acc, None, None, None, None)
+    for got, want in zip(acc, basis.sums(C, c1, s1, t), strict=True):  # measured ≤ 1e-15 of the largest
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-14 * max(float(np.abs(want).max()), 1.0))

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import importlib.util
 import threading
+from collections.abc import Callable, Mapping
 
 #: True when numba can be imported (the optional ``fast`` extra is installed).
 AVAILABLE = importlib.util.find_spec("numba") is not None
@@ -18,16 +19,31 @@ AVAILABLE = importlib.util.find_spec("numba") is not None
 _LOCK = threading.Lock()
 
 
-def compile_functions(namespace: dict, names: tuple[str, ...], fastmath: set[str]) -> None:
+def compile_functions(
+    namespace: dict,
+    names: tuple[str, ...],
+    fastmath: set[str],
+    overloads: Mapping[str, Callable] | None = None,
+) -> None:
     """Replace the functions ``names`` of a module (``namespace``, its globals) by their
     numba-compiled versions, once per process; they call one another by these global
-    names, which numba resolves when it compiles the first call."""
+    names, which numba resolves when it compiles the first call.
+
+    ``overloads``: module functions whose compiled implementation depends on the types
+    of their arguments, each with the function that returns that implementation for
+    the numba types it is given (numba's ``overload``, with the same options)."""
     with _LOCK:
         if namespace.get("_COMPILED"):
             return
         import numba
+        from numba.extending import overload
 
-        jit = numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=fastmath or False)
+        fm = fastmath or False
+        for name, typed in (overloads or {}).items():
+            overload(namespace[name], jit_options={"nogil": True, "error_model": "numpy", "fastmath": fm})(
+                typed
+            )
+        jit = numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=fm)
         for name in names:
             namespace[name] = jit(namespace[name])
         namespace["_COMPILED"] = True
