@@ -11,6 +11,8 @@ Tolerance tiers:
 
 from __future__ import annotations
 
+import queue
+
 import numpy as np
 import pytest
 from scipy import integrate
@@ -320,15 +322,37 @@ def test_results_are_read_only_shaped_and_serialisable():
     np.testing.assert_array_equal(vx, before)
 
 
-def test_threads_and_chunks_do_not_change_results(monkeypatch):
-    import fepost.friction.exact as exact
+@pytest.mark.parametrize(
+    "law", [FrictionLaw(f=0.5), FrictionLaw(f=0.5, speed_coef=-0.3)], ids=["coulomb", "speed"]
+)
+def test_threads_and_chunks_do_not_change_results(monkeypatch, law):
+    """Many chunks of three points on two threads: the same numbers as one chunk, the
+    working arrays reused from chunk to chunk (at most one set per thread) and by the
+    next call (none made)."""
+    from fepost.friction import chunksums
 
     quad = make_quad("hertz", nr=16, nphi=32)
     vx, vy, wz = kinematic_set()
-    a = friction_resultants(quad, vx, vy, wz, threads=1)
-    monkeypatch.setattr(exact, "CHUNK_ELEMENTS", 3 * quad.x.size)
-    b = friction_resultants(quad, vx, vy, wz, threads=2)
-    np.testing.assert_allclose(b.Mz, a.Mz, rtol=1e-13)
+    a = friction_resultants(quad, vx, vy, wz, law, threads=1, backend="numpy")
+    made = []
+
+    class Counted(chunksums.Scratch):
+        def __init__(self, elements: int) -> None:
+            made.append(elements)
+            super().__init__(elements)
+
+    monkeypatch.setattr(chunksums, "Scratch", Counted)
+    monkeypatch.setattr(chunksums, "_SPARE", queue.SimpleQueue())
+    monkeypatch.setattr(chunksums, "CHUNK_ELEMENTS", 3 * quad.x.size)
+    b = friction_resultants(quad, vx, vy, wz, law, threads=2, backend="numpy")
+    assert vx.size >= 12 and 1 <= len(made) <= 2 and set(made) == {3 * quad.x.size}  # 4+ chunks
+    c = friction_resultants(quad, vx, vy, wz, law, threads=2, backend="numpy")
+    assert len(made) <= 2
+    for name in ("Fx", "Fy", "Mz"):
+        for r in (b, c):
+            np.testing.assert_allclose(
+                getattr(r, name), getattr(a, name), rtol=1e-13, atol=1e-13 * abs(a.Mz).max()
+            )
 
 
 def test_nan_kinematics_rejected():

@@ -41,14 +41,10 @@ from threadpoolctl import threadpool_limits
 
 from .._arrays import frozen
 from ..errors import ArgumentError
-from . import nodesums
+from . import chunksums, nodesums
 from . import turns as turns_mod
 from .law import FrictionLaw
 from .quadrature import Ellipse, PressureQuadrature, turn_angles
-
-#: Elements (kinematic points × nodes) per chunk: 2^17 doubles = 1 MB per array, a
-#: handful of arrays per worker thread that stay in cache (8 MB arrays ran 1.4x slower).
-CHUNK_ELEMENTS = 1 << 17
 
 #: Trapezoid nodes in θ: at least this many ...
 THETA_MIN = 64
@@ -135,7 +131,7 @@ def ray_integrals(domain: Ellipse, px: np.ndarray, py: np.ndarray) -> np.ndarray
         trig2 = np.column_stack([c, s])
         trig3 = np.column_stack([c * c, c * s, s * s])
         trig4 = np.column_stack([c**3, c * c * s, c * s * s, s**3])
-        block = max(1, CHUNK_ELEMENTS // int(n))
+        block = max(1, chunksums.CHUNK_ELEMENTS // int(n))
         for start in range(0, idx.size, block):
             j = idx[start : start + block]
             rho = domain.ray_length(px[j, None], py[j, None], theta[None, :])
@@ -178,87 +174,13 @@ def _turned_rays(
     return out
 
 
-@dataclass(frozen=True)
-class _Nodes:
-    """Per-node matrices the chunks share (read-only).
-
-    Columns multiplied by ŵ_x: g dA, g dA y | dA, dA x, dA y, dA xy, dA y²;
-    by ŵ_y: g dA, g dA x | dA, dA x, dA y, dA x², dA xy. (g = μσ without the
-    speed factor, Pa.) Columns after the bar serve the subtraction.
-    """
-
-    x: np.ndarray
-    y: np.ndarray
-    bx: np.ndarray
-    by: np.ndarray
-
-
-def _nodes(quad: PressureQuadrature, law: FrictionLaw, sigma_ref: float) -> _Nodes:
-    x, y, da = quad.x, quad.y, quad.dA
-    g = law.f * law.pressure_factor(quad.sigma, sigma_ref) * quad.sigma * da
-    bx = np.column_stack([g, g * y, da, da * x, da * y, da * x * y, da * y * y])
-    by = np.column_stack([g, g * x, da, da * x, da * y, da * x * x, da * x * y])
-    return _Nodes(x, y, bx, by)
-
-
-def _directions(
-    nodes: _Nodes, law: FrictionLaw, vx, vy, wz
-) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """ŵ_x, ŵ_y (points, nodes) of the sliding velocity at every node (0 at the centre of
-    rotation), and |w| when μ depends on the sliding speed (else None)."""
-    wx = np.multiply(wz[:, None], nodes.y[None, :])
-    np.subtract(vx[:, None], wx, out=wx)
-    wy = np.multiply(wz[:, None], nodes.x[None, :])
-    np.add(vy[:, None], wy, out=wy)
-    # |w| as √(wx² + wy²), 6x cheaper than np.hypot (the bulk of a model build); hypot
-    # only where the squares could underflow or overflow
-    speed = np.multiply(wx, wx)
-    speed += wy * wy
-    np.sqrt(speed, out=speed)
-    # two reductions decide whether any square could have under- or overflowed (rare)
-    low = speed.min(initial=np.inf)
-    if not (low > 1e-150 and speed.max(initial=0.0) < 1e150):
-        odd = ~((speed > 1e-150) & (speed < 1e150))
-        speed[odd] = np.hypot(wx[odd], wy[odd])
-        low = speed.min(initial=np.inf)
-    if law.depends_on_speed:
-        inv = np.divide(1.0, speed, out=np.zeros_like(speed), where=speed > 0)
-    else:  # |w| is not needed after this: 1/|w| in its place (0 at the centre of rotation)
-        where = True if low > 0 else speed > 0  # 0 stays 0
-        inv = np.divide(1.0, speed, out=speed, where=where)
-    wx *= inv
-    wy *= inv
-    return wx, wy, (speed if law.depends_on_speed else None)
-
-
-def _chunk(nodes: _Nodes, law: FrictionLaw, vx, vy, wz) -> tuple[np.ndarray, np.ndarray]:
-    """Sums over the nodes for one chunk of kinematic points: ŵ_x @ bx and ŵ_y @ by.
-
-    Columns 0, 1 carry the speed factor of μ; the others (plain dA) do not.
-    """
-    wx, wy, speed = _directions(nodes, law, vx, vy, wz)
-    if speed is None:  # one product per component: ŵ read once
-        return wx @ nodes.bx, wy @ nodes.by
-    ncol = nodes.bx.shape[1]
-    sx = np.empty((vx.size, ncol))
-    sy = np.empty((vx.size, ncol))
-    sx[:, 2:] = wx @ nodes.bx[:, 2:]
-    sy[:, 2:] = wy @ nodes.by[:, 2:]
-    factor = law.speed_factor(speed)
-    wx *= factor
-    wy *= factor
-    sx[:, :2] = wx @ nodes.bx[:, :2]
-    sy[:, :2] = wy @ nodes.by[:, :2]
-    return sx, sy
-
-
 def _turned_sums(setting: _Setting, *, vx, vy, wz, layout, turns: int) -> tuple[np.ndarray, np.ndarray]:
     """The node sums of ``turns`` groups of points from the first group's (`fepost.friction.turns`):
     ``vx``, ``vy``, ``wz`` are the first group's kinematics."""
     law = setting.law
-    nodes = _nodes(setting.quad, law, setting.sigma_ref)
+    nodes = chunksums.node_matrices(setting.quad, law, setting.sigma_ref)
     with threadpool_limits(limits=1, user_api="blas"):
-        wx, wy, speed = _directions(nodes, law, vx, vy, wz)
+        wx, wy, speed = chunksums.directions(nodes, law, vx, vy, wz)
         fields: tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]] = ((wx,), (wy,))
         if speed is not None:  # columns 0, 1 with the speed factor, the others without
             factor = law.speed_factor(speed)
@@ -391,34 +313,10 @@ def friction_resultants(
     return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))
 
 
-def _in_parallel(work, starts: range, workers: int) -> None:
-    """``work(start)`` for each start, on up to ``workers`` threads."""
-    if workers > 1 and len(starts) > 1:
-        with ThreadPoolExecutor(max_workers=min(workers, len(starts))) as pool:
-            list(pool.map(work, starts))
-    else:
-        for start in starts:
-            work(start)
-
-
 def _numpy_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.ndarray, np.ndarray]:
-    """The node sums (points, 7) by whole-array numpy and BLAS, over chunks of points."""
-    quad, law = setting.quad, setting.law
-    nodes = _nodes(quad, law, setting.sigma_ref)
-    k = vx.size
-    sx = np.zeros((k, nodes.bx.shape[1]))
-    sy = np.zeros((k, nodes.by.shape[1]))
-    block = max(1, CHUNK_ELEMENTS // max(1, quad.x.size))
-
-    def work(start: int) -> None:
-        sl = slice(start, start + block)
-        sx[sl], sy[sl] = _chunk(nodes, law, vx[sl], vy[sl], wz[sl])
-
-    # Parallel over chunks, one BLAS thread each: a multi-threaded BLAS under our
-    # own thread pool oversubscribes the cores (5x slower on a busy 2-core machine).
-    with threadpool_limits(limits=1, user_api="blas"):
-        _in_parallel(work, range(0, k, block), workers)
-    return sx, sy
+    """The node sums (points, 7) by whole-array numpy and BLAS (`fepost.friction.chunksums`)."""
+    nodes = chunksums.node_matrices(setting.quad, setting.law, setting.sigma_ref)
+    return chunksums.numpy_sums(nodes, setting.law, vx, vy, wz, workers)
 
 
 def _compiled_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.ndarray, np.ndarray]:
@@ -438,7 +336,7 @@ def _compiled_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.n
             vx[sl], vy[sl], wz[sl], x=x, y=y, weights=weights, speed_coef=law.speed_coef
         )
 
-    _in_parallel(work, range(0, k, KERNEL_BLOCK), workers)
+    chunksums.in_parallel(work, range(0, k, KERNEL_BLOCK), workers)
     return sx, sy
 
 
