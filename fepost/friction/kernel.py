@@ -310,8 +310,9 @@ def _unrolled_source(rows: int, cols: int) -> str:
     """Python source of `_sums_block` for a C of ``rows`` × ``cols``: one loop over the
     block whose body holds every row and column, so that the Chebyshev values, the
     harmonics and the three partial sums stay in registers (the general loops pass
-    them through memory row by row, about twice the time). Same formulas, same order
-    of the terms within a row."""
+    them through memory row by row, about twice the time). The same terms in the same
+    order; only the grouping of a row's terms (the general loops add them four at a
+    time) changes the rounding."""
     lines = ["def _sums_unrolled(shape, C, Cd, t, c1, s1, n, T, acc, ck, sk, pk, dpk):"]
     lines += [
         f"    c{r}_{m} = C[{r}, {m}]\n    d{r}_{m} = Cd[{r}, {m}]" for r in range(rows) for m in range(cols)
