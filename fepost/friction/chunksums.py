@@ -44,10 +44,16 @@ class Nodes:
     by: np.ndarray
 
 
+def node_loads(quad: PressureQuadrature, law: FrictionLaw, sigma_ref: float) -> np.ndarray:
+    """g dA at every node (N): μσ dA without μ's sliding-speed factor (``sigma_ref``: the
+    law's reference pressure, Pa)."""
+    return law.f * law.pressure_factor(quad.sigma, sigma_ref) * quad.sigma * quad.dA
+
+
 def node_matrices(quad: PressureQuadrature, law: FrictionLaw, sigma_ref: float) -> Nodes:
     """`Nodes` of a map under a law (``sigma_ref``: the law's reference pressure, Pa)."""
     x, y, da = quad.x, quad.y, quad.dA
-    g = law.f * law.pressure_factor(quad.sigma, sigma_ref) * quad.sigma * da
+    g = node_loads(quad, law, sigma_ref)
     bx = np.column_stack([g, g * y, da, da * x, da * y, da * x * y, da * y * y])
     by = np.column_stack([g, g * x, da, da * x, da * y, da * x * x, da * x * y])
     return Nodes(x, y, bx, by)

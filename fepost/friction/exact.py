@@ -322,7 +322,7 @@ def _numpy_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.ndar
 def _compiled_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.ndarray, np.ndarray]:
     """The node sums (points, 7) by the compiled loop (`fepost.friction.nodesums`)."""
     quad, law = setting.quad, setting.law
-    g = law.f * law.pressure_factor(quad.sigma, setting.sigma_ref) * quad.sigma * quad.dA
+    g = chunksums.node_loads(quad, law, setting.sigma_ref)
     x = np.ascontiguousarray(quad.x, float)
     y = np.ascontiguousarray(quad.y, float)
     weights = nodesums.columns(x, y, g, np.asarray(quad.dA, float))
