@@ -4,8 +4,9 @@ The numpy evaluation (`GeneralisedModel._evaluate`) makes about a hundred
 passes over whole arrays, each reading and writing memory. Here the kinematic
 points go in blocks of `BLOCK` through a few fused, branch-free loops that LLVM
 vectorises (4 points per instruction with AVX2) and whose rows stay in cache:
-the same formulas (the module docstring of `fepost.friction.model`), 12 × the
-numpy speed with the default 72 numbers and 20 × with 204. numpy alone cannot
+the same formulas (the module docstring of `fepost.friction.model`), about 15 ×
+the numpy speed with the default 72 numbers and 17 × with 204
+(benchmarks/bench_model.py). numpy alone cannot
 fuse the passes, which is why this is hand-written. Two library calls would
 keep the loops scalar, so they are replaced by vectorisable equivalents:
 
