@@ -58,15 +58,15 @@ def run(args: argparse.Namespace) -> int:
     pmap = result.rolling_map if result.rolling_map is not None else result.static_map
     law = FrictionLaw(f=result.coefficients.f)
     c = result.coefficients
-    pred = predict(kin.vx, kin.vy, kin.wz, pmap=pmap, coefficients=c, law=law, rolling=rolling)
+    summary = result.model_summary
+    model = summary.rolling if rolling else summary.static
+    pred = predict(kin.vx, kin.vy, kin.wz, pmap=pmap, coefficients=c, law=law, rolling=rolling, model=model)
     write_text_atomic(args.out, pred.to_csv())
     if args.model_json:
         write_text_atomic(args.model_json, pred.model.to_json() + "\n")
-    acc = pred.model.accuracy
+    acc = summary.map_accuracy(rolling)  # the figure fepost coefficients and the report state
     print(
         f"{len(kin)} rows -> {args.out} ({pred.map} map, R = {result.coefficients.R:.6g} m); "
-        f"generalised model within {acc['model_force']:.1%} of F0 and {acc['model_torque']:.1%} of M0 "
-        f"of the exact integrals over the sphere (paper's forms: {acc['compare_force']:.0%}, "
-        f"{acc['compare_torque']:.0%})"
+        f"generalised model {acc.sentence()}"
     )
     return 0

@@ -17,6 +17,7 @@ import numpy as np
 from .. import __version__
 from ..analysis import analyse
 from ..errors import ReaderWarning
+from ..friction.summary import ACCURACY_GRID
 from ..options import DEFAULT_FRICTION, AnalysisOptions
 from ..output import staged_folder, to_json
 from ..table1 import DEFAULT_SEED, table1
@@ -47,10 +48,9 @@ FILE_NOTES = {
     "sweep/coefficients.parquet": "the same table as Parquet, with each column's unit",
     "rolling_outline.vtp": "rolling patch: the same, in the static frame",
 }
-#: Grid of the error maps: sliding directions β in [0°, 180°] and meridian points t in [0, 1]
-#: (10° and 1/32 steps: the maps show where the errors lie; the largest errors of the
-#: generalised model on its own, finer check grid are in coefficients.json "model").
-ERROR_MAP_GRID = {"n_beta": 19, "n_t": 33}
+#: Grid of the error maps: the grid of every stated accuracy (the summary's error maps are
+#: drawn, not computed again: `fepost.friction.summary.ACCURACY_GRID`).
+ERROR_MAP_GRID = ACCURACY_GRID
 #: Units of the closed-form error scales (curve -> unit).
 CURVE_UNITS = {"f_parallel": "N", "torque": "N·m", "f_perp": "N"}
 
@@ -63,14 +63,12 @@ _MAP_SIDES = (("error_map", "static"), ("error_map_rolling", "rolling"))
 def quote_error_maps(ctx: dict, map_docs: dict, summary) -> None:
     """Make the page quote the error maps' largest errors wherever it quotes an error.
 
-    The error maps are the densest grid the report evaluates (denser than the
-    model's own check grid, which misses some peaks: 0.68 % there, 0.81 % on the
-    map for the aircraft tire), so the coefficient table's model errors and the
-    recommendation's "within ..." are the largest errors the maps show, each
-    row citing the error map's JSON key. ``coefficients.json`` keeps the check
-    grid's, as ``fepost coefficients --json`` writes it.
+    The error maps are the model summary's (`fepost.friction.summary.ACCURACY_GRID`, the
+    densest grid fepost evaluates, denser than the model's own check grid), so the
+    coefficient table's model errors are the largest errors the maps show, each row
+    citing the error map's JSON key, and the recommendation is the summary's own
+    (the same sentence as ``fepost coefficients``).
     """
-    worst: dict[str, float] = {}
     rows = []
     for row in ctx.get("model_rows", []):
         for stem, side in _MAP_SIDES:
@@ -83,14 +81,9 @@ def quote_error_maps(ctx: dict, map_docs: dict, summary) -> None:
                     row = {**row, "key": f"{stem}.worst.{name}.{what}", "value": value}
                     row["definition"] += " (the error map's grid: the densest evaluated)"
         rows.append(row)
-    for doc in (map_docs[stem] for stem, _ in _MAP_SIDES if stem in map_docs):
-        for name, prefix in _ACCURACY_KEYS.items():
-            for what in ("force", "torque"):
-                key = f"{prefix}_{what}"
-                worst[key] = max(worst.get(key, 0.0), doc["worst"][name][what])
     ctx["model_rows"] = rows
-    if worst and ctx.get("model_recommendation"):
-        ctx["model_recommendation"] = summary.recommendation(worst)
+    if ctx.get("model_recommendation"):
+        ctx["model_recommendation"] = summary.recommendation()
 
 
 def inflation_pressure_of(option: float | None, a) -> tuple[float, str]:
@@ -294,17 +287,12 @@ def _curve_figures(fc, tmp: Path) -> dict[str, Figure]:
 def _error_maps(a, tmp: Path) -> tuple[dict[str, Figure], dict[str, dict]]:
     """The error maps of the static (and rolling) map: figures and their JSON documents."""
     from ..figures.errormap import plot_error_map
-    from ..friction.law import FrictionLaw
-    from ..friction.summary import model_error_map
 
     made, docs = {}, {}
-    law = FrictionLaw(f=a.coefficients.f)
     for stem, rolling in (("error_map", False), ("error_map_rolling", True)):
         if rolling and a.rolling_map is None:
             continue
-        pmap = a.rolling_map if rolling else a.static_map
-        model = a.model_summary.rolling if rolling else a.model_summary.static
-        em = model_error_map(pmap, a.coefficients, law, model=model, rolling=rolling, **ERROR_MAP_GRID)
+        em = a.model_summary.rolling_errors if rolling else a.model_summary.static_errors
         key = stem.replace("_", "-")
         alt = f"Error map of the {'rolling' if rolling else 'static'} map: closed forms and generalised model"
         made[key] = save_matplotlib(plot_error_map(em), tmp, stem, key, alt)
