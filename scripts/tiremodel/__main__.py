@@ -8,6 +8,11 @@
 - ``rig [--mesh coarse|tiny|full] [--only RUN ...] [--out DIR] [--work DIR]``:
   the slide/spin programme on the small tire (meshes/rig/: the road moves
   rigidly with a sliding velocity and a spin, Coulomb friction 0.3);
+- ``rig-aircraft [--mesh rig|fine] [--only RUN ...] [--out DIR] --work DIR
+  [--workers N | --scheduler ADDRESS]``: the slide/spin programme on the
+  aircraft tire (meshes/rig-aircraft/), resumable, its runs as Dask tasks;
+- ``roll --work DIR [--only RUN ...] [--out DIR] [--scheduler ADDRESS]``: the
+  aircraft tire rolling quasi-statically (free, braking, driving; meshes/rig-aircraft/roll_*);
 - ``check-elements``: tip deflection of a rubber cantilever (C3D8I / C3D8,
   K/G = 100 / 1000) against Timoshenko's beam, the locking check behind the
   element choice.
@@ -70,6 +75,25 @@ def _parser() -> argparse.ArgumentParser:
         "--work", type=Path, required=True, help="CalculiX work folder; finished runs there are reused"
     )
     r.add_argument("--debug", action="store_true", help="show tracebacks")
+    ra = sub.add_parser(
+        "rig-aircraft", help="slide/spin programme on the aircraft tire (meshes/rig-aircraft/)"
+    )
+    ra.add_argument("--mesh", choices=["rig", "fine"], default="rig")
+    ra.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
+    ra.add_argument("--only", nargs="+", default=None, help="solve only these runs (names)")
+    ra.add_argument("--out", type=Path, default=REPO / "meshes" / "rig-aircraft")
+    ra.add_argument(
+        "--work", type=Path, required=True, help="CalculiX work folder; finished solves there are reused"
+    )
+    ra.add_argument("--workers", type=int, default=2, help="local Dask workers (one thread each)")
+    ra.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
+    ra.add_argument("--debug", action="store_true", help="show tracebacks")
+    ro = sub.add_parser("roll", help="aircraft tire rolling: free, braking, driving (rig-aircraft/roll_*)")
+    ro.add_argument("--out", type=Path, default=REPO / "meshes" / "rig-aircraft")
+    ro.add_argument("--work", type=Path, required=True, help="CalculiX work folder; finished solves reused")
+    ro.add_argument("--only", nargs="+", default=None, help="solve only these runs (names, e.g. roll_free)")
+    ro.add_argument("--scheduler", default=None, help="Dask scheduler ADDRESS (default: one local worker)")
+    ro.add_argument("--debug", action="store_true", help="show tracebacks")
     c = sub.add_parser("check-elements", help="cantilever check of the rubber elements against Timoshenko")
     c.add_argument("--debug", action="store_true", help="show tracebacks")
     return ap
@@ -125,6 +149,25 @@ def main(argv: list[str] | None = None) -> int:
             from .rig_programme import run_programme
 
             run_programme(args.out, args.work, mesh_kind=args.mesh, inc=args.inc, only=args.only)
+            return 0
+        if args.command == "rig-aircraft":
+            from .aircraft_rig_programme import run_programme as run_aircraft_programme
+
+            run_aircraft_programme(
+                args.out,
+                args.work,
+                mesh_kind=args.mesh,
+                inc=args.inc,
+                only=args.only,
+                workers=None if args.scheduler else args.workers,
+                scheduler=args.scheduler,
+            )
+            return 0
+        if args.command == "roll":
+            from .aircraft_roll_programme import programme, run_programme
+
+            specs = [s for s in programme() if args.only is None or s.name in args.only]
+            run_programme(args.out, args.work, specs, scheduler=args.scheduler)
             return 0
         if args.command == "aircraft":
             from .aircraft_build import build_aircraft

@@ -128,20 +128,9 @@ def write_aircraft_deck(
     w("*HEADING")
     w("fepost aircraft tire (46x17R20 class), half model y >= 0")
     out += cx.node_block(mesh.nodes, road)
-    # tire elements, grouped by material
-    # incompatible-mode hexahedra (good in bending) in the refined region around the
-    # patch; plain C3D8 in the coarse upper part, which only carries the inflation, and
-    # in the shoulder rubber: there the incompatible modes of the elements under the
-    # lateral patch edge oscillated without converging once the edge reached them
-    incompatible = mesh.fine & ~((mesh.region == 1) & (mesh.layer == 0))
-    for etype, sel in (("C3D8I", incompatible), ("C3D8", ~incompatible)):
-        out += cx.element_block(etype, "TIRE", np.flatnonzero(sel) + 1, mesh.hexes[sel])
+    out += tire_elements(mesh)
     out += cx.road_elements(road, nt, et)
-    rubber = mesh.layer == 0
-    tread = rubber & (mesh.region == 0)
-    for name, sel in (("ETREAD", tread), ("ESIDEWALL", rubber & ~tread)):
-        w(f"*ELSET, ELSET={name}")
-        w(cx.data_lines(int(e) + 1 for e in np.flatnonzero(sel)))
+    out += rubber_sets(mesh)
     sets = {
         "BEAD": (int(n) + 1 for n in mesh.bead_nodes),
         "SYMN": (int(n) + 1 for n in mesh.symmetry_nodes),
@@ -151,29 +140,7 @@ def write_aircraft_deck(
     out += cx.node_sets(sets)
     table = face_lookup(mesh.hexes)
     out += cx.contact_surfaces(mesh.hexes, mesh.contact_quads, road, table)
-    # materials
-    for name, r in RUBBER.items():
-        w(f"*MATERIAL, NAME={name}")
-        w("*HYPERELASTIC, NEO HOOKE")
-        w(f"{r['shear_modulus'] / 2:.6e}, {2.0 / r['bulk_modulus']:.6e}")
-    for name, c in CARCASS.items():
-        w(f"*MATERIAL, NAME={name}")
-        w("*ELASTIC, TYPE=ENGINEERING CONSTANTS")
-        w(", ".join(f"{v:.6e}" for v in c[:8]))
-        w(f"{c[8]:.6e}")
-    out += cx.ROAD_MATERIAL
-    w("*SOLID SECTION, ELSET=ETREAD, MATERIAL=TREAD")
-    w("*SOLID SECTION, ELSET=ESIDEWALL, MATERIAL=SIDEWALL")
-    w(cx.ROAD_SECTION)
-    # carcass: one orientation per element (local 1 meridional, 2 circumferential)
-    for e in np.flatnonzero(mesh.layer == 1):
-        a, b = mesh.meridian[e], mesh.circumferential[e]
-        mat = "BELTED" if mesh.region[e] == 0 else "CARCASS"
-        w(f"*ORIENTATION, NAME=OR{e + 1}")
-        w(", ".join(f"{v:.8f}" for v in (*a, *b)))
-        w(f"*ELSET, ELSET=EC{e + 1}")
-        w(str(e + 1))
-        w(f"*SOLID SECTION, ELSET=EC{e + 1}, MATERIAL={mat}, ORIENTATION=OR{e + 1}")
+    out += material_lines(mesh)
     out += cx.contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE)
     # time schedule: inflation over [0, t0], then stage k over [t0 + k - 1, t0 + k]
     t0 = INFLATION_TIME
@@ -239,6 +206,59 @@ def write_aircraft_deck(
         output_times=output_times,
         step_names=list(output_times),
     )
+
+
+def tire_elements(mesh: AircraftMesh) -> list[str]:
+    """The tire's ``*ELEMENT`` cards (set TIRE), C3D8I or C3D8 by region."""
+    # incompatible-mode hexahedra (good in bending) in the refined region around the
+    # patch; plain C3D8 in the coarse upper part, which only carries the inflation, and
+    # in the shoulder rubber: there the incompatible modes of the elements under the
+    # lateral patch edge oscillated without converging once the edge reached them
+    incompatible = mesh.fine & ~((mesh.region == 1) & (mesh.layer == 0))
+    out: list[str] = []
+    for etype, sel in (("C3D8I", incompatible), ("C3D8", ~incompatible)):
+        out += cx.element_block(etype, "TIRE", np.flatnonzero(sel) + 1, mesh.hexes[sel])
+    return out
+
+
+def rubber_sets(mesh: AircraftMesh) -> list[str]:
+    """Element sets ETREAD (crown rubber) and ESIDEWALL (shoulder and sidewall rubber)."""
+    rubber = mesh.layer == 0
+    tread = rubber & (mesh.region == 0)
+    out: list[str] = []
+    for name, sel in (("ETREAD", tread), ("ESIDEWALL", rubber & ~tread)):
+        out.append(f"*ELSET, ELSET={name}")
+        out.append(cx.data_lines(int(e) + 1 for e in np.flatnonzero(sel)))
+    return out
+
+
+def material_lines(mesh: AircraftMesh) -> list[str]:
+    """Materials and sections of the tire (rubber, oriented carcass) and of the road."""
+    out: list[str] = []
+    w = out.append
+    for name, r in RUBBER.items():
+        w(f"*MATERIAL, NAME={name}")
+        w("*HYPERELASTIC, NEO HOOKE")
+        w(f"{r['shear_modulus'] / 2:.6e}, {2.0 / r['bulk_modulus']:.6e}")
+    for name, c in CARCASS.items():
+        w(f"*MATERIAL, NAME={name}")
+        w("*ELASTIC, TYPE=ENGINEERING CONSTANTS")
+        w(", ".join(f"{v:.6e}" for v in c[:8]))
+        w(f"{c[8]:.6e}")
+    out += cx.ROAD_MATERIAL
+    w("*SOLID SECTION, ELSET=ETREAD, MATERIAL=TREAD")
+    w("*SOLID SECTION, ELSET=ESIDEWALL, MATERIAL=SIDEWALL")
+    w(cx.ROAD_SECTION)
+    # carcass: one orientation per element (local 1 meridional, 2 circumferential)
+    for e in np.flatnonzero(mesh.layer == 1):
+        a, b = mesh.meridian[e], mesh.circumferential[e]
+        mat = "BELTED" if mesh.region[e] == 0 else "CARCASS"
+        w(f"*ORIENTATION, NAME=OR{e + 1}")
+        w(", ".join(f"{v:.8f}" for v in (*a, *b)))
+        w(f"*ELSET, ELSET=EC{e + 1}")
+        w(str(e + 1))
+        w(f"*SOLID SECTION, ELSET=EC{e + 1}, MATERIAL={mat}, ORIENTATION=OR{e + 1}")
+    return out
 
 
 def _half_road():

@@ -60,7 +60,6 @@ def model_lines(mesh: TireMesh, title: str, road=None, cut_refs: int | None = No
     set CUTREF) instead of the one bead node, so that a rigid motion of the rim
     that is not a rotation about the axle can be prescribed at the cut faces too.
     """
-    p = mesh.params
     road = cx.build_road() if road is None else road
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
     out = []
@@ -79,8 +78,21 @@ def model_lines(mesh: TireMesh, title: str, road=None, cut_refs: int | None = No
     out += cx.ROAD_MATERIAL
     w("*SOLID SECTION, ELSET=TIRE, MATERIAL=CORDRUBBER")
     w(cx.ROAD_SECTION)
-    # sector cut faces: tangential displacement equals the rim's (rigid-rim
-    # cyclic condition): t . u_node - t . u_ref = 0, t = circumferential direction
+    out += cut_equations(mesh, cut_refs)
+    out += cx.contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE, CONTACT_TYPE)
+    return out
+
+
+def cut_equations(mesh, cut_refs: int | None = None) -> list[str]:
+    """Sector cut faces: tangential displacement equals the rim's (rigid-rim cyclic condition).
+
+    t . u_node - t . u_ref = 0, t = circumferential direction; the reference is
+    the first bead node, or with ``cut_refs`` each cut node's own reference node
+    (see ``model_lines``).
+    """
+    p = mesh.params
+    out: list[str] = []
+    w = out.append
     ref = int(mesh.bead_nodes[0]) + 1
     if cut_refs is not None:
         w("*NODE, NSET=CUTREF")
@@ -102,7 +114,6 @@ def model_lines(mesh: TireMesh, title: str, road=None, cut_refs: int | None = No
         (d1, c1), (d2, c2) = terms
         w(f"{n + 1}, {d1}, {c1:.9f}, {n + 1}, {d2}, {c2:.9f}, ")
         out[-1] += f"{ref}, {d1}, {-c1:.9f}, {ref}, {d2}, {-c2:.9f}"
-    out += cx.contact_pair(CONTACT_SLOPE, CONTACT_TENSION, FRICTION, STICK_SLOPE, CONTACT_TYPE)
     return out
 
 

@@ -49,6 +49,7 @@ node's RF the moment about the reference node; both are printed per increment.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -60,6 +61,41 @@ from .meshing import face_lookup
 
 SLIDE_PATH = 0.06  # m, reference sliding path of a run: |v| T + |wz| R_REF T combined in quadrature
 R_REF = 0.10  # m, reference patch radius used to scale the spin
+
+
+@dataclass(frozen=True)
+class RigTire:
+    """What differs between the tires on the rig; the steps and the rig itself are shared.
+
+    ``model_lines(mesh, title, road, cut_refs)``: the deck lines before the
+    boundary conditions (nodes, elements, sets ``BEAD``, ``ROADN``, ``TIREN``,
+    materials, the cut faces' equations against the ``CUTREF`` nodes, the
+    contact pair); ``road()``: the road block; ``controls``: lines added to
+    every step (relaxed convergence criteria); ``slide_path`` and ``r_ref``:
+    the reference path of a run and the radius that scales the spin (m).
+    """
+
+    name: str
+    model_lines: Callable
+    road: Callable[[], cx.Road]
+    pressure: float  # Pa
+    deflection: float  # m, rim travel beyond the inflated tread's first contact
+    slide_path: float = SLIDE_PATH
+    r_ref: float = R_REF
+    inflation_inc: str = "0.25, 1.0, 1e-5, 0.5"
+    vertical_inc: str = "0.05, 1.0, 1e-6, 0.1"
+    controls: tuple[str, ...] = ()
+    friction: float = dk.FRICTION
+
+
+#: the small stand-in tire (homogeneous, 200 kPa, 29 mm deflection)
+SMALL = RigTire(
+    name="small",
+    model_lines=dk.model_lines,
+    road=cx.build_road,
+    pressure=dk.PRESSURE,
+    deflection=0.029,
+)
 
 
 @dataclass(frozen=True)
@@ -80,17 +116,19 @@ class Kinematics:
         return origin[0] - self.vy / self.wz, origin[1] + self.vx / self.wz
 
 
-def kinematics(direction_deg: float, spin_angle_deg: float, spin_sign: int) -> Kinematics:
-    """Kinematics of one run with the reference path ``SLIDE_PATH``.
+def kinematics(
+    direction_deg: float, spin_angle_deg: float, spin_sign: int, tire: RigTire = SMALL
+) -> Kinematics:
+    """Kinematics of one run with the tire's reference path S (``SLIDE_PATH`` for the small tire).
 
     ``spin_angle_deg``: 0 = pure sliding, 90 = pure spin; |v| = S cos(a),
-    |wz| R_REF = S sin(a). ``direction_deg``: direction of the sliding velocity
+    |wz| R_ref = S sin(a). ``direction_deg``: direction of the sliding velocity
     from +x towards +y. ``spin_sign``: sign of wz.
     """
     a = math.radians(spin_angle_deg)
     d = math.radians(direction_deg)
-    v = SLIDE_PATH * math.cos(a)
-    wz = spin_sign * SLIDE_PATH * math.sin(a) / R_REF
+    v = tire.slide_path * math.cos(a)
+    wz = spin_sign * tire.slide_path * math.sin(a) / tire.r_ref
     vx, vy = v * math.cos(d), v * math.sin(d)
     # exact zeros where they belong (pure spin, axis directions): the deck stays clean
     r = 12
@@ -102,6 +140,13 @@ class RigNodes:
     ref: int  # 1-based CalculiX node number of the rigid body's reference node
     rot: int  # ... of its rotation node
     ref_xy: tuple[float, float]  # m, reference position of the reference node (z = 0)
+
+
+def _static(w, tire: RigTire, inc: str) -> None:
+    w("*STATIC")
+    w(inc)
+    for line in tire.controls:
+        w(line)
 
 
 def _outputs(w, frequency: int) -> None:
@@ -119,11 +164,22 @@ def _outputs(w, frequency: int) -> None:
     w("RF")
 
 
-def write_base_deck(path, mesh: TireMesh, rim_travel: float, origin: tuple[float, float]) -> RigNodes:
-    """Steps 1-2 (inflation, vertical rim travel) with the rigid road; writes a restart file."""
-    road = cx.build_road()
+def write_base_deck(
+    path,
+    mesh: TireMesh,
+    rim_travel: float,
+    origin: tuple[float, float],
+    tire: RigTire = SMALL,
+    inflation_only: bool = False,
+) -> RigNodes:
+    """Steps 1-2 (inflation, vertical rim travel) with the rigid road; writes a restart file.
+
+    ``inflation_only``: step 1 alone (the pre-run that finds the inflated clearance).
+    """
+    road = tire.road()
     nt, nr = mesh.nodes.shape[0], road.nodes.shape[0]
-    out = dk.model_lines(mesh, "fepost tire sector, slide/spin rig", road, cut_refs=nt + nr + 3)
+    title = "fepost tire sector, slide/spin rig" + ("" if tire is SMALL else f" ({tire.name} tire)")
+    out = tire.model_lines(mesh, title, road, cut_refs=nt + nr + 3)
     w = out.append
     nodes = RigNodes(ref=nt + nr + 1, rot=nt + nr + 2, ref_xy=(float(origin[0]), float(origin[1])))
     w("*NODE, NSET=NALL")
@@ -141,15 +197,17 @@ def write_base_deck(path, mesh: TireMesh, rim_travel: float, origin: tuple[float
     w("CUTREF, 1, 3")
     table = face_lookup(mesh.hexes)
     w("*STEP, NLGEOM, INC=400")
-    w("*STATIC")
-    w("0.25, 1.0, 1e-5, 0.5")
+    _static(w, tire, tire.inflation_inc)
     w("*DLOAD")
-    out += cx.pressure_load(mesh.hexes, mesh.inner_quads, dk.PRESSURE, table)
+    out += cx.pressure_load(mesh.hexes, mesh.inner_quads, tire.pressure, table)
     _outputs(w, 1000)
     w("*END STEP")
+    if inflation_only:
+        with open(path, "w") as fh:
+            fh.write("\n".join(out) + "\n")
+        return nodes
     w("*STEP, NLGEOM, INC=400")
-    w("*STATIC")
-    w("0.05, 1.0, 1e-6, 0.1")
+    _static(w, tire, tire.vertical_inc)
     w("*BOUNDARY")
     w(f"BEAD, 3, 3, {-rim_travel:.9e}")
     w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
@@ -186,7 +244,13 @@ def substeps(inc: float) -> int:
 
 
 def write_slide_deck(
-    path, mesh: TireMesh, kin: Kinematics, rim_travel: float, origin: tuple[float, float], inc: float
+    path,
+    mesh: TireMesh,
+    kin: Kinematics,
+    rim_travel: float,
+    origin: tuple[float, float],
+    inc: float,
+    tire: RigTire = SMALL,
 ) -> None:
     """The run's deck: restart from the base's step 2, then K slide steps of pseudo-time 1/K.
 
@@ -201,7 +265,7 @@ def write_slide_deck(
     # reference and rotation nodes) follow the rim's rigid motion
     nt = mesh.nodes.shape[0]
     cut = dk.cut_nodes(mesh)
-    first = nt + cx.build_road().nodes.shape[0] + 3
+    first = nt + tire.road().nodes.shape[0] + 3
     bead = np.unique(mesh.bead_nodes)
     numbers = [int(n) + 1 for n in bead] + list(range(first, first + len(cut)))
     pos = np.vstack([mesh.nodes[bead, :2], mesh.nodes[cut, :2]])
@@ -212,8 +276,7 @@ def write_slide_deck(
         _, a = tire_motion(kin, origin, i * dt)
         u = xy1 @ a.T - xy1[:, :2]
         w("*STEP, NLGEOM, INC=400")
-        w("*STATIC")
-        w(f"{dt / 2 if i == 1 else dt:.6g}, {dt:.6g}, 1e-8, {dt:.6g}")
+        _static(w, tire, f"{dt / 2 if i == 1 else dt:.6g}, {dt:.6g}, 1e-8, {dt:.6g}")
         w("*BOUNDARY")
         for n, (ux, uy) in zip(numbers, u, strict=True):
             w(f"{n}, 1, 1, {ux:.12e}")

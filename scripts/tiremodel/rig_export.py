@@ -26,7 +26,6 @@ from pathlib import Path
 
 import numpy as np
 
-from . import deck as dk
 from . import rig_deck as rd
 from .export import quad_integral
 from .geometry import TireMesh
@@ -140,7 +139,7 @@ def shear_resultants(mesh: TireMesh, res: RunResult, origin=(0.0, 0.0)) -> dict:
     }
 
 
-def write_static(mesh: TireMesh, res: RunResult, out: Path, info: dict) -> dict:
+def write_static(mesh: TireMesh, res: RunResult, out: Path, info: dict, tire: rd.RigTire = rd.SMALL) -> dict:
     """The static map of the rig's mesh (end of the vertical step) as ``static.vtu`` + sidecar."""
     pts, quads, used = contact_surface(mesh)
     cp = res.static_cpress[used]
@@ -151,7 +150,8 @@ def write_static(mesh: TireMesh, res: RunResult, out: Path, info: dict) -> dict:
     n = quad_integral(x, quads, cp)
     side = {
         "case": "static",
-        "description": "the rig's static map: inflation, then 29 mm deflection; the simulation "
+        "description": f"the rig's static map: inflation, then {tire.deflection * 1e3:.4g} mm deflection; "
+        "the simulation "
         "that the slide/spin runs are compared with",
         "reaction_z": _num(res.static_load[2]),
         "reaction_z_source": "CalculiX reaction at the rigid road's reference node, end of the vertical step",
@@ -159,7 +159,7 @@ def write_static(mesh: TireMesh, res: RunResult, out: Path, info: dict) -> dict:
         "centre_of_pressure": _vec(
             [quad_integral(x, quads, cp * x[:, 0]) / n, quad_integral(x, quads, cp * x[:, 1]) / n], 4
         ),
-        "friction": dk.FRICTION,
+        "friction": tire.friction,
         "arrays": STATIC_ARRAYS,
         "points": "reference (undeformed) coordinates of the contact faces (crown and shoulder "
         "within the refined sector), m; road plane z = 0, x rolling direction, y axle",
@@ -169,11 +169,11 @@ def write_static(mesh: TireMesh, res: RunResult, out: Path, info: dict) -> dict:
     return side
 
 
-def _history_block(res: RunResult, origin) -> dict:
+def _history_block(res: RunResult, origin, r_ref: float) -> dict:
     h = res.history
     kin = res.kin
     # reference sliding path of the run at each increment: |v| t and |wz| R_REF t in quadrature
-    ref_path = np.hypot(kin.vx, kin.vy) ** 2 + (kin.wz * rd.R_REF) ** 2
+    ref_path = np.hypot(kin.vx, kin.vy) ** 2 + (kin.wz * r_ref) ** 2
     r = resultants(res, origin)
     return {
         "time": _vec(h.time, 6),
@@ -190,7 +190,9 @@ def _history_block(res: RunResult, origin) -> dict:
     }
 
 
-def write_run(mesh: TireMesh, res: RunResult, out: Path, info: dict, origin=(0.0, 0.0)) -> dict:
+def write_run(
+    mesh: TireMesh, res: RunResult, out: Path, info: dict, origin=(0.0, 0.0), tire: rd.RigTire = rd.SMALL
+) -> dict:
     """Write ``<run>.vtu``, ``<run>.dat.txt`` and ``<run>.json`` into ``out``; return the sidecar."""
     pts, quads, disp, tau, cp, slip = tire_fields(mesh, res, origin)
     arrays = {"CPRESS": cp, "shear": tau, "slip": slip, "displacement": disp}
@@ -240,8 +242,8 @@ def write_run(mesh: TireMesh, res: RunResult, out: Path, info: dict, origin=(0.0
         "shear_integral": {key: _num(v) for key, v in shear.items()},
         "shear_integral_note": "exact integrals of the exported bilinear shear traction (and CPRESS) "
         "over the deformed contact faces, tire's frame: Fx, Fy (N), Mz about the origin (N m), N (N)",
-        "history": _history_block(res, origin),
-        "friction": dk.FRICTION,
+        "history": _history_block(res, origin, tire.r_ref),
+        "friction": tire.friction,
         "units": "SI (m, N, Pa)",
         "arrays": ARRAYS,
         "deck_sha256": res.deck_sha256,

@@ -23,7 +23,6 @@ from .frd import read_dat_blocks, read_frd
 from .geometry import TireMesh
 from .solve import ModelError, run_ccx
 
-DEFLECTION = 0.029  # m, as the static sample case
 SLIDE_START = 2.0  # total time at the start of the slide step (steps 1 and 2 last 1 each)
 
 
@@ -70,11 +69,20 @@ class RunResult:
     dat_excerpt: str  # the .dat records of the last slide increment, verbatim
 
 
-def inflation_rim_travel(mesh: TireMesh, workdir: Path, exe: str) -> tuple[float, float, float]:
-    """(rim travel, inflated clearance, wall time): the static case's pre-run, reused when present."""
+def inflation_rim_travel(
+    mesh: TireMesh, workdir: Path, exe: str, tire: rd.RigTire = rd.SMALL
+) -> tuple[float, float, float]:
+    """(rim travel, inflated clearance, wall time): the inflation pre-run, reused when present.
+
+    The small tire's pre-run is its static case's; the other tires' is the rig's
+    base deck cut after the inflation step.
+    """
     workdir.mkdir(parents=True, exist_ok=True)
     inp = workdir / "inflate.inp"
-    dk.write_deck(inp, mesh, dk.CASES["static"], 0.0, inflation_only=True)
+    if tire is rd.SMALL:
+        dk.write_deck(inp, mesh, dk.CASES["static"], 0.0, inflation_only=True)
+    else:
+        rd.write_base_deck(inp, mesh, 0.0, (0.0, 0.0), tire, inflation_only=True)
     t = _solve_once(exe, inp, "")
     r0 = read_frd(inp.with_suffix(".frd"))
     _, u0 = r0.field(max(r0.last), "U")
@@ -82,7 +90,7 @@ def inflation_rim_travel(mesh: TireMesh, workdir: Path, exe: str) -> tuple[float
     z = float((mesh.nodes[slave, 2] + u0[slave, 2]).min())
     if z <= 0.0:
         raise ModelError("inflated tire already touches the road")
-    return z + DEFLECTION, z, t
+    return z + tire.deflection, z, t
 
 
 def _solve_once(exe: str, inp: Path, key: str) -> float:
@@ -108,11 +116,13 @@ def _nodal(mesh: TireMesh, frd: Path, step: int | None = None):
     return {k: c[:nt, i] for i, k in enumerate(comps)}, res.field(step, "U")[1][:nt]
 
 
-def solve_base(mesh: TireMesh, rim_travel: float, workdir: Path, exe: str) -> Base:
+def solve_base(
+    mesh: TireMesh, rim_travel: float, workdir: Path, exe: str, tire: rd.RigTire = rd.SMALL
+) -> Base:
     """Solve (or reuse) the base run: inflation and vertical load with the rigid road."""
     workdir.mkdir(parents=True, exist_ok=True)
     inp = workdir / "base.inp"
-    nodes = rd.write_base_deck(inp, mesh, rim_travel, (0.0, 0.0))
+    nodes = rd.write_base_deck(inp, mesh, rim_travel, (0.0, 0.0), tire)
     t = _solve_once(exe, inp, "")
     contact, u = _nodal(mesh, inp.with_suffix(".frd"), 2)
     recs = [r for r in read_dat_blocks(inp.with_suffix(".dat")) if r[0] == "forces" and r[1] == "REFN"]
@@ -169,11 +179,12 @@ def solve_run(
     workdir: Path,
     exe: str,
     inc: float,
+    tire: rd.RigTire = rd.SMALL,
 ) -> RunResult:
     """Write the run's deck, solve it from the base's restart file (or reuse it) and read it."""
     workdir.mkdir(parents=True, exist_ok=True)
     inp = workdir / f"{name}.inp"
-    rd.write_slide_deck(inp, mesh, kin, rim_travel, base.nodes.ref_xy, inc)
+    rd.write_slide_deck(inp, mesh, kin, rim_travel, base.nodes.ref_xy, inc, tire)
     shutil.copyfile(base.restart, inp.with_suffix(".rin"))
     runtime = _solve_once(exe, inp, base.deck_sha256)
     contact, u = _nodal(mesh, inp.with_suffix(".frd"))

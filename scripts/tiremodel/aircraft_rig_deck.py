@@ -1,0 +1,69 @@
+"""The aircraft tire on the slide/spin rig: its deck lines and settings (``rig_deck.RigTire``).
+
+The rig itself (rigid road held at its reference and rotation nodes, the rim
+moved rigidly, restart from a shared base of inflation and vertical load, the
+cut faces tied to the rim) is ``rig_deck``'s; what is the aircraft tire's
+own comes from ``aircraft_deck``: the two-layer wall (Neo-Hooke tread and
+sidewall rubber, the oriented carcass and belt layer), C3D8I/C3D8 by region,
+1.38 MPa, the contact pair and the relaxed convergence criteria of the
+aircraft sweep (force residual 0.02 of the average nodal force, displacement
+correction 0.5 of the increment; see ``aircraft_deck.write_aircraft_deck``).
+
+The deflection is the rated-load deflection of the aircraft sweep
+(``meshes/aircraft/static_100``: 102.3 mm beyond the inflated tread's first
+contact); the rig mesh's own load at it is in ``static.json``.
+"""
+
+from __future__ import annotations
+
+from . import aircraft_deck as ad
+from . import ccxdeck as cx
+from . import deck as dk
+from . import rig_deck as rd
+from .meshing import face_lookup
+
+DEFLECTION = 0.1023  # m, rated-load deflection of the aircraft sweep (static_100)
+SLIDE_PATH = 0.20  # m, reference path of a run (the lateral compliance needs most of it)
+R_REF = 0.20  # m, reference patch radius that scales the spin (the patch is 0.47 x 0.35 m)
+CONTROLS = (
+    "*CONTROLS, PARAMETERS=FIELD",
+    "0.02, 0.5",
+    "*CONTROLS, PARAMETERS=TIME INCREMENTATION",
+    "4, 8, 9, 16, 10, 4, 0, 10",
+)
+
+
+def road() -> cx.Road:
+    """Road block |x|, |y| <= 0.6 m, 50 mm faces: room for the slide and the turn of the patch."""
+    return cx.build_road(half_x=0.60, half_y=0.60, thick=0.02, size=0.05)
+
+
+def model_lines(mesh, title: str, road: cx.Road, cut_refs: int | None = None) -> list[str]:
+    """Deck lines of the aircraft tire sector on the road, before boundary conditions and steps."""
+    nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
+    out = ["*HEADING", title]
+    out += cx.node_block(mesh.nodes, road)
+    out += ad.tire_elements(mesh)
+    out += cx.road_elements(road, nt, et)
+    out += ad.rubber_sets(mesh)
+    out += cx.node_sets({"BEAD": (int(n) + 1 for n in mesh.bead_nodes), **cx.tire_road_sets(nt, road)})
+    out += cx.contact_surfaces(mesh.hexes, mesh.contact_quads, road, face_lookup(mesh.hexes))
+    out += ad.material_lines(mesh)
+    out += dk.cut_equations(mesh, cut_refs)
+    out += cx.contact_pair(ad.CONTACT_SLOPE, ad.CONTACT_TENSION, ad.FRICTION, ad.STICK_SLOPE)
+    return out
+
+
+AIRCRAFT = rd.RigTire(
+    name="aircraft",
+    model_lines=model_lines,
+    road=road,
+    pressure=ad.PRESSURE,
+    deflection=DEFLECTION,
+    slide_path=SLIDE_PATH,
+    r_ref=R_REF,
+    inflation_inc="0.1, 1.0, 1e-6, 0.25",
+    vertical_inc="0.02, 1.0, 1e-7, 0.05",
+    controls=CONTROLS,
+    friction=ad.FRICTION,
+)

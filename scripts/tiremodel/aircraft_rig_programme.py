@@ -1,0 +1,272 @@
+"""The slide/spin programme on the aircraft tire: which runs, in which order, and the driver.
+
+Runs (named as the small tire's, ``rig_programme.run_name``): sliding
+directions 0, 45 and 90 degrees, spin angles a (|v| = S cos a,
+|wz| R_ref = S sin a) of 0 (pure sliding), 20, 40, 60, 75 and 90 (pure spin)
+degrees, both spin signs. Order, most informative first (a session that ends
+early still has a programme): pure spin and one pure slide per direction;
+then the spin angles 40, 60, 20, 75 in turn, each at 0 and 90 degrees with
+positive spin and at 45 degrees with both signs; last the negative spins at
+0 and 90 degrees and the negative pure spin, which are the mirror images of
+positive ones (the tire and its sector are symmetric about x = 0 and y = 0):
+a check of the rig, not new data.
+
+The driver (``run_programme``) is resumable: a run whose ``.vtu``,
+``.dat.txt`` and sidecar exist in the output folder and whose sidecar holds
+the sha256 of the deck it would solve now is skipped; anything else (a run
+never started, half-written, or with a changed deck) is solved again. Each
+run is a task on Dask (the sweep's ``Cluster``: a local cluster of one-thread
+workers by default, ``scheduler`` for an existing one; the work folder must
+then be visible to the workers); the client writes every finished run's
+files at once (the sidecar last) and prints its progress.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import rig_deck as rd
+from .aircraft_rig_deck import AIRCRAFT
+from .aircraft_rig_mesh import build_rig_mesh
+from .rig_programme import run_name
+
+SPIN_ANGLES = (40.0, 60.0, 20.0, 75.0)
+DIRECTIONS = (0.0, 45.0, 90.0)
+RUN_FILES = (".vtu", ".dat.txt", ".json")  # written in this order: the sidecar marks a finished run
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    name: str
+    direction: float  # deg
+    angle: float  # spin angle, deg (0 pure sliding, 90 pure spin)
+    sign: int  # sign of wz
+
+
+def programme() -> list[RunSpec]:
+    """Every run of the programme, in solving order (see the module docstring)."""
+    runs = [(0.0, 90.0, 1), (0.0, 0.0, 1), (45.0, 0.0, 1), (90.0, 0.0, 1)]
+    for a in SPIN_ANGLES:
+        runs += [(45.0, a, 1), (45.0, a, -1), (0.0, a, 1), (90.0, a, 1)]
+    runs.append((0.0, 90.0, -1))
+    for a in SPIN_ANGLES:
+        runs += [(0.0, a, -1), (90.0, a, -1)]
+    return [RunSpec(run_name(d, a, s), d, a, s) for d, a, s in runs]
+
+
+@dataclass(frozen=True)
+class Setup:
+    """What every task needs: the mesh, the work folder, the largest increment of the slide."""
+
+    mesh_kind: str
+    work: str
+    inc: float
+
+
+@functools.lru_cache(maxsize=4)
+def _mesh(kind: str):
+    return build_rig_mesh(kind)
+
+
+def base_task(setup: Setup):
+    """Inflation pre-run and base run, reused from the work folder: (rim travel, clearance, Base)."""
+    from .rig_run import inflation_rim_travel, solve_base
+    from .solve import find_ccx
+
+    mesh, exe, work = _mesh(setup.mesh_kind), find_ccx(), Path(setup.work)
+    rim_travel, clearance, _ = inflation_rim_travel(mesh, work, exe, AIRCRAFT)
+    return rim_travel, clearance, solve_base(mesh, rim_travel, work / "base", exe, AIRCRAFT)
+
+
+def run_deck_sha256(setup: Setup, spec: RunSpec, rim_travel: float, base_sha: str) -> str:
+    """The sha256 the run's sidecar records (its slide deck and the base deck's sha256)."""
+    with tempfile.TemporaryDirectory(prefix="arig-deck-") as tmp:
+        inp = Path(tmp) / f"{spec.name}.inp"
+        kin = rd.kinematics(spec.direction, spec.angle, spec.sign, AIRCRAFT)
+        rd.write_slide_deck(inp, _mesh(setup.mesh_kind), kin, rim_travel, (0.0, 0.0), setup.inc, AIRCRAFT)
+        return hashlib.sha256(inp.read_bytes() + base_sha.encode()).hexdigest()
+
+
+def is_done(out: Path, name: str, sha: str) -> bool:
+    """A run is finished when all its files exist and its sidecar names this deck."""
+    if not all((out / f"{name}{s}").is_file() for s in RUN_FILES):
+        return False
+    try:
+        return json.loads((out / f"{name}.json").read_text()).get("deck_sha256") == sha
+    except (OSError, ValueError):
+        return False
+
+
+def run_task(setup: Setup, spec: RunSpec, info: dict) -> dict[str, bytes]:
+    """Solve one run (reusing a finished solve in the work folder) and export it: {file name: bytes}."""
+    from .rig_export import write_run
+    from .rig_run import inflation_rim_travel, solve_base, solve_run
+    from .solve import find_ccx
+
+    mesh, exe, work = _mesh(setup.mesh_kind), find_ccx(), Path(setup.work)
+    rim_travel, _, _ = inflation_rim_travel(mesh, work, exe, AIRCRAFT)
+    base = solve_base(mesh, rim_travel, work / "base", exe, AIRCRAFT)
+    kin = rd.kinematics(spec.direction, spec.angle, spec.sign, AIRCRAFT)
+    res = solve_run(mesh, base, spec.name, kin, rim_travel, work / spec.name, exe, setup.inc, AIRCRAFT)
+    extra = {"direction_deg": spec.direction, "spin_angle_deg": spec.angle, "spin_sign": spec.sign}
+    with tempfile.TemporaryDirectory(prefix="arig-export-") as tmp:
+        write_run(mesh, res, Path(tmp), {**info, **extra}, tire=AIRCRAFT)
+        return {f"{spec.name}{s}": (Path(tmp) / f"{spec.name}{s}").read_bytes() for s in RUN_FILES}
+
+
+def save_files(out: Path, files: dict[str, bytes]) -> None:
+    """Write the files atomically in their given order (the sidecar last)."""
+    out.mkdir(parents=True, exist_ok=True)
+    for name, data in files.items():
+        part = out / f"{name}.part"
+        part.write_bytes(data)
+        os.replace(part, out / name)
+
+
+def _log(msg: str) -> None:
+    print(f"rig-aircraft: {msg}", file=sys.stderr, flush=True)
+
+
+def drive(
+    specs: list[RunSpec],
+    shas: dict[str, str],
+    out: Path,
+    submit: Callable[[RunSpec], object],
+    completed: Callable[[list], Iterable[tuple[object, object]]],
+    log: Callable[[str], None] = _log,
+) -> dict[str, dict]:
+    """Skip the finished runs, submit the others in order, save each result as it arrives.
+
+    ``submit(spec)`` returns a handle whose result is the run's files
+    (``run_task``); ``completed(handles)`` yields (handle, result or exception)
+    as they finish. Returns {run name: sidecar} of the runs solved now; a
+    failed run is reported and the others go on (raises at the end if any failed).
+    """
+    todo = [s for s in specs if not is_done(out, s.name, shas[s.name])]
+    skipped = len(specs) - len(todo)
+    if skipped:
+        log(f"{skipped} of {len(specs)} runs already finished in {out}; skipped")
+    handles = {}
+    for s in todo:
+        h = submit(s)
+        handles[id(h)] = (s, h)
+    done, failed = {}, []
+    t0 = time.perf_counter()
+    for h, result in completed([h for _, h in handles.values()]):
+        spec = handles[id(h)][0]
+        if isinstance(result, BaseException):
+            failed.append(spec.name)
+            log(f"{spec.name}: FAILED: {type(result).__name__}: {result}")
+            continue
+        save_files(out, result)
+        side = json.loads(result[f"{spec.name}.json"])
+        done[spec.name] = side
+        f = side["reaction"]["force"]
+        log(
+            f"[{skipped + len(done)}/{len(specs)}] {spec.name}: F = ({f[0]:.0f}, {f[1]:.0f}, {f[2]:.0f}) N, "
+            f"Mz = {side['history']['Mz'][-1]:.0f} N m, solve {side['runtime_s']:.0f} s "
+            f"(programme {time.perf_counter() - t0:.0f} s)"
+        )
+    if failed:
+        raise RuntimeError(f"{len(failed)} run(s) failed: {', '.join(failed)}")
+    return done
+
+
+def model_info(mesh, setup: Setup, rim_travel: float, clearance: float, solver: str) -> dict:
+    """The provenance block every sidecar of the programme carries."""
+    from . import aircraft_deck as ad
+    from .aircraft_export import model_description
+
+    hexes = mesh.hexes.shape[0]
+    incompatible = int((mesh.fine & ~((mesh.region == 1) & (mesh.layer == 0))).sum())
+    return {
+        "solver": solver,
+        "mesh": {
+            "name": f"aircraft-{setup.mesh_kind}",
+            "tire_nodes": int(mesh.nodes.shape[0]),
+            "tire_elements": int(hexes),
+            "element_type": f"C3D8I ({incompatible}), C3D8 ({hexes - incompatible})",
+            "contact_faces": int(mesh.contact_quads.shape[0]),
+            "sector_deg": round(mesh.info["sector_deg"], 6),
+            "n_crown": mesh.params.n_crown,
+            "n_shoulder": mesh.params.n_shoulder,
+            "n_side": mesh.params.n_side,
+            "layer_deg": mesh.params.first_deg,
+            "fine_deg": mesh.params.fine_deg,
+            "full_section": True,
+        },
+        "model": {
+            **model_description(mesh),
+            "rim": "rigid: the bead nodes prescribed (inflation, vertical travel, the rig's rigid motion)",
+            "deflection": AIRCRAFT.deflection,
+            "rim_travel_z": round(rim_travel, 9),
+            "inflated_clearance": round(clearance, 9),
+            "inflation_pressure": ad.PRESSURE,
+            "rated_load": ad.RATED_LOAD,
+            "road": "rigid body (*RIGID BODY), held at its reference and rotation nodes; the rim moves",
+            "slide_path": AIRCRAFT.slide_path,
+            "r_ref": AIRCRAFT.r_ref,
+            "max_increment": setup.inc,
+            "slide_steps": rd.substeps(setup.inc),
+            "convergence": "CalculiX field controls 0.02 (force residual), 0.5 (displacement correction)",
+        },
+    }
+
+
+def run_programme(
+    out: Path,
+    work: Path,
+    *,
+    mesh_kind: str = "rig",
+    inc: float = 0.1,
+    only: list[str] | None = None,
+    workers: int | None = 2,
+    scheduler: str | None = None,
+) -> dict[str, dict]:
+    """Solve (or skip, when finished) and export the runs ``only`` (default: the whole programme)."""
+    from fepost.sweep.engine import Cluster
+
+    from .rig_export import write_static
+    from .solve import ccx_version, find_ccx
+
+    exe = find_ccx()
+    setup = Setup(mesh_kind, str(work.resolve()), inc)
+    specs = programme()
+    if only:
+        unknown = sorted(set(only) - {s.name for s in specs})
+        if unknown:
+            raise ValueError(f"--only: unknown run(s) {', '.join(unknown)}")
+        specs = [s for s in specs if s.name in only]
+    mesh = _mesh(mesh_kind)
+    _log(f"mesh aircraft-{mesh_kind}: {mesh.nodes.shape[0]} nodes, {mesh.hexes.shape[0]} hexahedra")
+    with Cluster(workers=None if scheduler else workers, scheduler=scheduler) as cluster:
+        client = cluster.client
+        t0 = time.perf_counter()
+        rim_travel, clearance, base = client.submit(base_task, setup, pure=False).result()
+        _log(
+            f"base (inflation + {AIRCRAFT.deflection * 1e3:.1f} mm): "
+            f"load {base.static_load[2] / 1e3:.1f} kN, "
+            f"{(base.static_cpress > 0).sum()} loaded nodes, solve {base.runtime_s:.0f} s "
+            f"(wall {time.perf_counter() - t0:.0f} s)"
+        )
+        info = model_info(mesh, setup, rim_travel, clearance, ccx_version(exe))
+        static = out / "static.json"
+        if not static.exists() or json.loads(static.read_text()).get("base_deck_sha256") != base.deck_sha256:
+            write_static(mesh, base, out, {**info, "base_deck_sha256": base.deck_sha256}, tire=AIRCRAFT)
+        shas = {s.name: run_deck_sha256(setup, s, rim_travel, base.deck_sha256) for s in specs}
+        n = len(specs)
+
+        def submit(spec: RunSpec):
+            # earlier runs first: a higher priority for each earlier place in the order
+            return client.submit(run_task, setup, spec, info, pure=False, priority=n - specs.index(spec))
+
+        return drive(specs, shas, out, submit, cluster.as_completed)

@@ -1,0 +1,269 @@
+"""The aircraft tire on the slide/spin rig: mesh builder, deck, the driver's resume rule, the runs.
+
+The committed runs (meshes/rig-aircraft/) get the checks of the small tire's
+runs in test_rig.py; the builder and the driver are checked without a solve.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fepost.rig import rig_table
+
+REPO = Path(__file__).resolve().parents[1]
+RIG = REPO / "meshes" / "rig-aircraft"
+FRICTION = 0.3
+
+
+def _runs() -> list[Path]:
+    out = []
+    for side in sorted(RIG.glob("*.json")):
+        data = json.loads(side.read_text())
+        if "kinematics" in data and side.with_suffix(".vtu").exists():
+            out.append(side.with_suffix(".vtu"))
+    return out
+
+
+RUNS = _runs()
+needs_runs = pytest.mark.skipif(not RUNS, reason="meshes/rig-aircraft/ holds no solved runs yet")
+needs_static = pytest.mark.skipif(
+    not (RIG / "static.vtu").exists(), reason="meshes/rig-aircraft/static.vtu not written yet"
+)
+_DAT = re.compile(r"forces \(fx,fy,fz\) for set REFN and time\s+\S+\s*\n\s*\n\s*\d+\s+(\S+)\s+(\S+)\s+(\S+)")
+
+
+@pytest.fixture(scope="module")
+def test_mesh():
+    pytest.importorskip("gmsh")
+    from scripts.tiremodel.aircraft_rig_mesh import build_rig_mesh
+
+    return build_rig_mesh("test")
+
+
+# ---------------------------------------------------------------- the mesh builder
+
+
+def test_rig_mesh_is_the_full_section(test_mesh):
+    m = test_mesh
+    y = m.nodes[:, 1]
+    assert y.min() == pytest.approx(-y.max(), abs=1e-9) and y.max() > 0.2
+    assert m.symmetry_nodes.size == 0
+    # the mirror image of every node is a node (the section is whole, merged on y = 0)
+    key = {tuple(np.round(p, 7)) for p in m.nodes}
+    assert all(tuple(np.round(p * [1.0, -1.0, 1.0], 7)) in key for p in m.nodes)
+    # both halves' contact faces, crown and shoulder, both layers through the wall
+    assert (m.nodes[np.unique(m.contact_quads), 1] < -0.1).any()
+    assert set(np.unique(m.layer)) == {0, 1} and set(np.unique(m.region)) == {0, 1, 2}
+
+
+def test_rig_mesh_elements_are_positive_and_faces_outward(test_mesh):
+    m = test_mesh
+    x = m.nodes[m.hexes]
+    jac = np.einsum("ij,ij->i", np.cross(x[:, 1] - x[:, 0], x[:, 3] - x[:, 0]), x[:, 4] - x[:, 0])
+    assert (jac > 0).all()
+    # the contact faces at the bottom face the road (-z); the cavity faces point into the cavity
+    q = m.nodes[m.contact_quads]
+    n = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1])
+    bottom = np.abs(q[:, :, 0].mean(axis=1)) < 0.05
+    assert (n[bottom, 2] < 0).all()
+    assert np.allclose(np.linalg.norm(m.meridian, axis=1), 1.0)
+    assert np.allclose(np.einsum("ij,ij->i", m.meridian, m.circumferential), 0.0, atol=1e-9)
+
+
+def test_rig_mesh_sector_cut_faces(test_mesh):
+    m = test_mesh
+    p = m.params
+    ang = np.degrees(np.arctan2(m.nodes[:, 0], p.axle_z - m.nodes[:, 2]))
+    assert abs(ang).max() == pytest.approx(p.sector_deg)
+    cut = set(m.cut_nodes.tolist())
+    assert cut == set(np.flatnonzero(np.isclose(abs(ang), p.sector_deg)).tolist())
+    # both cut faces, the whole section on each
+    assert (ang[m.cut_nodes] > 0).sum() == (ang[m.cut_nodes] < 0).sum()
+
+
+def test_unknown_mesh_kind():
+    pytest.importorskip("gmsh")
+    from scripts.tiremodel.aircraft_rig_mesh import build_rig_mesh
+
+    with pytest.raises(ValueError, match="unknown aircraft rig mesh 'huge'"):
+        build_rig_mesh("huge")
+
+
+def test_base_deck_has_the_rig_and_the_aircraft_materials(test_mesh, tmp_path):
+    from scripts.tiremodel import rig_deck as rd
+    from scripts.tiremodel.aircraft_rig_deck import AIRCRAFT
+
+    nodes = rd.write_base_deck(tmp_path / "base.inp", test_mesh, 0.12, (0.0, 0.0), AIRCRAFT)
+    text = (tmp_path / "base.inp").read_text()
+    assert "*RIGID BODY, NSET=ROADN" in text and "*RESTART, WRITE" in text
+    assert "SYMN" not in text  # no symmetry plane
+    assert text.count("*CONTROLS, PARAMETERS=FIELD") == 2  # both steps
+    assert "*HYPERELASTIC, NEO HOOKE" in text and "ORIENTATION=OR" in text
+    assert "1.380000e+06" in text  # the inflation pressure
+    # one equation per cut node (bead nodes excluded), each against its own CUTREF node
+    n_eq = len(set(test_mesh.cut_nodes.tolist()) - set(test_mesh.bead_nodes.tolist()))
+    eqs = text.split("*EQUATION")[1].split("*")[0].strip().splitlines()
+    assert len(eqs) == 2 * n_eq
+    assert nodes.ref == test_mesh.nodes.shape[0] + AIRCRAFT.road().nodes.shape[0] + 1
+    kin = rd.kinematics(90.0, 0.0, 1, AIRCRAFT)
+    assert (kin.vx, kin.vy, kin.wz) == (0.0, AIRCRAFT.slide_path, 0.0)
+    rd.write_slide_deck(tmp_path / "run.inp", test_mesh, kin, 0.12, (0.0, 0.0), 0.25, AIRCRAFT)
+    slide = (tmp_path / "run.inp").read_text()
+    assert slide.startswith("*RESTART, READ, STEP=2") and slide.count("*STEP") == 4
+
+
+# ---------------------------------------------------------------- the driver's resume rule
+
+
+def _fake_files(name: str, sha: str) -> dict[str, bytes]:
+    side = {
+        "case": name,
+        "deck_sha256": sha,
+        "reaction": {"force": [1.0, 2.0, 3.0]},
+        "history": {"Mz": [4.0]},
+        "runtime_s": 1.0,
+    }
+    return {f"{name}.vtu": b"vtu", f"{name}.dat.txt": b"dat", f"{name}.json": json.dumps(side).encode()}
+
+
+class _FakeSolver:
+    """Stands in for the Dask cluster: records what is submitted, 'solves' in order."""
+
+    def __init__(self, shas, fail=()):
+        self.shas, self.fail, self.submitted = shas, set(fail), []
+
+    def submit(self, spec):
+        self.submitted.append(spec.name)
+        return spec
+
+    def completed(self, handles):
+        for spec in handles:
+            if spec.name in self.fail:
+                yield spec, RuntimeError("did not converge")
+            else:
+                yield spec, _fake_files(spec.name, self.shas[spec.name])
+
+
+def _specs():
+    from scripts.tiremodel.aircraft_rig_programme import programme
+
+    specs = programme()[:4]
+    return specs, {s.name: hashlib.sha256(s.name.encode()).hexdigest() for s in specs}
+
+
+def test_driver_skips_finished_runs_and_redoes_half_written_ones(tmp_path):
+    from scripts.tiremodel.aircraft_rig_programme import drive, is_done, save_files
+
+    specs, shas = _specs()
+    a, b, c, d = (s.name for s in specs)
+    save_files(tmp_path, _fake_files(a, shas[a]))  # finished
+    files = _fake_files(b, shas[b])  # half-written: the sidecar never came
+    save_files(tmp_path, {k: v for k, v in files.items() if not k.endswith(".json")})
+    save_files(tmp_path, _fake_files(c, "an older deck"))  # finished, but with another deck
+    fake = _FakeSolver(shas)
+    logs: list[str] = []
+    done = drive(specs, shas, tmp_path, fake.submit, fake.completed, logs.append)
+    assert fake.submitted == [b, c, d]  # in the programme's order, the finished one skipped
+    assert sorted(done) == sorted([b, c, d])
+    assert all(is_done(tmp_path, s.name, shas[s.name]) for s in specs)
+    assert logs[0].startswith("1 of 4 runs already finished") and logs[-1].startswith("[4/4]")
+    assert not list(tmp_path.glob("*.part"))
+    # a second pass has nothing to do
+    again = _FakeSolver(shas)
+    assert drive(specs, shas, tmp_path, again.submit, again.completed, logs.append) == {}
+    assert again.submitted == []
+
+
+def test_driver_keeps_going_after_a_failed_run_and_reports_it(tmp_path):
+    from scripts.tiremodel.aircraft_rig_programme import drive, is_done
+
+    specs, shas = _specs()
+    fake = _FakeSolver(shas, fail={specs[1].name})
+    logs: list[str] = []
+    with pytest.raises(RuntimeError, match=f"1 run\\(s\\) failed: {specs[1].name}"):
+        drive(specs, shas, tmp_path, fake.submit, fake.completed, logs.append)
+    assert not is_done(tmp_path, specs[1].name, shas[specs[1].name])
+    assert all(is_done(tmp_path, s.name, shas[s.name]) for s in specs if s is not specs[1])
+    assert any("FAILED" in line for line in logs)
+
+
+def test_programme_order_and_content():
+    from scripts.tiremodel.aircraft_rig_programme import programme
+
+    specs = programme()
+    names = [s.name for s in specs]
+    assert len(names) == len(set(names)) >= 16
+    # pure spin and one pure slide per direction come first
+    assert names[:4] == ["spin_p", "d000_slide", "d045_slide", "d090_slide"]
+    assert {"spin_n", "d045_a40p", "d045_a40n"} <= set(names)
+    # the mirror images (negative spin along the axes) come after every other run
+    first_mirror = names.index("spin_n")
+    assert all(s.sign > 0 or s.direction == 45.0 for s in specs[:first_mirror])
+
+
+# ---------------------------------------------------------------- the committed runs
+
+
+@needs_static
+def test_static_patch_has_enough_loaded_nodes_over_the_full_width():
+    import meshio
+
+    m = meshio.read(RIG / "static.vtu")
+    cp = m.point_data["CPRESS"]
+    loaded = m.points[cp > 0]
+    assert loaded.shape[0] >= 150
+    assert loaded[:, 1].min() < -0.1 and loaded[:, 1].max() > 0.1  # full model: both sides
+    side = json.loads((RIG / "static.json").read_text())
+    assert side["mesh"]["full_section"] is True
+    assert side["reaction_z"] == pytest.approx(side["cpress_integral"], rel=2e-3)
+
+
+def _dat_force(run: Path) -> np.ndarray:
+    m = _DAT.findall(run.with_suffix(".dat.txt").read_text())
+    assert m, f"no REFN force record in {run.with_suffix('.dat.txt').name}"
+    return np.array([float(v) for v in m[-1]])
+
+
+@needs_runs
+def test_reactions_are_the_solver_printed_ones():
+    for run, r in zip(RUNS, rig_table(RUNS, shear=False).runs, strict=True):
+        f = _dat_force(run)
+        fn = FRICTION * r.reaction.N
+        assert math.hypot(r.reaction.Fx, r.reaction.Fy) == pytest.approx(
+            math.hypot(f[0], f[1]), abs=1e-2 * fn
+        )
+        assert r.reaction.N == pytest.approx(f[2], abs=1e-2 * fn)
+
+
+@needs_runs
+def test_no_run_exceeds_the_coulomb_bound():
+    for r in rig_table(RUNS, shear=False).runs:
+        assert math.hypot(r.reaction.Fx, r.reaction.Fy) <= FRICTION * r.reaction.N * (1 + 2e-3), r.source
+
+
+@needs_runs
+def test_pure_sliding_reaches_the_coulomb_limit_against_the_velocity():
+    slides = [r for r in rig_table(RUNS, shear=False).runs if r.wz == 0.0]
+    if not slides:
+        pytest.skip("no pure-sliding run in meshes/rig-aircraft/ yet")
+    for r in slides:
+        f = math.hypot(r.reaction.Fx, r.reaction.Fy)
+        assert f == pytest.approx(FRICTION * r.reaction.N, rel=5e-3), r.source
+        cos = (r.reaction.Fx * r.vx + r.reaction.Fy * r.vy) / (f * math.hypot(r.vx, r.vy))
+        assert cos < -0.999, r.source
+
+
+@needs_runs
+def test_shear_integral_agrees_with_the_reactions():
+    for r in rig_table(RUNS).runs:
+        fn = FRICTION * r.reaction.N
+        assert r.shear is not None
+        assert math.hypot(r.reaction.Fx - r.shear.Fx, r.reaction.Fy - r.shear.Fy) < 1e-2 * fn, r.source
+        assert abs(r.reaction.N - r.shear.N) < 1e-2 * r.reaction.N, r.source
