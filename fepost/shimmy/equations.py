@@ -1,0 +1,122 @@
+"""Equations of motion of the landing gear with dry-friction contact (docs/shimmy.md).
+
+Frame: the ground, X along the aircraft's forward speed V, Y lateral, Z up. The
+strut's lower end moves at (V, ẏ): y is the lateral bending deflection of the
+strut at the axle (modal mass m_y, stiffness k_y, damping c_y). The wheel
+assembly turns about the (vertical) strut axis by ψ (inertia I_ψ, torque-link
+stiffness k_ψ, damping c_ψ). Wheel j's contact centre sits at r_j = (−e, d_j) in
+the gear frame (trail e behind the axis, lateral offset d_j). The wheel rolls
+at Ω with Ω r = (1 − κ) V: the longitudinal slip κ is held (the touchdown
+spin-up frozen on the time scale of shimmy, or a brake holding a slip).
+
+Sliding velocity and spin of contact j in its patch frame (x along the wheel):
+
+    vx_j = V cos ψ + ẏ sin ψ − ψ̇ d_j − (1 − κ) V
+    vy_j = −V sin ψ + ẏ cos ψ − ψ̇ e
+    wz_j = ψ̇
+
+and the friction model gives (Fx_j, Fy_j, Mz_j) on tire j. The motion:
+
+    I_ψ ψ̈ = −k_ψ ψ − c_ψ ψ̇ + Σ_j (−e Fy_j − d_j Fx_j + Mz_j)
+    m_y ÿ = −k_y y − c_y ẏ + Σ_j (Fx_j sin ψ + Fy_j cos ψ)
+
+No tire elasticity and no non-holonomic rolling constraint: the tire slides
+(Klimov and Zhuravlev's rigid wheel with multi-component dry friction). State
+x = (ψ, ψ̇, y, ẏ). The steady motion is straight rolling with longitudinal
+sliding κV: ψ̇ = ẏ = 0 and (ψ, y) at the equilibrium `equilibrium` finds
+(zero for a map symmetric about x; a rolling map's small asymmetry moves it).
+Since the friction forces depend only on the direction of (v, R wz), the
+equilibrium does not depend on V.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import ArgumentError
+from .gear import Gear
+
+#: State components, in order.
+STATE = ("psi", "psi_dot", "y", "y_dot")
+
+
+def kinematics(x, V: float, gear: Gear):
+    """(vx, vy, wz) of each wheel's contact (arrays over the wheels; complex x allowed)."""
+    psi, dpsi, _, dy = x
+    c, s = np.cos(psi), np.sin(psi)
+    d = np.asarray(gear.offsets)
+    vx = V * c + dy * s - dpsi * d - (1.0 - gear.slip_ratio) * V
+    vy = (-V * s + dy * c - dpsi * gear.trail) * np.ones_like(d)
+    wz = dpsi * np.ones_like(d)
+    return vx, vy, wz
+
+
+def loads(x, forces, gear: Gear):
+    """(yaw moment about the strut axis, lateral force on the strut) from the wheels' forces."""
+    psi = x[0]
+    fx, fy, mz = (np.asarray(f) for f in forces)
+    d = np.asarray(gear.offsets)
+    moment = np.sum(-gear.trail * fy - d * fx + mz)
+    lateral = np.sum(fx * np.sin(psi) + fy * np.cos(psi))
+    return moment, lateral
+
+
+def rhs(x, V: float, gear: Gear, contact):
+    """dx/dt for the state ``x`` at speed ``V`` with ``contact(vx, vy, wz) -> (Fx, Fy, Mz)``."""
+    psi, dpsi, y, dy = x
+    moment, lateral = loads(x, contact(*kinematics(x, V, gear)), gear)
+    ddpsi = (-gear.torsional_stiffness * psi - gear.torsional_damping * dpsi + moment) / gear.yaw_inertia
+    ddy = (-gear.lateral_stiffness * y - gear.lateral_damping * dy + lateral) / gear.lateral_mass
+    return np.array([dpsi, ddpsi, dy, ddy])
+
+
+def equilibrium(gear: Gear, contact, V: float = 1.0) -> np.ndarray:
+    """The steady motion's state (ψ, 0, y, 0) (independent of V, module docstring)."""
+    from scipy.optimize import root
+
+    def residual(q):
+        return rhs(np.array([q[0], 0.0, q[1], 0.0]), V, gear, contact)[[1, 3]]
+
+    sol = root(residual, np.zeros(2), method="hybr", options={"xtol": 1e-13})
+    if not sol.success or np.max(np.abs(sol.x)) > 0.2:
+        raise ArgumentError(
+            f"no steady rolling state found for this gear and contact ({sol.message}; "
+            f"psi = {sol.x[0]:.3g} rad, y = {sol.x[1]:.3g} m): the torsional or lateral stiffness "
+            "is too small to hold the contact's asymmetry"
+        )
+    return np.array([sol.x[0], 0.0, sol.x[1], 0.0])
+
+
+def scalar_rhs(gear: Gear, V: float, one):
+    """`rhs` as a function ``f(t, x)`` of plain Python floats for the time integration.
+
+    ``one(vx, vy, wz) -> (Fx, Fy, Mz)`` is a contact's one-point evaluation
+    (`fepost.shimmy.contact.Contact.scalar`); the result equals `rhs` (tested).
+    """
+    e, kap = gear.trail, gear.slip_ratio
+    i_psi, k_psi, c_psi = gear.yaw_inertia, gear.torsional_stiffness, gear.torsional_damping
+    m_y, k_y, c_y = gear.lateral_mass, gear.lateral_stiffness, gear.lateral_damping
+    offsets = gear.offsets
+    slip = (1.0 - kap) * V
+    cos, sin = math.cos, math.sin
+
+    def f(t, x):
+        psi, dpsi, y, dy = x
+        c, s = cos(psi), sin(psi)
+        bx = V * c + dy * s - slip
+        by = -V * s + dy * c - dpsi * e
+        moment = lateral = 0.0
+        for d in offsets:
+            fx, fy, mz = one(bx - dpsi * d, by, dpsi)
+            moment += -e * fy - d * fx + mz
+            lateral += fx * s + fy * c
+        return [
+            dpsi,
+            (-k_psi * psi - c_psi * dpsi + moment) / i_psi,
+            dy,
+            (-k_y * y - c_y * dy + lateral) / m_y,
+        ]
+
+    return f

@@ -1,0 +1,113 @@
+"""Nonlinear time simulation of the gear from a small perturbation (scipy's solve_ivp).
+
+The motion starts at the steady state with the yaw angle perturbed by
+``perturbation`` (rad) and is integrated for ``duration`` seconds (Dormand–Prince
+8(5,3), rtol 1e-7) on `fepost.shimmy.equations.scalar_rhs`. The contact is the
+friction model's one-point evaluation (`fepost.shimmy.contact.Contact.scalar`):
+the closed forms themselves, or for the map-based models their
+`fepost.shimmy.table.DirectionTable` (the same model tabulated over the sphere
+of directions, so the integration does not repeat the map's integrals).
+
+Verdict, from the yaw deviation |ψ − ψ_eq| over the windows [0.6, 0.8] T (A_mid)
+and [0.8, 1] T (A_end) of the duration T, with A_0 the perturbation:
+
+* ``decays``: A_end < A_0 and A_end <= A_mid (the perturbation dies away);
+* ``grows``: otherwise, A_end > (1 + `SETTLED`) A_mid (still growing at the end);
+* ``limit_cycle``: otherwise (settled on an oscillation of amplitude A_end, rad).
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ArgumentError
+from .equations import STATE, scalar_rhs
+from .gear import Gear
+
+#: Relative change of the amplitude between the last two windows read as "settled".
+SETTLED = 0.05
+#: Default perturbation of the yaw angle (rad) and duration (s); output sampling (Hz).
+PERTURBATION, DURATION, SAMPLING = 1e-3, 10.0, 1000.0
+VERDICTS = ("decays", "grows", "limit_cycle")
+
+
+@dataclass(frozen=True)
+class TimeHistory:
+    """A simulated motion: times (s), the states (rows of ψ, ψ̇, y, ẏ), the verdict."""
+
+    speed: float
+    friction_model: str
+    t: np.ndarray
+    x: np.ndarray
+    equilibrium: np.ndarray
+    perturbation: float
+    verdict: str
+    amplitude: float | None
+    final_amplitude: float
+
+    def to_csv(self) -> str:
+        buf = io.StringIO()
+        buf.write("t," + ",".join(STATE) + "\n")
+        np.savetxt(buf, np.column_stack([self.t, self.x.T]), delimiter=",", fmt="%.9g")
+        return buf.getvalue()
+
+
+def verdict_of(t: np.ndarray, dev: np.ndarray, a0: float) -> tuple[str, float | None, float]:
+    """(verdict, limit-cycle amplitude or None, final amplitude) of a deviation history (module docstring)."""
+    T = t[-1]
+    a_mid = float(np.max(dev[(t >= 0.6 * T) & (t < 0.8 * T)]))
+    a_end = float(np.max(dev[t >= 0.8 * T]))
+    if a_end < a0 and a_end <= a_mid:
+        return "decays", None, a_end
+    if a_end > (1 + SETTLED) * a_mid:
+        return "grows", None, a_end
+    return "limit_cycle", a_end, a_end
+
+
+def simulate(
+    gear: Gear,
+    contact,
+    speed: float,
+    *,
+    equilibrium: np.ndarray,
+    name: str = "",
+    perturbation: float = PERTURBATION,
+    duration: float = DURATION,
+    sampling: float = SAMPLING,
+) -> TimeHistory:
+    """Integrate the motion at ``speed`` (m/s) from the steady state plus a yaw ``perturbation``.
+
+    ``contact``: a `fepost.shimmy.contact.Contact` with a one-point ``scalar``
+    evaluation (the closed forms, or a `fepost.shimmy.table.DirectionTable`'s contact).
+    """
+    from scipy.integrate import solve_ivp
+
+    if not (speed > 0 and duration > 0 and perturbation > 0 and sampling > 0):
+        raise ArgumentError("speed, duration, perturbation and sampling must be positive")
+    if getattr(contact, "scalar", None) is None:
+        raise ArgumentError(
+            f"contact {getattr(contact, 'name', contact)!r} has no one-point evaluation: tabulate it "
+            "(fepost.shimmy.table.DirectionTable)"
+        )
+    x0 = np.array(equilibrium, float)
+    x0[0] += perturbation
+    t_eval = np.linspace(0.0, duration, int(round(duration * sampling)) + 1)
+    sol = solve_ivp(
+        scalar_rhs(gear, speed, contact.scalar),
+        (0.0, duration),
+        x0,
+        method="DOP853",
+        t_eval=t_eval,
+        rtol=1e-7,
+        atol=1e-10,
+    )
+    if sol.status != 0:
+        raise ArgumentError(f"the time integration at {speed:g} m/s failed: {sol.message}")
+    dev = np.abs(sol.y[0] - equilibrium[0])
+    verdict, amplitude, final = verdict_of(sol.t, dev, perturbation)
+    return TimeHistory(
+        speed, name, sol.t, sol.y, np.array(equilibrium), perturbation, verdict, amplitude, final
+    )
