@@ -1,0 +1,162 @@
+"""The commands README.md and docs/ show with their output print that output.
+
+Each page's marked blocks run once, in order, in one scratch folder (``page_run``); every
+checked block is then compared with what its commands printed (`tests.docexamples`, where
+the markers, the options and the tolerances are explained). After a change of output, run
+``python -m tests.docexamples --update`` and review the diff of the pages.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from tests import docexamples as dx
+
+CHECKED = [
+    (page, b.name) for page in dx.pages_with_examples() for b in dx.blocks(page) if b.kind == "checked"
+]
+
+
+@pytest.fixture(scope="module")
+def page_run(tmp_path_factory):
+    """page -> its `PageRun`, each page run the first time one of its blocks is checked."""
+    runs: dict[str, dx.PageRun] = {}
+
+    def get(page: str) -> dx.PageRun:
+        if page not in runs:
+            runs[page] = dx.run_page(page, tmp_path_factory.mktemp(page.replace("/", "_")))
+        return runs[page]
+
+    return get
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("page", "name"), CHECKED, ids=[name for _, name in CHECKED])
+def test_documented_output_is_what_the_command_prints(page, name, page_run):
+    block = next(b for b in dx.blocks(page) if b.name == name)
+    problems = dx.check_block(block, page_run(page))
+    assert not problems, "\n".join(problems) + "\n(regenerate: python -m tests.docexamples --update)"
+
+
+def test_every_command_shown_with_output_is_checked():
+    """A ``$`` line followed by output lines, in any fenced block of the README or docs/, is
+    in a block marked ``checked``."""
+    unchecked = []
+    for page in dx.pages():
+        lines = (dx.REPO / page).read_text(encoding="utf-8").splitlines()
+        marked = {b.start for b in dx.blocks(page) if b.kind == "checked"}
+        start = None
+        for i, text in enumerate(lines):
+            if text.startswith("```"):
+                start = i + 1 if start is None else None
+                continue
+            if start is not None and text.startswith("$ ") and start not in marked:
+                following = lines[i + 1] if i + 1 < len(lines) else "```"
+                if not following.startswith(("```", "$ ")):
+                    unchecked.append(f"{page}:{i + 1}: {text}")
+    assert not unchecked, "\n".join(unchecked)
+    assert len(CHECKED) >= 6  # the tutorial's, diagnose's, rig's and the README's
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page", dx.pages_with_examples())
+def test_the_documented_commands_write_only_into_an_ignored_folder(page, page_run):
+    """Run from the clone's root, a page's examples leave nothing untracked there: all they
+    write is under out/, which .gitignore lists."""
+    folder = page_run(page).folder
+    made = sorted(p.name for p in folder.iterdir() if not p.is_symlink())
+    assert made in ([], ["out"]), made
+    assert "/out/" in (dx.REPO / ".gitignore").read_text(encoding="utf-8").splitlines()
+
+
+# ---------------------------------------------------------------- the comparison itself
+PAGE = """Intro.
+
+<!-- doc-example: checked rtol=1e-3 until="held" -->
+```console
+$ fepost diagnose x
+cause: friction_level
+  f = 0.269724  (95 % CI 0.268577 .. 0.270872)
+held-out RMSE: before 0.0542, after 0.02353; delta BIC -1014.4
+...
+```
+
+<!-- doc-example: setup -->
+```python
+print("made")
+```
+"""
+OUTPUT = (
+    "cause: friction_level\n  f = 0.269724  (95 % CI 0.268577 .. 0.270872)\n"
+    "held-out RMSE: before 0.0542, after 0.02353; delta BIC -1014.4\nlack of fit: none\n"
+)
+
+
+def _check(output: str, page: str = PAGE) -> list[str]:
+    block = dx.blocks("x.md", page)[0]
+    return dx.differences(list(block.commands()[0].expected), output, block.options, block.rtol, block.width)
+
+
+def test_the_blocks_of_a_page_are_found_with_their_options():
+    checked, setup = dx.blocks("x.md", PAGE)
+    assert (checked.kind, checked.lang, checked.rtol, checked.options["until"]) == (
+        "checked",
+        "console",
+        1e-3,
+        "held",
+    )
+    assert [c.line for c in checked.commands()] == ["fepost diagnose x"]
+    assert (setup.kind, setup.lang, setup.body) == ("setup", "python", ('print("made")',))
+
+
+def test_the_same_output_agrees_and_a_changed_number_or_word_does_not():
+    assert _check(OUTPUT) == []
+    # within rtol 1e-3 (plus the print's rounding): agrees
+    assert _check(OUTPUT.replace("0.269724", "0.269800")) == []
+    assert _check(OUTPUT.replace("-1014.4", "-1014.9")) == []
+    # beyond it: the line is named
+    (problem,) = _check(OUTPUT.replace("0.269724", "0.271"))
+    assert problem.startswith("line 2:") and "0.271" in problem
+    assert _check(OUTPUT.replace("-1014.4", "-1016.5"))
+    assert _check(OUTPUT.replace("friction_level", "pressure_shift"))
+    # a line more before the cut, or the cut gone
+    assert _check(OUTPUT.replace("cause: friction_level\n", "cause: friction_level\n  new line\n"))
+    assert _check(OUTPUT.replace("lack of fit: none\n", ""))
+
+
+def test_without_a_tolerance_the_text_must_be_exact():
+    page = PAGE.replace("rtol=1e-3 ", "")
+    assert _check(OUTPUT, page) == []
+    assert _check(OUTPUT.replace("0.269724", "0.269725"), page)
+
+
+def test_integers_get_no_rounding_allowance():
+    assert dx.numbers_agree("0.0445", "0.045", 0.0) is False
+    assert dx.numbers_agree("0.044", "0.045", 1e-3)  # a value on a rounding edge prints either way
+    assert not dx.numbers_agree("82", "83", 1e-3)  # row numbers are not rounded values
+    assert dx.numbers_agree("1e-18", "1.0000001e-18", 1e-3)
+
+
+def test_keep_and_width_shape_the_shown_lines():
+    out = "a 1\nb 2\nc 3\nd " + "x " * 80 + "\ne 5\n"
+    shown = [t for t, _ in dx.render(out, {"keep": "^(a|d|e)"}, width=40)]
+    assert shown[0] == "a 1" and shown[1] == "..." and shown[3] == "e 5"
+    assert shown[2].endswith(" ...") and len(shown[2]) <= 40
+    # a cut line states a prefix of the full line: its numbers and words are still compared
+    assert dx.line_agrees("d x x ...", "d x x x x", 0.0)
+    assert not dx.line_agrees("d y x ...", "d x x x x", 0.0)
+    assert dx.line_agrees("f = 0.3 and ...", "f = 0.3 and more", 0.0)
+    assert not dx.line_agrees("f = 0.4 and ...", "f = 0.3 and more", 0.0)
+
+
+def test_update_rewrites_only_the_output_lines(tmp_path):
+    block = dx.blocks("x.md", PAGE)[0]
+    new = OUTPUT.replace("0.269724", "0.2801")
+    run = dx.PageRun(tmp_path, {block.name: [new], dx.blocks("x.md", PAGE)[1].name: ["made\n"]})
+    text = dx.updated_page("x.md", run, PAGE)
+    assert text == PAGE.replace("0.269724", "0.2801")
+    # and the rewritten page agrees with the run
+    assert (
+        dx.differences(list(dx.blocks("x.md", text)[0].commands()[0].expected), new, block.options, 1e-3, 110)
+        == []
+    )
