@@ -1,7 +1,10 @@
 # fepost: `make demo` runs the main job on the sample meshes, `make test` runs the tests.
 # Both create their own virtual environment (.venv) and install what they need, saying
 # what they do: the demo only the package and the GL libraries VTK renders with; the
-# tests also the test, model and docs extras, CalculiX and Chromium.
+# tests also the test, model and docs extras, CalculiX and Chromium. Missing Debian
+# packages are listed first with every package apt will install or upgrade for them
+# (a simulated `apt-get -s install`), and Chromium's side effect is said before it
+# happens: it registers itself as the system's default web browser.
 
 PYTHON ?= python3
 VENV   := .venv
@@ -43,9 +46,15 @@ define apt_install
 	fi; \
 	missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -z "$$missing" ]; then echo "== system packages present: $(1)"; exit 0; fi; \
-	echo "== installing system packages:$$missing"; \
 	if [ "$$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi; \
-	$$SUDO apt-get update -q && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -q --no-install-recommends $$missing
+	$$SUDO apt-get update -q || exit 1; \
+	echo "== missing system packages:$$missing; apt will install or upgrade (a simulated run, apt-get -s):"; \
+	apt-get -s install --no-install-recommends $$missing | sed -n \
+	  -e 's/^Inst \([^ ]*\) \[\([^]]*\)\] (\([^ ]*\).*/     \1 \2 -> \3 (upgrade)/p' \
+	  -e 's/^Inst \([^ ]*\) (\([^ ]*\).*/     \1 \2 (new)/p'; \
+	case " $$missing " in *" chromium "*) echo "== note: the chromium package registers itself as the system's default web browser (x-www-browser, gnome-www-browser; undo with update-alternatives --config x-www-browser)";; esac; \
+	echo "== installing them"; \
+	DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -q --no-install-recommends $$missing
 endef
 
 system-deps-demo:
