@@ -1,0 +1,181 @@
+"""The whole shimmy study on FE maps: `shimmy_study`.
+
+For each friction model asked for (``closed_forms``, ``generalised``, ``exact``,
+`fepost.shimmy.contact`) built from an `fepost.analysis.Analysis` (the rolling
+map and k_x when the analysis has one, else the static map and k_x = 0), it
+linearises the gear about the steady rolling with sliding, sweeps the speeds
+(`fepost.shimmy.linear.stability_map`), carries the coefficients' 95 % intervals
+to the critical speed (`critical_interval`), and simulates the nonlinear motion
+below and above each critical speed (`fepost.shimmy.simulate`); it adds the
+outside anchor (`fepost.shimmy.anchor`).
+
+Intervals (`critical_interval`), from the paper's identification experiment run on
+the same maps (`fepost.table1.table1`, the default seed and noise):
+
+* closed forms: the delta method, V_c ± t·√(gᵀ Σ g), with Σ the fit's covariance of
+  (F0, M0, a, m, k_x) and g = ∂V_c/∂(F0, M0, a, m, k_x) by central differences;
+* generalised and exact: those models have no F0 … k_x to perturb; the one
+  identified quantity that maps onto them unchanged is the friction level f (every
+  force and torque is proportional to f), so V_c is recomputed with the forces
+  scaled to the ends of f's interval.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..errors import ArgumentError
+from .contact import MODEL_NAMES, Contact, closed_forms_contact, exact_contact, model_contact
+from .gear import Gear
+from .linear import Linearisation, stability_map
+from .result import ModelStability, ShimmyResult, Simulation
+from .simulate import DURATION, simulate
+from .table import DirectionTable
+
+#: Default speed sweep (m/s): 200 speeds.
+DEFAULT_SPEEDS = (1.0, 150.0, 200)
+#: Speeds of the time simulations, as fractions of each critical speed.
+SIMULATION_FRACTIONS = (0.8, 1.2)
+
+
+def contacts(analysis, names: Sequence[str] = MODEL_NAMES) -> dict[str, Contact]:
+    """The friction models of ``analysis`` as contacts (module docstring)."""
+    from ..friction.law import FrictionLaw
+    from ..friction.quadrature import PressureQuadrature
+
+    unknown = [n for n in names if n not in MODEL_NAMES]
+    if unknown:
+        raise ArgumentError(f"friction model must be one of {', '.join(MODEL_NAMES)}, got {unknown[0]!r}")
+    c = analysis.coefficients
+    rolling = analysis.rolling_map is not None
+    out: dict[str, Contact] = {}
+    for name in names:
+        if name == "closed_forms":
+            k_x = float(c.k_x) if c.k_x is not None else 0.0
+            out[name] = closed_forms_contact(F0=c.F0, M0=c.M0, a=c.a, m=c.m, k_x=k_x, R=c.R)
+        elif name == "generalised":
+            summary = analysis.model_summary
+            out[name] = model_contact(summary.rolling if rolling else summary.static)
+        else:
+            pmap = analysis.rolling_map if rolling else analysis.static_map
+            out[name] = exact_contact(PressureQuadrature.from_polar(pmap), FrictionLaw(f=c.f), c.R)
+    return out
+
+
+def _lowest_critical(gear: Gear, contact: Contact, speeds: np.ndarray) -> float | None:
+    return stability_map(Linearisation.of(gear, contact), speeds).critical_speed
+
+
+def critical_interval(gear: Gear, contact: Contact, vc: float, speeds: np.ndarray, table1) -> tuple:
+    """(lo, hi) of the critical speed from Table 1's intervals, and the method (module docstring)."""
+    fit = table1.identification
+    if contact.name == "closed_forms":
+        info = contact.info
+        names = ("F0", "M0", "a", "m", "k_x")
+        theta = np.array([info[n] for n in names], float)
+        cov = np.asarray(fit.covariance, float)
+        grad = np.zeros(5)
+        window = np.linspace(0.5 * vc, 1.5 * vc, 41)
+        for i in range(5):
+            h = 0.05 * float(np.sqrt(cov[i, i]))
+            ends = []
+            for sign in (1.0, -1.0):
+                t = theta.copy()
+                t[i] += sign * h
+                v = _lowest_critical(gear, closed_forms_contact(**dict(zip(names, t)), R=info["R"]), window)
+                if v is None:
+                    return None, "delta method: the critical speed left the window under a perturbation"
+                ends.append(v)
+            grad[i] = (ends[0] - ends[1]) / (2 * h)
+        sd = float(np.sqrt(grad @ cov @ grad))
+        half = fit.t_quantile * sd
+        return (vc - half, vc + half), "delta method on Table 1's covariance of F0, M0, a, m, k_x"
+    row = next(r for r in table1.rows if r.name == "f")
+    ends = []
+    for f_end in row.ci95:
+        v = _lowest_critical(gear, contact.scaled(f_end / row.fitted), speeds)
+        if v is None:
+            return None, "friction level f at the ends of its interval: no critical speed in the sweep"
+        ends.append(v)
+    return (min(ends), max(ends)), "forces scaled to the ends of Table 1's interval of f"
+
+
+def shimmy_study(
+    analysis,
+    gear: Gear,
+    *,
+    speeds=None,
+    models: Sequence[str] = MODEL_NAMES,
+    intervals: bool = True,
+    simulate_motion: bool = True,
+    duration: float = DURATION,
+    anchor: bool = True,
+) -> ShimmyResult:
+    """Stability of ``gear`` on the tire of ``analysis`` with each friction model (module docstring).
+
+    ``speeds``: the sweep (m/s, increasing; default `DEFAULT_SPEEDS`, 200 speeds
+    from 1 to 150 m/s). ``intervals``: carry Table 1's intervals to the critical
+    speeds. ``simulate_motion``: time histories at 0.8 and 1.2 times each critical
+    speed (at the top speed when there is none), ``duration`` seconds each.
+    """
+    from .anchor import anchor_record
+
+    if not isinstance(gear, Gear):
+        raise ArgumentError(f"gear must be a Gear, got {type(gear).__name__}")
+    speeds = np.linspace(*DEFAULT_SPEEDS) if speeds is None else np.asarray(speeds, float)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    found = contacts(analysis, models)
+    timings["contacts"] = time.perf_counter() - t0
+    t1 = None
+    if intervals:
+        from ..table1 import table1
+
+        t1 = table1(analysis, bias=False, profile=False, generalised=False)
+    results, sims = [], []
+    for name, contact in found.items():
+        t0 = time.perf_counter()
+        lin = Linearisation.of(gear, contact)
+        smap = stability_map(lin, speeds)
+        timings[f"{name}_stability_map"] = time.perf_counter() - t0
+        ci, method = None, "not computed"
+        if t1 is not None and smap.critical_speed is not None:
+            ci, method = critical_interval(gear, contact, smap.critical_speed, speeds, t1)
+        elif smap.critical_speed is None:
+            method = "no critical speed in the sweep"
+        info = {k: float(v) for k, v in contact.info.items() if isinstance(v, int | float)}
+        results.append(ModelStability(name, smap, ci, method, {"F0": contact.F0, "M0": contact.M0, **info}))
+        if simulate_motion:
+            t0 = time.perf_counter()
+            sim_contact = (
+                contact if contact.scalar is not None else DirectionTable.build(contact).as_contact()
+            )
+            timings[f"{name}_table"] = time.perf_counter() - t0
+            vc = smap.critical_speed
+            run_speeds = [f * vc for f in SIMULATION_FRACTIONS] if vc is not None else [float(speeds[-1])]
+            for v in run_speeds:
+                t0 = time.perf_counter()
+                h = simulate(gear, sim_contact, v, equilibrium=lin.state, name=name, duration=duration)
+                timings[f"{name}_simulation_{v:.4g}"] = time.perf_counter() - t0
+                sims.append(Simulation(h, f"time_{name}_{v:.2f}.csv", lin.growth(v)[0]))
+    c = analysis.coefficients
+    source = {
+        "static": str(analysis.static_field.source),
+        "rolling": None if analysis.rolling_field is None else str(analysis.rolling_field.source),
+        "map": "rolling" if analysis.rolling_map is not None else "static (k_x = 0)",
+        "N": c.N,
+        "R": c.R,
+        "f": c.f,
+        "wheel_load_note": "each wheel of the gear carries the FE tire's load N",
+    }
+    return ShimmyResult(
+        gear=gear,
+        models=tuple(results),
+        simulations=tuple(sims),
+        anchor=anchor_record() if anchor else {},
+        source=source,
+        timings=timings,
+    )
