@@ -141,8 +141,10 @@ def test_bad_recordings_are_one_line_errors(recording, tmp_path):
     back = dict(rec)
     back["time"] = rec["time"][::-1].copy()
     bad = write_recording(back, tmp_path / "t.parquet")
-    with pytest.raises(DataError, match=r"row 2, column time: time must increase"):
+    with pytest.raises(DataError, match=r"no steady hold found .*; 47799 clock reset\(s\) cut the recording"):
         find_holds(bad)
+    with pytest.raises(DataError, match=r"row 2, column time: time must increase \(--strict-recording\)"):
+        find_holds(bad, rule=HoldRule(strict=True))
     ramp = {k: np.linspace(0, 1, 500) for k in ("time", "vx", "vy", "wz", "Fx", "Fy", "Mz")}
     with pytest.raises(DataError, match="no steady hold found"):
         find_holds(write_recording(ramp, tmp_path / "ramp.parquet"))

@@ -29,8 +29,10 @@ or a common alias (`ALIASES`, matched without regard to case, e.g.
 rigs record the load as a compressive, often negative, Fz). **Units**: each
 channel is converted to SI with a factor from `UNITS` (``--channel-units
 Fx=kN,wz=deg/s``); TYDEX files state their units, which are used when no unit
-is given. Unknown units, missing channels and non-finite values are one-line
-`fepost.errors.DataError` naming the file and the column.
+is given. Unknown units and missing channels are one-line
+`fepost.errors.DataError` naming the file and the column. Non-finite values
+(empty cells, ``nan``, ``inf``: a channel that dropped out) are passed on as NaN;
+`fepost.diagnose.gaps` finds them and the holds leave them out.
 
 Reading streams `CHUNK_ROWS` rows at a time (Parquet batches, CSV blocks,
 HDF5 slices), so the caller (`fepost.diagnose.holds.find_holds`) holds one
@@ -152,10 +154,12 @@ class Columns:
 
 @dataclass(frozen=True)
 class Chunk:
-    """One block of rows in SI: channel -> array (float64); ``start`` its first row (0-based)."""
+    """One block of rows in SI: channel -> array (float64); ``start`` its first row (0-based);
+    ``names``: channel -> its column in the source (for messages)."""
 
     start: int
     values: dict[str, np.ndarray]
+    names: dict[str, str] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return int(next(iter(self.values.values())).size)
@@ -386,17 +390,20 @@ def read_chunks(path, columns: Columns | None = None) -> Iterator[Chunk]:
             raw = (
                 batch[name] if isinstance(batch, dict) else batch.column(name).to_numpy(zero_copy_only=False)
             )
-            values[ch] = _to_si(np.asarray(raw, float), ch, name, units, info.get(name), source, start)
+            values[ch] = _to_si(np.asarray(raw, float), ch, name, units, info.get(name), source)
         if values and len(next(iter(values.values()))):
-            chunk = Chunk(start, values)
+            chunk = Chunk(start, values, dict(cols))
             start += len(chunk)
             yield chunk
     if start == 0:
         raise DataError(f"{path}: no data rows")
 
 
-def _to_si(raw, ch, name, units, tdx, source, start) -> np.ndarray:
-    """One column in SI: TYDEX conversion, then the unit's factor; absolute value for Fz sources."""
+def _to_si(raw, ch, name, units, tdx, source) -> np.ndarray:
+    """One column in SI: TYDEX conversion, then the unit's factor; absolute value for Fz sources.
+
+    Non-finite values stay non-finite (NaN or ±inf; module docstring).
+    """
     if tdx is not None:
         unit, factor, meas_off, phys_off = tdx
         raw = (raw - meas_off) * factor + phys_off
@@ -406,10 +413,6 @@ def _to_si(raw, ch, name, units, tdx, source, start) -> np.ndarray:
             raise DataError(
                 f"{source}: column {name}: unit {unit!r} of {ch} is not one of {', '.join(UNITS[ch])}"
             )
-    bad = ~np.isfinite(raw)
-    if np.any(bad) and ch != "point":
-        i = int(np.flatnonzero(bad)[0])
-        raise DataError(f"{source}: row {start + i + 1}, column {name}: not a finite number")
     out = raw * UNITS[ch][units.get(ch, next(iter(UNITS[ch])))]
     if ch == "N" and name.lower() in ABSOLUTE:
         out = np.abs(out)
