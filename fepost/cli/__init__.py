@@ -41,6 +41,7 @@ COMMANDS = [
     "predict",
     "sweep",
     "rig",
+    "shimmy",
 ]
 
 #: Exit statuses of ``fepost`` (the ``--help`` epilog and docs/cli-exit-codes.md).

@@ -85,7 +85,9 @@ def critical_interval(gear: Gear, contact: Contact, vc: float, speeds: np.ndarra
             for sign in (1.0, -1.0):
                 t = theta.copy()
                 t[i] += sign * h
-                v = _lowest_critical(gear, closed_forms_contact(**dict(zip(names, t)), R=info["R"]), window)
+                v = _lowest_critical(
+                    gear, closed_forms_contact(**dict(zip(names, t, strict=True)), R=info["R"]), window
+                )
                 if v is None:
                     return None, "delta method: the critical speed left the window under a perturbation"
                 ends.append(v)
