@@ -1,0 +1,121 @@
+"""fepost shimmy: bad gear files refused in one line (exit 2), and the whole command on a sample map."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from fepost.cli import main
+from fepost.shimmy import GearFileError, load_gear
+
+REPO = Path(__file__).resolve().parents[1]
+EXAMPLE = REPO / "examples" / "gear_a320_main.json"
+STATIC = REPO / "meshes" / "aircraft" / "static_100.vtu"
+
+
+def _gear(tmp_path, change=None, drop=None, text=None) -> Path:
+    data = json.loads(EXAMPLE.read_text())
+    if change:
+        data.update(change)
+    if drop:
+        del data[drop]
+    p = tmp_path / "gear.json"
+    p.write_text(text if text is not None else json.dumps(data))
+    return p
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"drop": "lateral_stiffness"}, ["missing key 'lateral_stiffness'"]),
+        ({"change": {"trail": -0.1}}, ["trail must be >= 0", "-0.1"]),
+        ({"change": {"yaw_inertia": 0}}, ["yaw_inertia must be > 0"]),
+        ({"change": {"torsional_stifness": 1e6}}, ["unknown key 'torsional_stifness'"]),
+        ({"change": {"slip_ratio": 1.5}}, ["slip_ratio must be in (0, 1]"]),
+        ({"change": {"lateral_mass": "700"}}, ["lateral_mass must be a number"]),
+        ({"change": {"wheels": 3}}, ["wheels must be 1 or 2"]),
+        ({"text": "{not json"}, ["not JSON (line 1"]),
+        ({"text": "[1, 2]"}, ["must hold a JSON object"]),
+    ],
+)
+def test_bad_gear_file_one_line_exit_2(tmp_path, capsys, kwargs, words):
+    gear = _gear(tmp_path, **kwargs)
+    out = tmp_path / "out"
+    status = main(["shimmy", str(STATIC), "--gear", str(gear), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert err.count("\n") == 1 and err.startswith("fepost: error: "), err
+    assert str(gear) in err
+    for w in words:
+        assert w in err, err
+    assert not out.exists()
+    with pytest.raises(GearFileError):
+        load_gear(gear)
+
+
+def test_missing_gear_file(tmp_path, capsys):
+    missing = tmp_path / "nowhere.json"
+    assert main(["shimmy", str(STATIC), "--gear", str(missing), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err == f"fepost: error: {missing}: gear file not found\n"
+
+
+def test_unknown_friction_model_is_a_usage_error(tmp_path, capsys):
+    status = main(
+        ["shimmy", str(STATIC), "--gear", str(EXAMPLE), "--out", str(tmp_path / "o"), "--models", "hertz"]
+    )
+    assert status == 2
+    assert "--models" in capsys.readouterr().err
+
+
+def test_example_gear_file_cites_every_parameter():
+    from fepost.shimmy.gear import PARAMETERS
+
+    g = load_gear(EXAMPLE)
+    assert set(g.sources) == set(PARAMETERS)
+
+
+def test_shimmy_end_to_end_writes_the_contract(tmp_path, capsys):
+    if not STATIC.is_file():
+        pytest.skip(f"{STATIC} not shipped")
+    out = tmp_path / "shimmy"
+    status = main(
+        [
+            "shimmy",
+            str(STATIC),
+            "--gear",
+            str(EXAMPLE),
+            "--out",
+            str(out),
+            "--models",
+            "closed_forms,generalised",
+            "--speeds",
+            "60",
+            "--duration",
+            "3",
+        ]
+    )
+    assert status == 0, capsys.readouterr().err
+    data = json.loads((out / "shimmy.json").read_text())
+    assert {"gear", "model", "friction_models", "simulations", "anchor"} <= set(data)
+    assert set(data["friction_models"]) == {"closed_forms", "generalised"}
+    for name, fm in data["friction_models"].items():
+        assert {"critical_speed", "critical_speed_ci95", "frequency_hz", "stability"} <= set(fm), name
+        assert len(fm["stability"]) == 60
+        assert set(fm["stability"][0]) == {"speed", "growth_rate", "frequency_hz"}
+    for row in data["simulations"]:
+        assert {"speed", "friction_model", "csv", "verdict", "amplitude"} <= set(row)
+        assert row["verdict"] in ("decays", "grows", "limit_cycle")
+        assert (out / row["csv"]).is_file()
+        assert row["agrees_with_linear"]
+    assert set(data["anchor"]) == {"reference", "published", "computed"}
+    assert data["gear"]["trail"] == {"value": 0.1, "unit": "m"}
+    for fig in (
+        "stability_map.png",
+        "eigenvalue_paths.png",
+        "time_histories.png",
+        "limit_cycle_amplitude.png",
+    ):
+        assert (out / fig).stat().st_size > 1000, fig
