@@ -9,6 +9,18 @@ import numpy as np
 
 from .result import ShimmyResult
 
+#: matplotlib settings of these figures (fepost's figure look: size, grid, no top/right spines).
+STYLE = {
+    "figure.figsize": (7.0, 4.6),
+    "savefig.dpi": 130,
+    "font.size": 10,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "legend.fontsize": 8.5,
+    "legend.frameon": False,
+}
 #: Line colour of each friction model.
 COLOURS = {"closed_forms": "#2ca02c", "generalised": "#c0392b", "exact": "#1f4e99"}
 LABELS = {
@@ -126,10 +138,8 @@ def save_figures(result: ShimmyResult, folder: Path) -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..figures.theme import mpl_style
-
     names = []
-    with mpl_style():
+    with matplotlib.rc_context(STYLE):
         for name, draw in FIGURES.items():
             if name in ("time_histories", "limit_cycle_amplitude") and not result.simulations:
                 continue
