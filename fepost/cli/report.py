@@ -37,6 +37,7 @@ def add_parser(sub) -> None:
         help="replace a non-empty output folder (never one holding the inputs or the current folder)",
     )
     add_friction_option(p)
+    p.add_argument("--gear", metavar="GEAR.json", help="add the landing-gear shimmy section (docs/shimmy.md)")
     p.add_argument(
         "--inflation-pressure",
         type=v.pressure,
@@ -65,6 +66,10 @@ def run(args: argparse.Namespace) -> int:
     from ..report import build_report
     from ..report.samples import meshes_folder, sample_inputs
 
+    if args.gear:
+        from ..shimmy import load_gear
+
+        load_gear(args.gear)  # a bad gear file fails before the report's work
     inputs = [args.static, args.rolling] if args.static is not None else [*sample_inputs()]
     check_replaceable(args.out, [*inputs, meshes_folder()])
     result = build_report(
@@ -76,6 +81,7 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         options=analysis_options(args),
         progress=_progress,
+        gear=args.gear,
     )
     total = sum(t for _, t in result.timings)
     print(f"{result.out / 'report.html'}  ({len(result.files)} files, {total:.1f} s)")

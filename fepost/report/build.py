@@ -161,6 +161,7 @@ def build_report(
     seed: int | None = DEFAULT_SEED,
     progress: Progress | None = None,
     sections: Sequence[SectionProvider] = DEFAULT_SECTIONS,
+    gear: str | Path | None = None,
 ) -> ReportResult:
     """Run the pipeline and write the report folder ``out`` (see `fepost.report`).
 
@@ -189,6 +190,8 @@ def build_report(
     sections : sequence of section providers
         Optional sections (`fepost.report.sections`), default
         `fepost.report.providers.DEFAULT_SECTIONS`.
+    gear : path, optional
+        A landing-gear file: adds the shimmy section (`fepost.report.shimmysection`).
 
     Raises
     ------
@@ -219,7 +222,9 @@ def build_report(
         maps, map_docs = steps.run("error maps (closed forms and generalised model)", _error_maps, a, tmp)
         figs.update(maps)
         vtk_names = steps.run("VTK files of the polar maps and patches", _vtk_files, a, tmp)
-        data = ReportData(a, t, fc, p_star, seed, a.coefficients.f, options=opts)
+        data = ReportData(
+            a, t, fc, p_star, seed, a.coefficients.f, options=opts, gear=None if gear is None else str(gear)
+        )
         extra = steps.run("optional sections", run_providers, sections, data, tmp)
         page = _Page(a, t, fc, map_docs, figs, [*vtk_names, *(f for x in extra for f in x.files)], extra)
         written = steps.run("write HTML, JSON and CSV", _write_page, page, tmp, steps, p_star, p_src, seed)

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 from .rigsection import rig_section
 from .sections import SectionProvider
+from .shimmysection import shimmy_section
 from .sweepsection import sample_sweep_section
 
 #: Providers run by ``fepost report``, in page order.
-DEFAULT_SECTIONS: tuple[SectionProvider, ...] = (sample_sweep_section, rig_section)
+DEFAULT_SECTIONS: tuple[SectionProvider, ...] = (sample_sweep_section, rig_section, shimmy_section)

@@ -48,6 +48,7 @@ class ReportData:
     seed: int | None
     friction: float
     options: AnalysisOptions = field(default_factory=AnalysisOptions)
+    gear: str | None = None
 
 
 @dataclass(frozen=True)
