@@ -23,10 +23,22 @@ with ρ_max(θ) the distance from p0 to the domain boundary along θ:
     ∬ (α x ê_θ,y − y ê_θ,x) dA = α p0_x I_x + p0_y I_y + ∫ (α cos²θ + sin²θ) ρ_max³/3 dθ.
 
 ρ_max is analytic and periodic, so the periodic trapezoid converges spectrally;
-its strip of analyticity narrows like √δ as p0 nears the boundary (δ = 1 − q,
+its strip of analyticity narrows like √δ as p0 nears the boundary (δ = |1 − q|,
 q the ellipse level of p0), and the number of θ nodes grows accordingly
-(`_theta_nodes`). The subtraction is applied only when p0 is inside the
-domain (when it is outside, the integrand is smooth on the patch).
+(`_theta_nodes`).
+
+Centres on and near the boundary
+--------------------------------
+Just outside (1 ≤ q < `OUTSIDE_BAND`) the integrand turns within a node spacing
+of the edge: a uniform disc lost 1.2e-4 of fN there, a jump against the value
+just inside. Such centres are subtracted too, L the constant g at the boundary
+point c + (p0 − c)/q, with ρ_maxⁿ replaced by ρ_outⁿ − ρ_inⁿ over the directions
+[θ_c − Δ, θ_c + Δ] that meet the domain; with θ = θ_c + Δ cos φ the integrand is
+smooth and even in φ (ρ_out − ρ_in ∝ sin φ), so the midpoint rule in φ converges
+spectrally. Near a square-root edge (Hertz) g's gradient grows like δ^(−1/2) and
+its term cost 1.9e-4 of fN at δ = 1e-6: inside, it is scaled by
+min(1, δ/`GRADIENT_TAPER`). The integrals do not depend on L, only the error
+does: below 2e-5 of fN on either side (tests/test_friction_continuity.py).
 """
 
 from __future__ import annotations
@@ -54,6 +66,13 @@ THETA_MAX = 1 << 16
 THETA_DECAY = 25.0
 #: Finite-difference step for ∇(μσ) at the ICR, relative to the larger semi-axis.
 FD_STEP = 1e-4
+#: Centres of rotation outside the domain up to this ellipse level are subtracted too
+#: (with g at the boundary); beyond it the node sums alone are exact to round-off.
+OUTSIDE_BAND = 2.0
+#: Inside, the gradient term of the subtraction is scaled by min(1, (1 − q)/this).
+GRADIENT_TAPER = 0.01
+#: g at the boundary is taken this far (in ellipse level) inside it.
+EDGE_INSET = 1e-9
 
 
 @dataclass(frozen=True)
@@ -104,8 +123,9 @@ def checked_kinematics(vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray, 
 
 
 def _theta_nodes(domain: Ellipse, level: np.ndarray) -> np.ndarray:
-    """Trapezoid node counts (powers of two) for p0 at ellipse level q < 1."""
-    delta = np.maximum(1.0 - level, 1e-300)
+    """Trapezoid (inside) or midpoint (outside) node counts, powers of two, for p0 at
+    ellipse level q."""
+    delta = np.maximum(np.abs(1.0 - level), 1e-300)
     aspect = max(domain.ax, domain.ay) / min(domain.ax, domain.ay)
     need = THETA_DECAY * aspect / np.sqrt(2.0 * delta)
     n = np.exp2(np.ceil(np.log2(np.maximum(need, THETA_MIN))))
@@ -113,34 +133,88 @@ def _theta_nodes(domain: Ellipse, level: np.ndarray) -> np.ndarray:
 
 
 def ray_integrals(domain: Ellipse, px: np.ndarray, py: np.ndarray) -> np.ndarray:
-    """Polar moments of ``domain`` about inside points p0 = (px, py), shape (k, 9).
+    """Polar moments of ``domain`` about points p0 = (px, py), shape (k, 9).
 
     With c = cos θ, s = sin θ and ρ = ρ_max(θ), each column is ∫₀^{2π} · dθ of:
     c ρ²/2, s ρ²/2 (m²); c² ρ³/3, cs ρ³/3, s² ρ³/3 (m³);
     c³ ρ⁴/4, c²s ρ⁴/4, cs² ρ⁴/4, s³ ρ⁴/4 (m⁴).
+    For a point on or outside the boundary (level ≥ 1) ρⁿ is ρ_outⁿ − ρ_inⁿ over the
+    directions that meet the domain (`_outside_rays`).
     """
     px = np.asarray(px, float).ravel()
     py = np.asarray(py, float).ravel()
     out = np.empty((px.size, 9))
-    counts = _theta_nodes(domain, domain.level(px, py))
+    level = domain.level(px, py)
+    counts = _theta_nodes(domain, level)
+    inside = level < 1.0
     for n in np.unique(counts):
-        idx = np.flatnonzero(counts == n)
-        theta = np.arange(n) * (2.0 * np.pi / n)
-        c, s = np.cos(theta), np.sin(theta)
-        w = 2.0 * np.pi / n
-        trig2 = np.column_stack([c, s])
-        trig3 = np.column_stack([c * c, c * s, s * s])
-        trig4 = np.column_stack([c**3, c * c * s, c * s * s, s**3])
-        block = max(1, chunksums.CHUNK_ELEMENTS // int(n))
-        for start in range(0, idx.size, block):
-            j = idx[start : start + block]
-            rho = domain.ray_length(px[j, None], py[j, None], theta[None, :])
-            r2 = rho * rho * w
-            out[j, 0:2] = (r2 / 2.0) @ trig2
-            r3 = r2 * rho
-            out[j, 2:5] = (r3 / 3.0) @ trig3
-            out[j, 5:9] = (r3 * rho / 4.0) @ trig4
+        for where in (inside, ~inside):
+            idx = np.flatnonzero((counts == n) & where)
+            block = max(1, chunksums.CHUNK_ELEMENTS // int(n))
+            for start in range(0, idx.size, block):
+                j = idx[start : start + block]
+                if where is inside:
+                    out[j] = _inside_rays(domain, px[j], py[j], int(n))
+                else:
+                    out[j] = _outside_rays(domain, px[j], py[j], int(n))
     return out
+
+
+def _moments(r2: np.ndarray, r3: np.ndarray, r4: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """The 9 columns of `ray_integrals` from weighted ρ-powers (points, nodes) and the
+    nodes' cos, sin: (nodes,), the same for every point, or (points, nodes)."""
+    groups = (
+        (r2, 2.0, (c, s)),
+        (r3, 3.0, (c * c, c * s, s * s)),
+        (r4, 4.0, (c**3, c * c * s, c * s * s, s**3)),
+    )
+    return np.column_stack(
+        [(r @ t if t.ndim == 1 else np.einsum("ij,ij->i", r, t)) / k for r, k, trig in groups for t in trig]
+    )
+
+
+def _inside_rays(domain: Ellipse, px: np.ndarray, py: np.ndarray, n: int) -> np.ndarray:
+    """`ray_integrals` about inside points by the periodic trapezoid of ``n`` nodes."""
+    theta = np.arange(n) * (2.0 * np.pi / n)
+    c, s = np.cos(theta), np.sin(theta)
+    rho = domain.ray_length(px[:, None], py[:, None], theta[None, :])
+    r2 = rho * rho * (2.0 * np.pi / n)
+    r3 = r2 * rho
+    return _moments(r2, r3, r3 * rho, c, s)
+
+
+def _outside_rays(domain: Ellipse, px: np.ndarray, py: np.ndarray, n: int) -> np.ndarray:
+    """`ray_integrals` about points on or outside the boundary: over the directions
+    [θ_c − Δ, θ_c + Δ] that meet the domain, θ = θ_c + Δ cos φ, ``n`` midpoints in φ."""
+    dx = (px - domain.cx) / domain.ax
+    dy = (py - domain.cy) / domain.ay
+    level = np.hypot(dx, dy)
+    # the tangent directions in the coordinates where the domain is the unit disc, then
+    # as angles in the patch (the affine map keeps rays from p0 rays, and their order)
+    half = np.arcsin(np.minimum(1.0, 1.0 / level))
+    towards = np.arctan2(-dy, -dx)
+    t1, t2 = (
+        np.arctan2(domain.ay * np.sin(towards + k * half), domain.ax * np.cos(towards + k * half))
+        for k in (-1.0, 1.0)
+    )
+    span = np.mod(t2 - t1, 2.0 * np.pi)
+    centre = t1 + span / 2.0
+    phi = (np.arange(n) + 0.5) * (np.pi / n)
+    theta = centre[:, None] + (span[:, None] / 2.0) * np.cos(phi)[None, :]
+    weight = (span[:, None] / 2.0) * np.sin(phi)[None, :] * (np.pi / n)  # dθ
+    c, s = np.cos(theta), np.sin(theta)
+    ex, ey = c / domain.ax, s / domain.ay
+    qa = ex * ex + ey * ey
+    qb = -np.minimum(dx[:, None] * ex + dy[:, None] * ey, 0.0)  # −b ≥ 0 towards the domain
+    qc = np.maximum(dx * dx + dy * dy - 1.0, 0.0)[:, None]
+    root = np.sqrt(np.maximum(qb * qb - qa * qc, 0.0))
+    far = (qb + root) / qa
+    near = np.divide(qc, qb + root, out=np.zeros_like(far), where=qb + root > 0)
+    gap = 2.0 * root / qa * weight  # (ρ_out − ρ_in) dθ
+    r2 = gap * (far + near)
+    r3 = gap * (far * far + far * near + near * near)
+    r4 = r2 * (far * far + near * near)
+    return _moments(r2, r3, r4, c, s)
 
 
 def _rays(domain: Ellipse, idx: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
@@ -342,7 +416,8 @@ def _compiled_sums(setting: _Setting, *, vx, vy, wz, workers: int) -> tuple[np.n
 
 def _centres(setting: _Setting, *, vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(indices, p0x, p0y) of the points whose centre of rotation p0 lies inside the domain
-    (where the subtraction applies; none without it)."""
+    or outside it below the level `OUTSIDE_BAND` (where the subtraction applies; none
+    without it)."""
     if not setting.order:
         return np.empty(0, np.int64), np.empty(0), np.empty(0)
     spin = wz != 0
@@ -350,7 +425,7 @@ def _centres(setting: _Setting, *, vx, vy, wz) -> tuple[np.ndarray, np.ndarray, 
     p0y = np.zeros(vx.size)
     p0x[spin] = -vy[spin] / wz[spin]
     p0y[spin] = vx[spin] / wz[spin]
-    i = np.flatnonzero(spin & (setting.quad.domain.level(p0x, p0y) < 1.0))
+    i = np.flatnonzero(spin & (setting.quad.domain.level(p0x, p0y) < OUTSIDE_BAND))
     return i, p0x[i], p0y[i]
 
 
@@ -372,18 +447,36 @@ def _finish(
     return fx, fy, mz
 
 
+def _subtracted_field(setting: _Setting, px, py) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """L(p0) (Pa) and ∇L (Pa/m) of the subtracted L = L(p0) + ∇L·(p − p0) for centres p0:
+    inside, g(p0) and (order 2) g's gradient scaled by min(1, (1 − q)/`GRADIENT_TAPER`);
+    outside, g at the boundary point p_b = c + (p0 − c)/q (`EDGE_INSET` inside), no gradient."""
+    quad, law = setting.quad, setting.law
+    d = quad.domain
+    level = d.level(px, py)
+    inside = level < 1.0
+    scale = np.where(inside, 1.0, (1.0 - EDGE_INSET) / np.maximum(level, 1.0))
+    bx, by = d.cx + (px - d.cx) * scale, d.cy + (py - d.cy) * scale
+    gx = np.zeros(px.size)
+    gy = np.zeros(px.size)
+    if setting.order == 2 and np.any(inside):
+        g0, gx[inside], gy[inside] = _g_and_gradient(quad, law, setting.sigma_ref, px[inside], py[inside])
+        taper = np.minimum(1.0, (1.0 - level[inside]) / GRADIENT_TAPER)
+        gx[inside] *= taper
+        gy[inside] *= taper
+    s0 = np.asarray(quad.sigma_at(bx, by), float)
+    g = law.f * law.pressure_factor(s0, setting.sigma_ref) * s0
+    if setting.order == 2 and np.any(inside):
+        g[inside] = g0
+    return g, gx, gy
+
+
 def _subtraction(setting: _Setting, *, px, py, sgn, X, Y, rays) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For points whose ICR p0 = (px, py) is inside, with node sums X, Y (rows of sx, sy):
     the change of (F_x, F_y, M_z) when the node sums of L ŵ, L = g0 + G·(p − p0), are
     swapped for their exact integrals over the domain."""
-    quad, law = setting.quad, setting.law
-    if setting.order == 2:
-        g0, gx, gy = _g_and_gradient(quad, law, setting.sigma_ref, px, py)
-    else:
-        s0 = np.asarray(quad.sigma_at(px, py), float)
-        g0 = law.f * law.pressure_factor(s0, setting.sigma_ref) * s0
-        gx = gy = np.zeros_like(g0)
-    alpha = law.anisotropy
+    g0, gx, gy = _subtracted_field(setting, px, py)
+    alpha = setting.law.anisotropy
     c0 = g0 - gx * px - gy * py  # L = c0 + gx·x + gy·y
     # columns 2..6 of X: ŵx @ dA·(1, x, y, xy, y²); of Y: ŵy @ dA·(1, x, y, x², xy)
     node_x = c0 * X[:, 2] + gx * X[:, 3] + gy * X[:, 4]
