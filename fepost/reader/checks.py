@@ -8,6 +8,7 @@ from here and never from each other's private names.
 from __future__ import annotations
 
 import mmap
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -55,6 +56,30 @@ def inside_folder(path: Path, ref: str, what: str) -> Path:
         raise bad_file(path, f"refused: {what} {ref!r} lies outside the file's folder")
     return target
 
+
+def regular_file(path: Path, target: Path, ref: str, what: str) -> None:
+    """Refuse ``target`` (named ``ref`` in ``path``) unless it is a regular file: missing, a
+    directory, a FIFO (never opened: reading one would wait for a writer), a device or a socket."""
+    try:
+        mode = target.stat().st_mode
+    except OSError:
+        raise bad_file(path, f"{what} {ref!r} not found") from None
+    if stat.S_ISREG(mode):
+        return
+    kind = next(
+        (name for test, name in _KINDS if test(mode)),
+        "something else",
+    )
+    raise bad_file(path, f"refused: {what} {ref!r} is not a regular file but {kind}")
+
+
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+)
 
 #: Bytes of a mapped file walked before the pages behind are let go (`release`).
 RELEASE_STEP = 64 << 20

@@ -14,7 +14,14 @@ What is read (the records: `fepost.reader.frdparse`):
   components ``COPEN CSLIP1 CSLIP2 CPRESS CSHEAR1 CSHEAR2``; the pressure is
   its ``CPRESS`` component, the others stay available; nodes without a
   record hold zero (CalculiX writes node-to-surface contact at the slave nodes
-  that have a contact spring only). A node listed twice keeps its last record;
+  that have a contact spring only). A node listed twice with the same values
+  is read once; with different values, or two CONTACT (or DISP) blocks of one
+  increment that differ, the file is refused (which one is right?);
+* when no step is asked for and the last increment holds no CONTACT block (a
+  last step without contact output, as in CalculiX's ``contact10`` example),
+  the last increment that holds one is read, with a note; an asked-for step
+  without one is refused, naming the steps that have contact output, and so
+  is a file cut off (no closing ``9999`` line) before its last step's contact output;
 * ``DISP`` (``*NODE FILE`` / ``*NODE OUTPUT`` with ``U``) as the displacement,
   and the other nodal blocks of the increment under their frd names.
 
@@ -143,9 +150,9 @@ class _Nodes:
         return self.order[pos]
 
 
-def _nodal(frd: FrdFile, nodes: _Nodes, block: ResultBlock, keep: np.ndarray) -> np.ndarray:
+def _nodal(frd: FrdFile, nodes: _Nodes, block: ResultBlock, keep: np.ndarray, where: str) -> np.ndarray:
     """The block's values at the nodes ``keep`` (NaN where it has no record; ``DISP`` must cover them)."""
-    ids, vals = block_values(frd, block)
+    ids, vals = _records(frd, block, where)
     out = np.full((len(frd.node_ids), vals.shape[1]), np.nan)
     written = np.zeros(len(frd.node_ids), bool)
     rows = nodes.rows(ids, f"result block {block.name}")
@@ -166,15 +173,19 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
     chosen = choose_step(path, step, len(incs))
     if chosen is None:
         raise FieldError(f"{path}: the file holds no results; {NO_CONTACT}")
+    notes: list[str] = []
+    if not _blocks_at(frd, incs[chosen][0]).get("CONTACT"):
+        chosen = _contact_step(frd, path, incs, chosen, explicit=step is not None)
+        notes.append(
+            f"step {len(incs) - 1} (t = {incs[-1][1]:g}), the last, holds no contact output: read step "
+            f"{chosen} (t = {incs[chosen][1]:g}), the last with a CONTACT block; choose another with --step"
+        )
+        warnings.warn(f"{path}: {notes[-1]}", ReaderWarning, stacklevel=3)
     kode = incs[chosen][0]
-    here: dict[str, ResultBlock] = {}
-    for b in frd.blocks:
-        if b.kode == kode:
-            here.setdefault(b.name, b)
-    contact = here.get("CONTACT")
-    if contact is None:
-        _refuse_step(frd, path, incs, chosen)
-    assert contact is not None
+    where = f"step {chosen} (t = {incs[chosen][1]:g})"
+    named = _blocks_at(frd, kode)
+    here = {name: _one(frd, blocks, where) for name, blocks in named.items()}
+    contact = here["CONTACT"]
     if "CPRESS" not in contact.components:
         raise FieldError(
             f"{path}: the CONTACT block has no CPRESS component ({', '.join(contact.components)})"
@@ -184,7 +195,7 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
     conn = {
         t: nodes.rows(c, f"an element of frd type {t} ({CANONICAL[t]})") for t, c in frd.elem_nodes.items()
     }
-    cids, cvals = block_values(frd, contact)
+    cids, cvals = _records(frd, contact, where)
     rows = nodes.rows(cids, "the CONTACT block")
     written = np.zeros(n, bool)
     written[rows] = True
@@ -206,6 +217,7 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
         steps=tuple(t for _, t in incs),
         step=chosen,
     )
+    raw.notes += notes
     raw.point_data.add("CONTACT", contact_values[keep])
     raw.components["CONTACT"] = contact.components
     raw.ncomp["CONTACT"] = len(contact.components)
@@ -214,7 +226,7 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
             continue
 
         def load(b=b) -> np.ndarray:
-            return _nodal(frd, nodes, b, keep)
+            return _nodal(frd, nodes, b, keep, where)
 
         raw.point_data.add(name, load)
         raw.components[name] = b.components
@@ -246,16 +258,88 @@ def _surface(
     return keep, _element_blocks({t: remap[c] for t, c in chosen.items()}, conn)
 
 
-def _refuse_step(frd: FrdFile, path: Path, incs: list[tuple[int, float]], chosen: int) -> None:
+def _blocks_at(frd: FrdFile, kode: int) -> dict[str, list[ResultBlock]]:
+    """The result blocks of one increment by name, in file order."""
+    out: dict[str, list[ResultBlock]] = {}
+    for b in frd.blocks:
+        if b.kode == kode:
+            out.setdefault(b.name, []).append(b)
+    return out
+
+
+def _one(frd: FrdFile, blocks: list[ResultBlock], where: str) -> ResultBlock:
+    """The block of a name at one increment; several are refused unless they hold the same records."""
+    first = blocks[0]
+    if len(blocks) > 1 and first.name in _CHECKED_TWICE:
+        ids, vals = block_values(frd, first)
+        for other in blocks[1:]:
+            ids2, vals2 = block_values(frd, other)
+            if not (np.array_equal(ids, ids2) and np.array_equal(vals, vals2, equal_nan=True)):
+                raise InputFileError(
+                    f"{frd.path}: {where} holds {len(blocks)} {first.name} blocks with different values "
+                    "(corrupt file, or two runs written into one file?); fepost cannot tell which to read"
+                )
+    return first
+
+
+#: Blocks whose repetition at one increment is checked (the ones the field is made of).
+_CHECKED_TWICE = ("CONTACT", "DISP")
+
+
+def _records(frd: FrdFile, block: ResultBlock, where: str) -> tuple[np.ndarray, np.ndarray]:
+    """(node ids, values) of a block, a node's repeated records dropped where they are equal and
+    refused where they differ (which one holds the node's values?)."""
+    ids, vals = block_values(frd, block)
+    if len(ids) < 2:
+        return ids, vals
+    order = np.argsort(ids, kind="stable")
+    same = ids[order[1:]] == ids[order[:-1]]
+    if not same.any():
+        return ids, vals
+    first, second = order[:-1][same], order[1:][same]
+    differ = np.any((vals[first] != vals[second]) & ~(np.isnan(vals[first]) & np.isnan(vals[second])), axis=1)
+    if differ.any():
+        k = int(np.flatnonzero(differ)[0])
+        node = int(ids[first[k]])
+        raise InputFileError(
+            f"{frd.path}: result block {block.name} at {where} holds node {node} twice, with different "
+            f"values ({_shown(block, vals[first[k]])} and {_shown(block, vals[second[k]])}); "
+            "fepost cannot tell which to read (corrupt file?)"
+        )
+    keep = np.ones(len(ids), bool)
+    keep[second] = False
+    return ids[keep], vals[keep]
+
+
+def _shown(block: ResultBlock, row: np.ndarray) -> str:
+    if "CPRESS" in block.components:
+        return f"CPRESS {row[block.components.index('CPRESS')]:g}"
+    return ", ".join(f"{v:g}" for v in row[:3])
+
+
+def _contact_step(
+    frd: FrdFile, path: Path, incs: list[tuple[int, float]], chosen: int, explicit: bool
+) -> int:
+    """The step to read when step ``chosen`` holds no CONTACT block: the last that holds one when
+    no step was asked for; else (or in a file cut off while that step was written) refused."""
     with_contact = {b.kode for b in frd.blocks if b.name == "CONTACT"}
     if not with_contact:
         raise FieldError(f"{path}: {NO_CONTACT}")
-    listed = [f"{k} (t = {t:g})" for k, (kd, t) in enumerate(incs) if kd in with_contact]
-    more = f" and {len(listed) - 10} more" if len(listed) > 10 else ""
-    raise FieldError(
-        f"{path}: no CONTACT block at step {chosen} (t = {incs[chosen][1]:g}); contact output is at "
-        f"step(s) {', '.join(listed[:10])}{more}: choose one with --step"
-    )
+    listed = [k for k, (kd, _) in enumerate(incs) if kd in with_contact]
+    shown = ", ".join(f"{k} (t = {incs[k][1]:g})" for k in listed[-10:])
+    more = f"{len(listed) - 10} more and " if len(listed) > 10 else ""
+    if not frd.complete and chosen == len(incs) - 1:
+        raise InputFileError(
+            f"{path}: truncated .frd file: it ends at byte {len(frd.data)} without CalculiX's closing 9999 "
+            f"line, in step {chosen} (t = {incs[chosen][1]:g}), before its contact output (cut off while "
+            f"written?); contact output is complete at step(s) {more}{shown}: choose one with --step"
+        )
+    if explicit:
+        raise FieldError(
+            f"{path}: no CONTACT block at step {chosen} (t = {incs[chosen][1]:g}); contact output is at "
+            f"step(s) {more}{shown}: choose one with --step"
+        )
+    return listed[-1]
 
 
 def _element_blocks(chosen: dict[int, np.ndarray], conn: dict[int, np.ndarray]) -> list[Block]:

@@ -44,6 +44,8 @@ NODES_PER_TYPE = {1: 8, 2: 6, 3: 4, 4: 20, 5: 15, 6: 10, 7: 3, 8: 6, 9: 4, 10: 8
 #: Longest text line accepted (frd lines are at most ~130 characters).
 MAX_LINE = 1024
 _FORTRAN_EXP = re.compile(rb"([0-9.])([+-])(\d{2,3})$")
+#: How the line after a binary block's records starts (``    1PSTEP``, ``  100C``, `` 9999`` ...).
+_LINE_START = re.compile(rb" {0,4}\d{1,4}(?:[A-Z ]|\r?\n|$)")
 
 
 @dataclass(frozen=True)
@@ -73,6 +75,7 @@ class FrdFile:
     elem_nodes: dict[int, np.ndarray]  # frd type -> (k, nodes) node ids, in file order per type
     blocks: list[ResultBlock] = field(default_factory=list)
     data: mmap.mmap | bytes = b""
+    complete: bool = True  # the closing ``9999`` line was found (False: cut off while written?)
 
 
 def _show(raw: bytes) -> str:
@@ -154,6 +157,8 @@ def _ascii_records(path: str, lines: list[bytes], nvals: int, what: str) -> tupl
         ids = _columns(lines, [3], 10)
         vals = _columns(lines, [13 + 12 * k for k in range(nvals)], 12)
         if ids is not None and vals is not None and lines:
+            if (len(lines[0]) - 13) // 12 > nvals:
+                raise _bad(path, _too_many(what, (len(lines[0]) - 13) // 12, nvals))
             values = np.column_stack([_floats(path, v) for v in vals]) if vals else np.empty((len(lines), 0))
             return _ids(path, ids[0], what), values
     return _slow_records(path, lines, nvals, what)
@@ -165,6 +170,13 @@ def _ids(path: str, col: np.ndarray, what: str) -> np.ndarray:
     except ValueError:
         bad = next(b for b in col if not b.strip().lstrip(b"-").isdigit())
         raise _bad(path, f"{what}: node number {_show(bad.strip()[:20])}") from None
+
+
+def _too_many(what: str, held: int, nvals: int) -> str:
+    return (
+        f"{what}: a record holds {held} values, its -5 lines declare {nvals} stored components "
+        "(a component flagged as derived, IEXIST = 1, that has values?)"
+    )
 
 
 def _slow_records(path: str, lines: list[bytes], nvals: int, what: str) -> tuple[np.ndarray, np.ndarray]:
@@ -181,6 +193,8 @@ def _slow_records(path: str, lines: list[bytes], nvals: int, what: str) -> tuple
             raise _bad(path, f"{what}: unexpected line {_show(ln[:40])}")
     if any(len(r) < nvals for r in rows):
         raise _bad(path, f"{what}: a record holds fewer than {nvals} values")
+    if any(len(r) > nvals for r in rows):
+        raise _bad(path, _too_many(what, max(len(r) for r in rows), nvals))
     cols = np.array([r[:nvals] for r in rows], dtype="S12").reshape(len(rows), nvals)
     return np.array(ids, np.int64), _floats(path, cols)
 
@@ -325,6 +339,13 @@ def _result_header(path: str, data, pos: int, head: bytes, step: int) -> tuple[R
         size = 4 + len(comps) * (4 if fmt == 2 else 8)
         _need(path, data, pos, count * size, f"result block {name} ({count} nodes)")
         end = nxt = pos + count * size
+        if end < len(data) and not _LINE_START.match(data, end, min(len(data), end + 12)):
+            raise _bad(
+                path,
+                f"result block {name}: its records do not end where its -5 lines say ({count} nodes, "
+                f"{len(comps)} stored components of {size // len(comps) if comps else 0} bytes each): "
+                "a component flagged as derived (IEXIST = 1) that has values, or the reverse?",
+            )
     elif fmt == 1:
         _need(path, data, pos, count * 13, f"result block {name} ({count} nodes)")
         end, nxt = _ascii_end(path, data, pos, f"result block {name}")
@@ -355,6 +376,7 @@ def scan(path: Path, data) -> FrdFile:
     nodes = elems = None
     frd = FrdFile(where, False, np.empty(0, np.int64), np.empty((0, 3)), np.empty(0, np.int64), {}, data=data)
     step = 0
+    complete = False
     while pos < n:
         eol = data.find(b"\n", pos, pos + MAX_LINE)
         if eol < 0:
@@ -384,12 +406,14 @@ def scan(path: Path, data) -> FrdFile:
             block, pos = _result_header(where, data, pos, line, step)
             frd.blocks.append(block)
         elif key == b"9999":
+            complete = True
             break
         elif line.strip():
             raise _bad(where, f"unexpected line {_show(line[:40])} at byte {pos - len(line) - 1}")
     if nodes is None:
         raise InputFileError(f"{where}: not a CalculiX .frd result file (no node block '2C')")
     frd.node_ids, frd.coords = nodes
+    frd.complete = complete
     if elems is not None:
         frd.elem_types, frd.elem_nodes = elems[0], _group(elems[0], elems[1])
     return frd

@@ -56,6 +56,7 @@ import numpy as np
 import pybase64
 
 from ..errors import InputFileError
+from . import b64text
 from .checks import release
 from .names import ArrayInfo, needed_point_arrays
 from .raw import RawMesh, defer_point_arrays
@@ -115,6 +116,7 @@ class _Format:
     endian: Literal["<", ">"]
     inflate: Callable[[Any, int], bytes] | None
     appended: tuple[int, bool] | None  # (first byte, base64?) of the AppendedData
+    text_end: Callable[[int], int] | None = None  # where an appended base64 array's text ends
 
 
 def read_direct(path: Path, *, field: str | None = None, displacement: str | None = "auto") -> RawMesh | None:
@@ -133,7 +135,7 @@ def read_direct(path: Path, *, field: str | None = None, displacement: str | Non
     with open(path, "rb") as fh:
         data = _mapped(fh)
         try:
-            xml = Xml(path, data, 0)
+            xml = Xml(path, data, 0, verify=False)
             try:
                 xml.check()
             except InputFileError:
@@ -182,7 +184,7 @@ def _format(xml: Xml) -> _Format:
     if compressor and compressor not in _INFLATE:
         raise _NotHere  # LZ4 and unknown compressors: VTK's
     endian: Literal["<", ">"] = ">" if xml.endian == ">" else "<"
-    return _Format(xml.path, xml.header_size, endian, _INFLATE.get(compressor), xml.appended)
+    return _Format(xml.path, xml.header_size, endian, _INFLATE.get(compressor), xml.appended, xml.text_end)
 
 
 def _piece(xml: Xml):
@@ -352,8 +354,8 @@ class _Job:
             start = base + int(arr.attrs["offset"])
             if not b64:
                 return _raw_payload(fmt, data, start, self.name)
-            end = data.find(b"<", base)
-            end = end if end >= 0 else len(data)
+            assert fmt.text_end is not None
+            end = fmt.text_end(int(arr.attrs["offset"]))
         while start < end and data[start] in _SPACE:
             start += 1
         while end > start and data[end - 1] in _SPACE:
@@ -389,20 +391,46 @@ def _words(fmt: _Format, raw, n: int) -> tuple[int, ...]:
 
 def _b64(fmt: _Format, text, name: str) -> bytes:
     """The bytes of base64 ``text``: strict base64 by pybase64, anything else by binascii's
-    lenient decoder (which skips line breaks and stops at padding)."""
+    lenient decoder (which skips line breaks and stops at padding) once the text is known to
+    hold nothing but the alphabet, padding and whitespace (binascii would skip anything else)."""
     try:
         return pybase64.b64decode(text, validate=True)
     except ValueError:
         pass  # not strict base64: decoded leniently below (the same bytes where both decode)
+    chunk = bytes(text)
+    if chunk.translate(None, b64text.ALPHABET + b"=" + _SPACE):
+        raise _damaged(fmt, name, b64text.Damaged(b64text.describe(chunk, skip=_SPACE)))
     try:
-        return binascii.a2b_base64(text)
+        return binascii.a2b_base64(chunk)
     except (binascii.Error, ValueError):
         raise InputFileError(f"{fmt.path}: array {name!r}: invalid base64 data") from None
 
 
+def _damaged(fmt: _Format, name: str, exc: b64text.Damaged) -> InputFileError:
+    return InputFileError(f"{fmt.path}: array {name!r}: damaged base64 data ({exc})")
+
+
+def _groups(fmt: _Format, text, name: str, want: int, inline: bool) -> bytes:
+    """The array's whole text decoded group by group as VTK reads it (padding inside the
+    stream: a length header encoded on its own), at least ``want`` bytes, or the error
+    naming the damage."""
+    chunk = bytes(text).translate(None, _SPACE) if inline else bytes(text)
+    try:
+        decoded = b64text.decode_groups(chunk)
+    except b64text.Damaged as exc:
+        raise _damaged(fmt, name, exc) from None
+    if len(decoded) < want:
+        raise _damaged(
+            fmt,
+            name,
+            b64text.Damaged(f"it decodes to {len(decoded)} bytes, its header announces {want}"),
+        )
+    return decoded
+
+
 def _chars(nbytes: int) -> int:
     """Base64 characters that encode ``nbytes`` bytes (padding included)."""
-    return -(-nbytes // 3) * 4
+    return b64text.chars(nbytes)
 
 
 def _spaced(text) -> bool:
@@ -427,9 +455,8 @@ def _base64_payload(fmt: _Format, text, name: str, inline: bool) -> tuple[tuple[
     if fmt.inflate is None:
         nbytes = _words(fmt, _b64(fmt, text[:head], name), 1)[0] if len(text) >= head else 0
         decoded = _b64(fmt, text if inline else text[: _chars(h + nbytes)], name)
-        if len(decoded) < h + nbytes:
-            # padding inside the stream (the length encoded on its own): VTK's reading decides
-            raise _NotHere
+        if len(decoded) < h + nbytes:  # padding inside the stream (the length encoded on its own), or damage
+            decoded = _groups(fmt, text, name, h + nbytes, inline)
         return (nbytes,), memoryview(decoded)[h : h + nbytes]
     first = _b64(fmt, text[:head], name)
     if len(first) < 3 * h:
@@ -441,8 +468,8 @@ def _base64_payload(fmt: _Format, text, name: str, inline: bool) -> tuple[tuple[
     words = _words(fmt, _b64(fmt, text[:chars], name), 3 + nblocks)
     need = sum(words[3:])
     body = _b64(fmt, text[chars:] if inline else text[chars : chars + _chars(need)], name)
-    if len(body) < need:
-        raise _NotHere  # padding or breaks VTK's stream reading may read otherwise
+    if len(body) < need:  # padding inside the stream, or damage
+        body = _groups(fmt, text[chars:], name, need, inline)
     return words, memoryview(body)
 
 

@@ -26,7 +26,7 @@ from .cells import SPECS, VTK_TYPES, check_connectivity
 from .exodus import choose_step
 from .raw import Block, RawMesh
 from .suffixes import XDMF_SUFFIXES
-from .xdmfcheck import check_xdmf
+from .xdmfcheck import XdmfLayout, check_xdmf
 
 #: meshio cell type → VTK cell type (meshio keeps VTK's node order).
 MESHIO_TO_VTK = {
@@ -150,10 +150,30 @@ def read_xdmf(path: Path, step: int | None) -> RawMesh:
     except InputFileError:
         raise
     except _meshio_errors() as exc:
+        damaged = _damaged_dataset(path, layout)
+        if damaged is not None:
+            raise damaged from None
         raise InputFileError(f"{path}: cannot read XDMF file ({_one_line(exc)})") from None
     raw = _raw(path, np.asarray(points), cells, point_data, cell_data)
     raw.steps, raw.step = times, chosen
     return raw
+
+
+def _damaged_dataset(path: Path, layout: XdmfLayout) -> InputFileError | None:
+    """The error naming the first HDF5 dataset whose values do not read (damaged chunks or
+    filters), or None: looked for only after meshio failed, each dataset read on its own."""
+    import h5py
+
+    for ref, target, dataset in layout.datasets:
+        try:
+            with h5py.File(target, "r") as h5:
+                h5[dataset][()]
+        except (OSError, KeyError, RuntimeError, ValueError, TypeError):
+            return InputFileError(
+                f"{path}: heavy-data file {ref!r}: the values of dataset {dataset!r} cannot be read "
+                "(damaged HDF5 data)"
+            )
+    return None
 
 
 def _raw(path: Path, points: np.ndarray, cells, point_data: dict, cell_data: dict) -> RawMesh:

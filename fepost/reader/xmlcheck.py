@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import base64
 import binascii
+import bisect
+import codecs
 import mmap
 import re
 import struct
@@ -17,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import InputFileError
+from . import b64text
 from .checks import (
     MAX_COUNT,
     MAX_DEPTH,
@@ -26,6 +29,7 @@ from .checks import (
     bad_file,
     find_releasing,
     inside_folder,
+    regular_file,
     release,
 )
 
@@ -70,6 +74,19 @@ _SECTIONS = frozenset(
 _ATTR = re.compile(rb"([A-Za-z_][\w:.-]*)\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
 
 
+_DECLARED = re.compile(rb"<\?xml[^>]*?encoding\s*=\s*[\"']([A-Za-z][A-Za-z0-9._-]{0,39})[\"']")
+
+
+def _encoding(path: Path, prologue: bytes) -> str:
+    """The encoding the XML declaration names (UTF-8 without one)."""
+    m = _DECLARED.search(prologue[:1024])
+    name = m.group(1).decode("ascii") if m else "utf-8"
+    try:
+        return codecs.lookup(name).name
+    except LookupError:
+        raise bad_file(path, f"the XML declaration names the unknown encoding {name!r}") from None
+
+
 def _int(path: Path, attrs: dict[str, str], key: str, default: int | None = None) -> int:
     if key not in attrs:
         if default is None:
@@ -103,8 +120,16 @@ class Piece:
 
 
 class Xml:
-    def __init__(self, path: Path, data: bytes | mmap.mmap, depth: int):
-        self.path, self.data, self.depth = path, data, depth
+    """The structure of one VTK XML file, checked by `check`.
+
+    ``verify``: also check every base64 array's text as VTK's reader will decode it
+    (`fepost.reader.b64text`: damaged text would come out of VTK as zeros or shifted
+    values without an error). The direct decoder, which checks the text as it decodes
+    it, passes False.
+    """
+
+    def __init__(self, path: Path, data: bytes | mmap.mmap, depth: int, verify: bool = True):
+        self.path, self.data, self.depth, self.verify = path, data, depth, verify
 
     def check(self) -> Counts:
         path, data = self.path, self.data
@@ -117,6 +142,7 @@ class Xml:
             raise bad_file(
                 path, "refused: XML with DOCTYPE/ENTITY declarations (not a VTK file; entity expansion)"
             )
+        self.encoding = _encoding(path, prologue)
         root, pieces, refs = self._scan(limit)
         self.root, self.pieces = root, pieces  # the structure, for the direct decoder (`vtkdirect`)
         want = _ROOT.get(suffix)
@@ -128,6 +154,7 @@ class Xml:
         self.endian = ">" if root.get("byte_order", "LittleEndian") == "BigEndian" else "<"
         self.compressed = bool(root.get("compressor"))
         self.appended = self._appended(cut)
+        self.offsets, self.stream_end = self._stream(pieces)
         counts = Counts()
         if suffix == ".vtm":
             self._check_refs(refs, (".vtu", ".vtp", ".vtm"), "multi-block piece")
@@ -183,7 +210,7 @@ class Xml:
                     section = ""
                 continue
             attrs = {
-                k.decode("latin-1"): (a if a is not None else b or b"").decode("latin-1")
+                k.decode("latin-1"): self._text(a if a is not None else b or b"")
                 for k, a, b in _ATTR.findall(rest)
             }
             if root is None:
@@ -210,6 +237,14 @@ class Xml:
             raise bad_file(self.path, f"XML element <{stack[-1].decode('latin-1')}> is not closed")
         return root, pieces, refs
 
+    def _text(self, raw: bytes) -> str:
+        """An attribute's value in the file's encoding (UTF-8 unless its XML declaration says
+        otherwise, as for VTK's XML parser); bytes that are not in it as Latin-1."""
+        try:
+            return raw.decode(self.encoding)
+        except UnicodeDecodeError:
+            return raw.decode("latin-1")
+
     def _appended(self, cut: int) -> tuple[int, bool] | None:
         if cut < 0:
             return None
@@ -225,10 +260,35 @@ class Xml:
             raise bad_file(self.path, "AppendedData without its '_' marker")
         return mark + 1, attrs.get("encoding", "raw") == "base64"
 
+    def _stream(self, pieces: list[Piece]) -> tuple[tuple[int, ...], int]:
+        """(the appended arrays' offsets, sorted; the end of the base64 AppendedData text)."""
+        if self.appended is None or not self.appended[1]:
+            return (), len(self.data)
+        offsets = {
+            int(a.attrs["offset"])
+            for p in pieces
+            for a in p.arrays
+            if a.attrs.get("format") == "appended" and a.attrs.get("offset", "").strip().isdigit()
+        }
+        end = self.data.find(b"<", self.appended[0])
+        return tuple(sorted(offsets)), end if end >= 0 else len(self.data)
+
+    def text_end(self, offset: int) -> int:
+        """Where the base64 text of the appended array at ``offset`` ends: at the next array's
+        offset, or at the end of the AppendedData text."""
+        assert self.appended is not None
+        k = bisect.bisect_right(self.offsets, offset)
+        return (
+            min(self.appended[0] + self.offsets[k], self.stream_end)
+            if k < len(self.offsets)
+            else self.stream_end
+        )
+
     def _check_refs(self, refs: list[str], suffixes: tuple[str, ...], what: str) -> Counts:
         if self.depth >= MAX_VTM_DEPTH:
             raise bad_file(self.path, f"refused: multi-block files nested more than {MAX_VTM_DEPTH} deep")
         counts = Counts()
+        seen: set[Path] = set()
         for ref in refs:
             sub = inside_folder(self.path, ref, what)
             if sub.suffix.lower() not in suffixes:
@@ -237,8 +297,12 @@ class Xml:
             if sub == self.path.resolve():
                 whole = "multi-block" if what.startswith("multi") else "parallel"
                 raise bad_file(self.path, f"{whole} file refers to itself")
-            if not sub.is_file():
-                raise bad_file(self.path, f"{what} {ref!r} not found")
+            if what == "piece" and sub in seen:
+                raise bad_file(
+                    self.path, f"refused: piece {ref!r} is listed twice; its nodes would count twice"
+                )
+            seen.add(sub)
+            regular_file(self.path, sub, ref, what)
             try:
                 counts.connectivity += check_xml(sub, self.depth + 1).connectivity
             except InputFileError as exc:
@@ -270,8 +334,7 @@ class Xml:
             off = _int(self.path, a, "offset")
             base, b64 = self.appended
             if b64:
-                end = self.data.find(b"<", base)
-                nbytes, have = self._binary_size(base + off, end if end >= 0 else len(self.data), name)
+                nbytes, have = self._binary_size(base + off, self.text_end(off), name)
             else:
                 nbytes, have = self._raw_size(base + off, name)
         else:
@@ -322,6 +385,7 @@ class Xml:
                 raise bad_file(
                     self.path, f"array {name!r}: compressed data shorter than its header says (truncated?)"
                 )
+            self._verify(start, end, (3 + nblocks) * h + sum(csizes), name)
             return total, present
         head = self._decoded(start, end, h, name)
         if len(head) < h:
@@ -332,7 +396,16 @@ class Xml:
             raise bad_file(
                 self.path, f"array {name!r}: {nbytes} bytes announced, {max(present, 0)} present (truncated?)"
             )
+        self._verify(start, end, h + nbytes, name)
         return nbytes, present
+
+    def _verify(self, start: int, end: int, need: int, name: str) -> None:
+        """Refuse base64 text VTK's reader would decode to other bytes than it holds (`verify`)."""
+        if not self.verify:
+            return
+        why = b64text.problem(self.data, start, end, need)
+        if why is not None:
+            raise bad_file(self.path, f"array {name!r}: damaged base64 data ({why})")
 
     def _raw_size(self, pos: int, name: str) -> tuple[int, int]:
         h = self.header_size
