@@ -44,6 +44,13 @@ class Linearisation:
         forces = tuple(np.asarray(f, float) for f in contact(*k))
         return cls(gear, x0, forces, k, grads)  # type: ignore[arg-type]
 
+    def scaled(self, factor: float, contact: Contact) -> Linearisation:
+        """The linearisation of ``contact.scaled(factor)`` (a friction level f'/f): forces and
+        gradients times ``factor`` (every model is linear in f), the steady state solved again."""
+        x0 = equilibrium(self.gear, contact.scaled(factor))
+        forces = tuple(factor * f for f in self.forces)
+        return Linearisation(self.gear, x0, forces, self.kinematics, factor * self.gradients)  # type: ignore[arg-type]
+
     def contact_at(self, V: float):
         """The linearised contact at speed V: (vx, vy, wz) -> (Fx, Fy, Mz), complex allowed."""
         k0 = self.kinematics * V

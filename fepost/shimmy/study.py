@@ -17,7 +17,8 @@ the same maps (`fepost.table1.table1`, the default seed and noise):
 * generalised and exact: those models have no F0 … k_x to perturb; the one
   identified quantity that maps onto them unchanged is the friction level f (every
   force and torque is proportional to f), so V_c is recomputed with the forces
-  scaled to the ends of f's interval.
+  scaled over f's interval (`F_POINTS` levels from end to end, and the nominal one;
+  the interval is their range, as V_c need not be monotonic in f).
 """
 
 from __future__ import annotations
@@ -37,6 +38,8 @@ from .table import DirectionTable
 
 #: Default speed sweep (m/s): 200 speeds.
 DEFAULT_SPEEDS = (1.0, 150.0, 200)
+#: Friction levels across f's interval at which the map-based models' V_c is recomputed.
+F_POINTS = 9
 #: Speeds of the time simulations, as fractions of each critical speed.
 SIMULATION_FRACTIONS = (0.8, 1.2)
 
@@ -69,7 +72,7 @@ def _lowest_critical(gear: Gear, contact: Contact, speeds: np.ndarray) -> float 
     return stability_map(Linearisation.of(gear, contact), speeds).critical_speed
 
 
-def critical_interval(gear: Gear, contact: Contact, vc: float, speeds: np.ndarray, table1) -> tuple:
+def critical_interval(gear: Gear, contact: Contact, vc: float, speeds: np.ndarray, table1, lin=None) -> tuple:
     """(lo, hi) of the critical speed from Table 1's intervals, and the method (module docstring)."""
     fit = table1.identification
     if contact.name == "closed_forms":
@@ -96,13 +99,14 @@ def critical_interval(gear: Gear, contact: Contact, vc: float, speeds: np.ndarra
         half = fit.t_quantile * sd
         return (vc - half, vc + half), "delta method on Table 1's covariance of F0, M0, a, m, k_x"
     row = next(r for r in table1.rows if r.name == "f")
-    ends = []
-    for f_end in row.ci95:
-        v = _lowest_critical(gear, contact.scaled(f_end / row.fitted), speeds)
+    lin = Linearisation.of(gear, contact) if lin is None else lin
+    found = [vc]
+    for level in np.linspace(row.ci95[0], row.ci95[1], F_POINTS):
+        v = stability_map(lin.scaled(level / row.fitted, contact), speeds).critical_speed
         if v is None:
-            return None, "friction level f at the ends of its interval: no critical speed in the sweep"
-        ends.append(v)
-    return (min(ends), max(ends)), "forces scaled to the ends of Table 1's interval of f"
+            return None, "friction level f across its interval: no critical speed in the sweep at one end"
+        found.append(v)
+    return (min(found), max(found)), f"forces scaled across Table 1's interval of f ({F_POINTS} levels)"
 
 
 def shimmy_study(
@@ -145,7 +149,7 @@ def shimmy_study(
         timings[f"{name}_stability_map"] = time.perf_counter() - t0
         ci, method = None, "not computed"
         if t1 is not None and smap.critical_speed is not None:
-            ci, method = critical_interval(gear, contact, smap.critical_speed, speeds, t1)
+            ci, method = critical_interval(gear, contact, smap.critical_speed, speeds, t1, lin)
         elif smap.critical_speed is None:
             method = "no critical speed in the sweep"
         info = {k: float(v) for k, v in contact.info.items() if isinstance(v, int | float)}
