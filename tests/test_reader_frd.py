@@ -272,3 +272,47 @@ def test_sample_tire_frd_against_its_reaction_and_export(tmp_path):
     a, b = analyse(frd).coefficients, analyse(out / "static.vtu").coefficients
     for key in ("N", "M0", "R", "F0"):
         assert getattr(a, key) == pytest.approx(getattr(b, key), rel=1e-5), key
+
+
+def _without_last_contact(path: Path, out: Path) -> Path:
+    """The file with the CONTACT block of its last increment taken out (its DISP kept), as a
+    last step without contact output writes it (CalculiX's ``contact10`` example)."""
+    data = path.read_bytes()
+    last = data.rindex(b" -4  CONTACT")
+    start = data.rindex(b"    1PSTEP", 0, last)
+    end = data.index(b" 9999", last)
+    out.write_bytes(data[:start] + data[end:])
+    return out
+
+
+def test_a_last_step_without_contact_output_reads_the_last_with_it(cases, tmp_path):
+    """No --step: the last increment holding a CONTACT block is read, with a note, and its load
+    is CalculiX's reaction at that increment; an asked-for step without one is refused."""
+    path, totals = cases["steps"]
+    cut = _without_last_contact(path, tmp_path / "unloaded.frd")
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        fld = read_contact(cut)
+    assert fld.step == 2 and fld.time == pytest.approx(0.75)
+    assert any("the last with a CONTACT block" in n for n in fld.notes)
+    assert any(
+        issubclass(w.category, ReaderWarning) and "holds no contact output" in str(w.message) for w in seen
+    )
+    assert build_patch(fld).N_fe == pytest.approx(totals[2][1], rel=ASCII_TOL)
+    with pytest.raises(
+        FieldError, match=r"no CONTACT block at step 3 \(t = 1\); contact output is at step\(s\) 0"
+    ):
+        read_contact(cut, step=3)
+
+
+def test_a_binary_file_cut_inside_its_last_step_is_called_truncated(cases, tmp_path, capsys):
+    path, totals = cases["steps"]
+    data = path.read_bytes()
+    cut = data.rindex(b"    1PSTEP", 0, data.rindex(b" -4  CONTACT"))
+    short = tmp_path / "cut.frd"
+    short.write_bytes(data[:cut])
+    assert main(["coefficients", str(short)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith(f"fepost: error: {short}: truncated .frd file: it ends at byte {cut}")
+    assert "*CONTACT FILE" not in err[-1]
+    assert _n_fe(short, step=2) == pytest.approx(totals[2][1], rel=ASCII_TOL)

@@ -29,9 +29,12 @@ Legacy (``.vtk``, ASCII or binary, ``UNSTRUCTURED_GRID`` and ``POLYDATA``)
 
 The structure is VTK's documented file format ("VTK File Formats", VTK User's
 Guide); nothing here is used to *read* data, only to decide whether VTK may.
-Corruption inside the data (a bad zlib block, wild connectivity) is left to
-VTK's own errors, to the connectivity check after reading, and to the child
-process the file is read in (`fepost.reader.isolate`).
+Base64 text is checked as VTK's reader will decode it (`fepost.reader.b64text`:
+a character outside the alphabet, padding inside a group, whitespace inside the
+text or fewer bytes than the header announces would come out of VTK as zeros or
+shifted values without an error). Other corruption inside the data (a bad zlib
+block, wild connectivity) is left to VTK's own errors, to the connectivity check
+after reading, and to the child process the file is read in (`fepost.reader.isolate`).
 """
 
 from __future__ import annotations

@@ -14,8 +14,10 @@ the base64 with ``pybase64`` (vectorised, it lets go of the GIL: 1.6 GB/s here
 against 0.28 GB/s for ``binascii``) and the blocks inflated on two threads (zlib
 and lzma release the GIL; zlib by ISA-L where ``isal`` is installed, `ZLIB`),
 takes 0.24 s on that file (0.29 s with the standard zlib) and never imports VTK.
-Text that is not strict base64 (line breaks, padding inside the stream) is
-decoded by ``binascii``'s lenient decoder, as before: the same bytes either way.
+Text that is not strict base64 (line breaks) is decoded by ``binascii``'s lenient
+decoder once it is known to hold only the alphabet, padding and whitespace; where
+that stops short at padding inside the stream (a length header encoded on its own),
+the text is decoded group by group as VTK reads it (`fepost.reader.b64text`).
 
 What is decoded here, and what is not
 -------------------------------------
@@ -31,9 +33,10 @@ The point arrays the field does not need are not decoded: they stay in the
 `fepost.reader.vtkselect` makes for VTK). The arrays then go through the
 assembly VTK's path uses (`fepost.reader.vtkassemble`), so both give identical
 meshes (``tests/test_read_direct_vtk.py`` compares them on every writer's file).
-A block that does not inflate to its declared size, bad base64 or a file
-changed under a loader is an `fepost.errors.InputFileError` naming the file and
-the array.
+A block that does not inflate to its declared size, damaged base64 (a character
+outside the alphabet, padding inside a group, text that decodes to fewer bytes than
+the header announces: VTK would read zeros there) or a file changed under a loader
+is an `fepost.errors.InputFileError` naming the file and the array.
 """
 
 from __future__ import annotations

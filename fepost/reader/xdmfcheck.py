@@ -16,9 +16,13 @@ disagree). This module refuses, before meshio sees the file:
 * inline arrays whose value count differs from their ``Dimensions``;
 * ``Format="Binary"`` arrays (raw bytes named relative to the working
   directory: not read; write HDF5);
+* inline values that are not numbers of the item's type (named with the item);
 * HDF5 references to files outside the XDMF file's folder, to files that do
-  not exist or are not HDF5 (signature), to datasets the file does not hold,
-  or to datasets whose size differs from the declared ``Dimensions``.
+  not exist, are not regular files (a FIFO is never opened) or are not HDF5
+  (signature), to datasets the file does not hold, or to datasets whose size
+  differs from the declared ``Dimensions``; HDF5 links are followed one by one and
+  an external link, a virtual dataset's source or external raw storage outside
+  the folder is refused (h5py would follow it anywhere).
 
 The HDF5 files are opened with h5py for their structure only (no array is
 read). Like every check here it runs in the reading child (`fepost.reader.isolate`).

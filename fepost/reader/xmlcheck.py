@@ -3,7 +3,9 @@
 Serial files (``.vtu .vtp``), structured grids (``.vts .vtr``: the counts follow from
 the piece's ``Extent``), multi-block files (``.vtm``) and parallel files (``.pvtu
 .pvtp``). The files a ``.vtm`` or a parallel file points at must lie in its folder (or
-below), exist, have the suffix of their kind and pass these same checks.
+below), be regular files, have the suffix of their kind and pass these same checks; a
+parallel file may not list a piece twice. Attribute values are decoded in the encoding
+of the XML declaration (UTF-8 without one), as VTK's XML parser decodes them.
 """
 
 from __future__ import annotations
