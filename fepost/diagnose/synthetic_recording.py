@@ -5,7 +5,14 @@
 them) into what a rig writes: each point held for ``hold`` s at ``rate`` Hz,
 joined by linear ramps of ``ramp`` s (kinematics and forces both ramp), with
 AR(1) noise (lag-1 correlation ``rho``, stationary SD ``sd`` per force channel)
-added to every sample. `write_recording` writes it as CSV, Parquet,
+added to every sample. Every length is in seconds, so one test can be written
+at any logging rate: ``tau`` gives the noise's correlation time in seconds
+instead of ``rho`` (ρ = exp(−1/(rate·τ)), the same noise in time at every rate),
+``cutoff`` passes the force channels through a logger's anti-alias filter (a
+causal second-order Butterworth low-pass, Hz, started at rest on the first
+sample; the commanded kinematics are digital and are written as they are), and
+``repeat`` holds each written value of every channel for that many samples (a
+logger that writes faster than its converter and the controller update). `write_recording` writes it as CSV, Parquet,
 MATLAB v5 or v7.3, or TYDEX, with the rig's own channel names and units when
 asked (so the reading side's mapping is exercised).
 """
@@ -36,14 +43,25 @@ def synthetic_recording(
     sd=(0.0, 0.0, 0.0),
     rho: float = 0.9,
     seed: int = 0,
+    tau: float | None = None,
+    cutoff: float | None = None,
+    repeat: int = 1,
 ) -> dict[str, np.ndarray]:
     """The recording of ``syn``'s test points in file order (module docstring); channel -> array (SI).
 
     Also returns ``hold_id`` (the test point of each sample, −1 on ramps).
     """
+    if tau is not None:
+        if not tau > 0:
+            raise ArgumentError(f"need tau > 0 (s), got {tau}")
+        rho = float(np.exp(-1.0 / (rate * tau))) if rate > 0 else rho
     if not (rate > 0 and hold > 0 and ramp >= 0 and -1 < rho < 1):
         got = f"{rate}, {hold}, {ramp}, {rho}"
         raise ArgumentError(f"need rate, hold > 0, ramp >= 0 and |rho| < 1, got {got}")
+    if not (isinstance(repeat, (int, np.integer)) and repeat >= 1):
+        raise ArgumentError(f"need repeat >= 1 (an integer), got {repeat!r}")
+    if cutoff is not None and not 0 < cutoff < rate / 2:
+        raise ArgumentError(f"need 0 < cutoff < rate / 2 = {rate / 2:g} Hz, got {cutoff}")
     d = syn.data
     clean = np.asarray(syn.clean)
     pts = np.column_stack([d.vx, d.vy, d.wz, clean])
@@ -62,6 +80,12 @@ def synthetic_recording(
     rng = np.random.default_rng([seed, 31])
     noise = signal.lfilter([np.sqrt(1 - rho**2)], [1, -rho], rng.normal(size=(n, 3)), axis=0)
     values[:, 3:] += noise * np.asarray(sd, float)
+    if cutoff is not None:
+        sos = signal.butter(2, cutoff, fs=rate, output="sos")
+        zi = signal.sosfilt_zi(sos)[:, :, None] * values[0, 3:][None, None, :]
+        values[:, 3:] = signal.sosfilt(sos, values[:, 3:], axis=0, zi=zi)[0]
+    if repeat > 1:
+        values = values[(np.arange(n) // repeat) * repeat]
     out = {"time": np.arange(n) / rate}
     for k, name in enumerate(CHANNELS[1:]):
         out[name] = values[:, k]
