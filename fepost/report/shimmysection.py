@@ -45,7 +45,7 @@ def shimmy_section(data: ReportData, folder: Path) -> Section | None:
     (sub / "shimmy.json").write_text(to_json(result.to_dict()) + "\n", encoding="utf-8")
     import matplotlib
 
-    with matplotlib.rc_context(STYLE):
+    with matplotlib.rc_context(STYLE):  # type: ignore[arg-type]  # matplotlib types keys as Literal
         fig, ax = plt.subplots()
         stability_figure(result, ax)
         fig.tight_layout()

@@ -139,7 +139,7 @@ def save_figures(result: ShimmyResult, folder: Path) -> list[str]:
     import matplotlib.pyplot as plt
 
     names = []
-    with matplotlib.rc_context(STYLE):
+    with matplotlib.rc_context(STYLE):  # type: ignore[arg-type]  # matplotlib types keys as Literal
         for name, draw in FIGURES.items():
             if name in ("time_histories", "limit_cycle_amplitude") and not result.simulations:
                 continue
