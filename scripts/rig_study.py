@@ -1,6 +1,7 @@
 """The friction model against the FE with friction: misfit of four predictions over the rig runs.
 
     python scripts/rig_study.py [--rig meshes/rig] [--out docs/rig]
+    python scripts/rig_study.py --rig meshes/rig-aircraft --out docs/rig/aircraft
 
 Reads the slide/spin runs of ``meshes/rig/`` (``fepost.rig``: forces of the road
 on the tire from CalculiX's reactions) and compares them with
@@ -28,6 +29,16 @@ N the run's load, R the static patch radius. Writes ``misfit.csv`` (per run),
 ``table.txt`` (RMS and max per model, the identified law), figures
 ``rig_<direction>.png``, the shifts against the forces ``rig_shift.png`` and the
 forces against the sliding path, ``rig_history.png``.
+
+Two more tables in ``table.txt``: the steady state (how much |F| moves over the
+last 20 % of each run's path, in f N) and the load-transfer heights found in
+four ways (``heights``): from the runs' maps (the centre-of-pressure shifts, as
+(e)), and by least squares on the forces that the shifted static map should
+reproduce, three targets in turn: the static map moved by each run's own
+measured shift (a rigid move, so the shape change is left out), the exact
+integrals over the run's own map (c) (rigid slip, so the compliance is left
+out), and the FE reactions (as ``fepost diagnose`` fits them). The steps
+between the rows say which part of the FE's behaviour each h absorbs.
 """
 
 from __future__ import annotations
@@ -364,11 +375,112 @@ def history_figure(rig: Path, out: Path, runs: list[Path], friction: float) -> N
     plt.close(fig)
 
 
+def steady_state(runs: list[Path], friction: float, share: float = 0.2) -> list[tuple[str, float, float]]:
+    """(run, largest change of |F| over the last ``share`` of the path / fN, the same for Mz / fN R_ref)."""
+    out = []
+    for run in runs:
+        side = json.loads(run.with_suffix(".json").read_text())
+        h = side["history"]
+        path = np.array(h["path"])
+        tail = path >= (1.0 - share) * path[-1] - 1e-12
+        fn = friction * np.array(h["Fz"])[tail]
+        f = np.hypot(h["Fx"], h["Fy"])[tail] / fn
+        m = np.array(h["Mz"])[tail] / (fn * side["model"]["r_ref"])
+        out.append((run.stem, float(np.ptp(f)), float(np.ptp(m))))
+    return out
+
+
+def steady_lines(rows: list[tuple[str, float, float]], limit: float = 0.005) -> list[str]:
+    worst = max(rows, key=lambda r: r[1])
+    over = [r[0] for r in rows if r[1] >= limit]
+    return [
+        "",
+        f"Steady state: over the last 20 % of the path |F| moves by at most {worst[1]:.4f} fN "
+        f"({worst[0]}); runs at or above {limit} fN: {', '.join(over) if over else 'none'}.",
+        "",
+        "| run | max change of \\|F\\| / fN | max change of Mz / fN R_ref |",
+        "|---|---|---|",
+        *(f"| {r} | {df:.4f} | {dm:.4f} |" for r, df, dm in rows),
+    ]
+
+
+def _fit_heights(quad, kin, target, scale, R: float, friction: float) -> tuple[float, float]:
+    """(h_x, h_y) (m) that make the shifted static map reproduce ``target`` (n, 3) best.
+
+    Least squares on (Fx, Fy) / fN and Mz / fNR, each row in its own load
+    (``scale`` = N_run / N_static), f fixed: the residuals ``fepost diagnose``
+    weighs, without its noise model and its free f.
+    """
+    from scipy.optimize import least_squares
+
+    from fepost.friction.law import FrictionLaw
+    from fepost.rig.extension import ShiftLaw, predict_shifted
+
+    law = FrictionLaw(f=friction)
+    n0 = float(np.sum(quad.sigma * quad.dA))
+    unit = np.array([1.0, 1.0, 1.0 / R]) / (friction * n0 * scale[:, None])
+
+    def residual(h):
+        shift = ShiftLaw(h[0], h[1], 0.0, 0.0, (h[0], h[0]), (h[1], h[1]), 0.0, 0.0, 0.0, 0.0, len(scale))
+        r = predict_shifted(quad, *kin, law=shift, friction=law).resultants
+        pred = np.column_stack([r.Fx, r.Fy, r.Mz]) * scale[:, None]
+        return ((pred - target) * unit).ravel()
+
+    sol = least_squares(residual, x0=np.array([0.01, 0.01]), bounds=([-0.5, -0.5], [0.5, 0.5]), x_scale=0.01)
+    return float(sol.x[0]), float(sol.x[1])
+
+
+def heights(table, static, preds, shifts, shift_law, friction: float, diagnosis: Path | None) -> list[str]:
+    """Markdown: the load-transfer heights from the maps and from three force targets (module docstring)."""
+    from fepost.friction.law import FrictionLaw
+    from fepost.friction.quadrature import PressureQuadrature
+    from fepost.rig.extension import shifted_resultants
+
+    quad = PressureQuadrature.from_polar(static.static_map)
+    kin = tuple(np.array([getattr(r, k) for r in table.runs]) for k in ("vx", "vy", "wz"))
+    scale = np.array([r.reaction.N for r in table.runs]) / static.coefficients.N
+    moved = shifted_resultants(quad, *kin, dx=shifts[:, 0], dy=shifts[:, 1], law=FrictionLaw(f=friction))
+    fe = np.array([[r.reaction.Fx, r.reaction.Fy, r.reaction.Mz] for r in table.runs])
+    R = static.coefficients.R
+    rows = [("the runs' maps: centre-of-pressure shift against F / N (as (e))", shift_law.h_x, shift_law.h_y)]
+    for label, target in (
+        (
+            "forces of the static map moved by each run's own shift (rigid: no shape change)",
+            np.column_stack([moved.Fx, moved.Fy, moved.Mz]) * scale[:, None],
+        ),
+        ("forces of (c), the run's own map (shape change, rigid slip: no compliance)", preds["own"]),
+        ("forces of the FE (solver's reactions: shape change and compliance)", fe),
+    ):
+        hx, hy = _fit_heights(quad, kin, target, scale, R, friction)
+        rows.append((label, hx, hy))
+    if diagnosis is not None and diagnosis.exists():
+        values = json.loads(diagnosis.read_text()).get("parameters", {})
+        if "h_x" in values and "h_y" in values:
+            rows.append(
+                (
+                    "`fepost diagnose` on the FE reactions (f free, its noise model)",
+                    float(values["h_x"]["value"]),
+                    float(values["h_y"]["value"]),
+                )
+            )
+    return [
+        "",
+        "Load-transfer heights found in different ways (h / mm):",
+        "",
+        "| from | h_x | h_y |",
+        "|---|---|---|",
+        *(f"| {label} | {hx * 1e3:.1f} | {hy * 1e3:.1f} |" for label, hx, hy in rows),
+    ]
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rig", type=Path, default=REPO / "meshes" / "rig")
     ap.add_argument("--out", type=Path, default=REPO / "docs" / "rig")
     ap.add_argument("--friction", type=float, default=0.3)
+    ap.add_argument(
+        "--diagnosis", type=Path, default=None, help="a `fepost diagnose` diagnosis.json to compare h with"
+    )
     args = ap.parse_args(argv)
     runs = _runs(args.rig)
     if not runs:
@@ -392,6 +504,10 @@ def main(argv=None) -> int:
         ]
         with open(args.out / "table.txt", "a") as fh:
             fh.write("\n".join(head + conv) + "\n")
+    with open(args.out / "table.txt", "a") as fh:
+        fh.write("\n".join(steady_lines(steady_state(runs, args.friction))) + "\n")
+        fh.write("\n".join(heights(table, static, preds, shifts, shift_law, args.friction, args.diagnosis)))
+        fh.write("\n")
     figures(args.out, rows)
     shift_figure(args.out, table, shifts, shift_law)
     history_figure(args.rig, args.out, runs, args.friction)

@@ -223,7 +223,7 @@ def write_run(
             "force": _vec(f),
             "moment": _vec(h.rot_rf[-1]),
             "rim_force": _vec(h.bead_rf[-1]),
-            "time": _num(h.time[-1] + 2.0, 7),
+            "time": _num(h.time[-1] + tire.slide_start, 7),
             "source": f"CalculiX .dat, last increment of the slide step ({res.name}.dat.txt): RF of "
             "the rigid road's reference node (force) and rotation node (moment)",
             "sign": "RF at the road's nodes = force (moment) of the road on the tire, in the road's "

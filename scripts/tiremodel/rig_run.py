@@ -124,9 +124,9 @@ def solve_base(
     inp = workdir / "base.inp"
     nodes = rd.write_base_deck(inp, mesh, rim_travel, (0.0, 0.0), tire)
     t = _solve_once(exe, inp, "")
-    contact, u = _nodal(mesh, inp.with_suffix(".frd"), 2)
+    contact, u = _nodal(mesh, inp.with_suffix(".frd"), 1 if tire.one_step else 2)
     recs = [r for r in read_dat_blocks(inp.with_suffix(".dat")) if r[0] == "forces" and r[1] == "REFN"]
-    load = next(arr[-1, -3:] for _, _, t_, arr in recs if abs(t_ - SLIDE_START) < 1e-9)
+    load = next(arr[-1, -3:] for _, _, t_, arr in recs if abs(t_ - tire.slide_start) < 1e-9)
     return Base(
         nodes=nodes,
         restart=inp.with_suffix(".rout"),
@@ -138,14 +138,14 @@ def solve_base(
     )
 
 
-def _history(dat: Path) -> History:
+def _history(dat: Path, start: float = SLIDE_START) -> History:
     blocks = read_dat_blocks(dat)
     rows: dict[tuple[str, str], dict[float, np.ndarray]] = {}
     for kind, name, t, arr in blocks:
-        if t > SLIDE_START + 1e-9 or (kind, name) == ("total force", "BEAD"):
+        if t > start + 1e-9 or (kind, name) == ("total force", "BEAD"):
             rows.setdefault((kind, name), {})[t] = arr[-1, -3:]
     key_u, key_f = "displacements", "forces"
-    times = sorted(t for t in rows.get((key_f, "REFN"), {}) if t > SLIDE_START + 1e-9)
+    times = sorted(t for t in rows.get((key_f, "REFN"), {}) if t > start + 1e-9)
     if not times:
         raise ModelError(f"no reactions of the slide step in {dat.name}")
 
@@ -154,7 +154,7 @@ def _history(dat: Path) -> History:
         return np.array([d[t] for t in times])
 
     return History(
-        time=np.array(times) - SLIDE_START,
+        time=np.array(times) - start,
         ref_u=stack(key_u, "REFN"),
         ref_rf=stack(key_f, "REFN"),
         rot_u=stack(key_u, "ROTN"),
@@ -192,7 +192,7 @@ def solve_run(
         name=name,
         kin=kin,
         nodes=base.nodes,
-        history=_history(inp.with_suffix(".dat")),
+        history=_history(inp.with_suffix(".dat"), tire.slide_start),
         static_load=base.static_load,
         static_cpress=base.static_cpress,
         static_u=base.static_u,
