@@ -119,3 +119,28 @@ def test_shimmy_end_to_end_writes_the_contract(tmp_path, capsys):
         "limit_cycle_amplitude.png",
     ):
         assert (out / fig).stat().st_size > 1000, fig
+
+
+def test_report_section_from_a_gear_file(aircraft, tmp_path):
+    from types import SimpleNamespace
+
+    from fepost.report.shimmysection import shimmy_section
+
+    assert shimmy_section(SimpleNamespace(analysis=aircraft, gear=None), tmp_path) is None
+    section = shimmy_section(SimpleNamespace(analysis=aircraft, gear=str(EXAMPLE)), tmp_path)
+    assert section is not None and section.key == "shimmy"
+    head, *rows = section.table
+    assert [r[0] for r in rows] == ["closed_forms", "generalised", "exact"]
+    assert float(rows[0][1]) < float(rows[2][1]), "closed forms below the exact integrals on this tire"
+    data = json.loads((tmp_path / "shimmy" / "shimmy.json").read_text())
+    assert data["simulations"] == []
+    assert (tmp_path / "shimmy_stability.png").is_file()
+
+
+def test_report_refuses_a_bad_gear_file_before_work(tmp_path, capsys):
+    gear = _gear(tmp_path, change={"lateral_damping": -1.0})
+    out = tmp_path / "rep"
+    assert main(["report", str(STATIC), "--gear", str(gear), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "lateral_damping must be >= 0" in err and str(gear) in err
+    assert not out.exists()
