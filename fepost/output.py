@@ -18,6 +18,10 @@ this host, whose process is gone or started after the entry was last touched
 
 `check_replaceable` refuses to replace a folder that holds the run's own
 inputs, the current folder, the home folder or the file-system root.
+
+A file named ``-`` (`STDOUT`, given as a string) is standard output:
+`write_text_atomic` writes the text there (a file really named ``-`` is ``./-``);
+`staged_folder` refuses ``-``, a folder cannot be standard output.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ import re
 import secrets
 import shutil
 import signal
+import sys
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -133,12 +138,26 @@ def remove_stale_temporaries(folder: str | Path) -> list[Path]:
     return removed
 
 
+#: The output name that means standard output (files only; ``./-`` is a file named ``-``).
+STDOUT = "-"
+
+
+def is_stdout(path: str | Path | None) -> bool:
+    """True when ``path`` is the string `STDOUT` (a `Path` never is: ``Path("./-")`` prints as ``-``)."""
+    return isinstance(path, str) and path == STDOUT
+
+
 def _folder_of(path: Path) -> Path:
     return path.parent if str(path.parent) else Path(".")
 
 
 def write_text_atomic(path: str | Path, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same folder, then rename."""
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same folder, then
+    rename; to standard output when ``path`` is `STDOUT` (``-``)."""
+    if is_stdout(path):
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return Path(STDOUT)
     given = Path(path)
     path = Path(os.path.realpath(given)) if given.is_symlink() else given  # keep the link
     folder = _folder_of(path)
@@ -286,6 +305,8 @@ def staged_folder(
     home folder is always refused (`check_replaceable`). On any error or
     interruption the temporary folder is removed and ``out`` is left as it was.
     """
+    if str(out) == STDOUT:  # also Path("-"): a folder is never standard output
+        raise OutputError(f"{STDOUT}: an output folder cannot be standard output; give a folder name")
     out = Path(os.path.realpath(out)) if Path(out).is_symlink() else Path(out)
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: exists and is not a folder")

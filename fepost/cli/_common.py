@@ -3,12 +3,25 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
+from typing import TextIO
 
 from ..errors import ArgumentError
 from ..options import DEFAULT_FRICTION, FRICTION_RANGE, AnalysisOptions
 from ..reader.units import SYSTEMS  # a light module: no numpy
 from . import _validate as v
+
+
+def summary_stream(*outputs: str | None) -> TextIO:
+    """Where a command's human summary goes: standard error when one of its data ``outputs``
+    is standard output (``-``, `fepost.output.STDOUT`), so that stdout holds the data alone."""
+    return sys.stderr if any(o == "-" for o in outputs) else sys.stdout
+
+
+def output_name(path: str) -> str:
+    """``path`` as a summary names it: ``standard output`` for ``-``."""
+    return "standard output" if path == "-" else path
 
 
 def repo_meshes() -> Path:

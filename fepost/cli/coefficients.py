@@ -27,7 +27,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument("--rolling", metavar="ROLLING", help="rolling contact map at the same deflection")
     add_friction_option(p)
-    p.add_argument("--json", metavar="PATH", help="write the coefficients as JSON")
+    p.add_argument("--json", metavar="PATH", help="write the coefficients as JSON (- for standard output)")
     add_input_options(p)
     p.set_defaults(func=run)
 
@@ -121,8 +121,9 @@ def run(args: argparse.Namespace) -> int:
         for p in pending:
             p.cancel()
     from ..output import write_json_atomic
+    from ._common import summary_stream
 
-    print(format_analysis(result))
+    print(format_analysis(result), file=summary_stream(args.json))
     if args.json:
         write_json_atomic(args.json, result.to_dict())
     return 0

@@ -39,19 +39,28 @@ def add_parser(sub) -> None:
         help="CSV with columns vx, vy (m/s) and wz (rad/s); other columns are ignored",
     )
     add_friction_option(p)
-    p.add_argument("--out", required=True, metavar="CSV", help="output CSV (written atomically)")
-    p.add_argument("--model-json", metavar="PATH", help="also write the generalised model's coefficients")
+    p.add_argument(
+        "--out", required=True, metavar="CSV", help="output CSV (written atomically; - for standard output)"
+    )
+    p.add_argument(
+        "--model-json",
+        metavar="PATH",
+        help="also write the generalised model's coefficients (- for standard output)",
+    )
     add_input_options(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..analysis import analyse
+    from ..errors import ArgumentError
     from ..friction.law import FrictionLaw
     from ..friction.predict import predict, read_kinematics
     from ..output import write_text_atomic
-    from ._common import analysis_options
+    from ._common import analysis_options, output_name, summary_stream
 
+    if args.out == "-" and args.model_json == "-":
+        raise ArgumentError("--out - and --model-json -: only one of them can be standard output")
     kin = read_kinematics(args.kinematics)  # bad CSV: fail before the FE work
     result = analyse(args.static, args.rolling, friction=args.friction, options=analysis_options(args))
     rolling = result.rolling_map is not None
@@ -66,7 +75,8 @@ def run(args: argparse.Namespace) -> int:
         write_text_atomic(args.model_json, pred.model.to_json() + "\n")
     acc = summary.map_accuracy(rolling)  # the figure fepost coefficients and the report state
     print(
-        f"{len(kin)} rows -> {args.out} ({pred.map} map, R = {result.coefficients.R:.6g} m); "
-        f"generalised model {acc.sentence()}"
+        f"{len(kin)} rows -> {output_name(args.out)} ({pred.map} map, R = {result.coefficients.R:.6g} m); "
+        f"generalised model {acc.sentence()}",
+        file=summary_stream(args.out, args.model_json),
     )
     return 0

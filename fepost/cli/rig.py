@@ -23,19 +23,26 @@ def add_parser(sub) -> None:
         ),
     )
     p.add_argument("runs", nargs="+", metavar="RUN", help="FE exports of rig runs (.vtu with <run>.json)")
-    p.add_argument("--out", required=True, metavar="CSV", help="output CSV (written atomically)")
+    p.add_argument(
+        "--out", required=True, metavar="CSV", help="output CSV (written atomically; - for standard output)"
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from ..output import write_text_atomic
     from ..rig import rig_table
+    from ._common import output_name, summary_stream
 
     table = rig_table(args.runs)
     write_text_atomic(args.out, table.to_csv())
     d = table.max_shear_difference()
+    say = summary_stream(args.out)
+    for path, why in table.skipped:
+        print(f"note: {path} skipped: {why}", file=say)
     print(
-        f"{len(table.runs)} runs -> {args.out}; reactions vs shear-traction integrals: "
-        f"max |dF| = {d['F']:.3g} N, max |dMz| = {d['Mz']:.3g} N m"
+        f"{len(table.runs)} runs -> {output_name(args.out)}; reactions vs shear-traction integrals: "
+        f"max |dF| = {d['F']:.3g} N, max |dMz| = {d['Mz']:.3g} N m",
+        file=say,
     )
     return 0

@@ -67,12 +67,16 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import ArgumentError
+    from ..output import is_stdout
     from ..report.sweeppage import write_trends
     from ..sweep import run_sweep
+    from ..sweep.trends import load_trends, trend_lines
     from . import FAILED_INPUTS, OK, Terminated
     from ._common import analysis_options
 
     options = analysis_options(args)
+    if is_stdout(args.out):
+        raise ArgumentError("--out -: the sweep writes a folder, which cannot be standard output")
     if args.step is not None and args.steps == "all":
         raise ArgumentError("--step N picks one time step of every file; it cannot go with --steps all")
     steps = args.step if args.step is not None else (args.steps or "last")
@@ -104,11 +108,18 @@ def run(args: argparse.Namespace) -> int:
     for r in result.rows:
         if r["also_as"]:
             print(f"note: {r['source']} read; the same case also as {r['also_as']} (not read)")
+        if r.get("rolling_also_as"):
+            print(
+                f"note: {r['rolling']} read as the rolling map of {r['source']}; the same rolling case "
+                f"also as {r['rolling_also_as']} (not read)"
+            )
         if r["role"] == "rolling" and r["step"] in (None, 0):
             print(
                 f"note: {r['source']} is a rolling map without its static map among the inputs: "
                 "listed apart (role rolling), not a load point of the trends"
             )
+    for line in trend_lines(load_trends(result.rows)):  # the fits the trends page draws
+        print(line)
     print(f"table: {result.csv}  {result.parquet}")
     if result.trends is not None:
         print(f"trends: {result.trends}")

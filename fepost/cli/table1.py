@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 
 from . import _validate as v
-from ._common import add_friction_option, add_input_options, analysis_options
+from ._common import add_friction_option, add_input_options, analysis_options, summary_stream
 
 #: The committed seed of ``fepost table1`` (`fepost.table1.DEFAULT_SEED`).
 SEED = v.LibraryDefault("fepost.table1", "DEFAULT_SEED")
@@ -41,7 +41,7 @@ def add_parser(sub) -> None:
         help="rolling contact map (default: meshes/aircraft/rolling_100.vtu when --static is not given)",
     )
     p.add_argument("--seed", type=v.seed, default=SEED, metavar="S", help="noise seed (default %(default)s)")
-    p.add_argument("--json", metavar="PATH", help="write the table as JSON")
+    p.add_argument("--json", metavar="PATH", help="write the table as JSON (- for standard output)")
     p.add_argument(
         "--source",
         choices=("closed_form", "exact"),
@@ -103,10 +103,11 @@ def run(args: argparse.Namespace) -> int:
         span=args.span,
         k_x=args.k_x,
     )
-    print(f"static map: {result.static_field.source}")
+    say = summary_stream(args.json)
+    print(f"static map: {result.static_field.source}", file=say)
     if result.rolling_field is not None:
-        print(f"rolling map: {result.rolling_field.source}")
-    print(format_table(t))
+        print(f"rolling map: {result.rolling_field.source}", file=say)
+    print(format_table(t), file=say)
     if args.json:
         d = t.to_dict()
         d["inputs"] = {

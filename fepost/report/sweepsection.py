@@ -160,8 +160,8 @@ def sweep_provider(
         if own is not None and same:
             pr = pairings[own]
             job = Job(pr.static.given, pr.static.path, None, options, rolling=pr.rolling,
-                      rolling_given=pr.rolling_given, role=pr.role, also=pr.static.also + pr.rolling_also,
-                      friction=friction)  # fmt: skip
+                      rolling_given=pr.rolling_given, role=pr.role, also=pr.static.also,
+                      rolling_also=pr.rolling_also, friction=friction)  # fmt: skip
             with WorkFolder(out, force=True) as work:
                 work.save_row(job.key(), analysis_row(job, data.analysis))
         result = run_sweep(

@@ -84,6 +84,22 @@ def _load(run: Path) -> dict:
     return data
 
 
+def not_a_run(path) -> str | None:
+    """Why the export ``path`` is no slide/spin run although its sidecar reads (a sidecar with
+    neither ``kinematics`` nor ``reaction``: the static reference map of a rig folder), or
+    None when it is one or its sidecar is faulty (`read_run` then says how)."""
+    run = Path(path)
+    try:
+        data = _load(run)
+    except (InputFileError, DataError):
+        return None
+    if "kinematics" in data or "reaction" in data:
+        return None
+    what = f" (case {data['case']!r})" if isinstance(data.get("case"), str) else ""
+    side = sidecar_path(run).name
+    return f"its sidecar {side}{what} has no kinematics and no reaction: not a slide/spin run"
+
+
 def _number(side: Path, where: str, value) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise DataError(f"{side}: {where} must be a number, got {value!r}")

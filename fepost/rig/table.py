@@ -16,16 +16,18 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..errors import ArgumentError
-from .run import RigRun, read_run
+from .run import RigRun, not_a_run, read_run
 
 COLUMNS = ("vx", "vy", "wz", "Fx", "Fy", "Mz", "N", "source", "Fx_shear", "Fy_shear", "Mz_shear", "N_shear")
 
 
 @dataclass(frozen=True)
 class RigTable:
-    """The rows of the rig CSV, one per run, in the order given."""
+    """The rows of the rig CSV, one per run, in the order given; ``skipped``: (path, why) of
+    the exports given that are no slide/spin runs (a static reference map caught by a glob)."""
 
     runs: tuple[RigRun, ...]
+    skipped: tuple[tuple[str, str], ...] = ()
 
     def rows(self) -> list[dict]:
         out = []
@@ -56,11 +58,22 @@ class RigTable:
         return dif
 
     def to_dict(self) -> dict:
-        return {"runs": [r.to_dict() for r in self.runs]}
+        return {
+            "runs": [r.to_dict() for r in self.runs],
+            "skipped": [{"source": p, "reason": why} for p, why in self.skipped],
+        }
 
 
 def rig_table(paths: Sequence, *, shear: bool = True) -> RigTable:
-    """Read every rig run of ``paths`` (see ``fepost.rig.run``) into a table."""
+    """Read every rig run of ``paths`` (see ``fepost.rig.run``) into a table; an export whose
+    sidecar holds neither kinematics nor a reaction (`not_a_run`) is skipped and listed in
+    ``skipped``. `ArgumentError` when no path is a run."""
     if not paths:
         raise ArgumentError("no rig runs given")
-    return RigTable(runs=tuple(read_run(p, shear=shear) for p in paths))
+    reasons = [not_a_run(p) for p in paths]
+    skipped = tuple((str(p), why) for p, why in zip(paths, reasons, strict=True) if why is not None)
+    runs = [p for p, why in zip(paths, reasons, strict=True) if why is None]
+    if not runs:
+        path, why = skipped[0]
+        raise ArgumentError(f"no slide/spin run among the {len(paths)} exports given: {path}: {why}")
+    return RigTable(runs=tuple(read_run(p, shear=shear) for p in runs), skipped=skipped)

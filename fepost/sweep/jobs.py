@@ -60,6 +60,8 @@ class Job:
         listed apart and left out of the load trends).
     also : tuple of str
         Other files of the same case (other formats), not read.
+    rolling_also : tuple of str
+        Other files of the rolling map's case (other formats), not read.
     """
 
     source: str
@@ -73,6 +75,7 @@ class Job:
     role: str = "static"
     also: tuple[str, ...] = ()
     friction: float = DEFAULT_FRICTION
+    rolling_also: tuple[str, ...] = ()
 
     def key(self) -> str:
         """Identity of the row: inputs, their size and modification time, step and options."""
@@ -86,7 +89,7 @@ class Job:
             _stamp(None if self.path is None else str(sidecar_path(self.path))),
             self.error,
             self.role,
-            list(self.also),
+            list(self.also + self.rolling_also),  # as when they were one list: earlier rows keep their keys
         ]
         return hashlib.sha1(json.dumps(ident, sort_keys=True).encode()).hexdigest()
 
@@ -98,6 +101,7 @@ class Job:
             "time": self.time,
             "role": self.role,
             "also_as": " ".join(self.also),
+            "rolling_also_as": " ".join(self.rolling_also),
         }
 
 

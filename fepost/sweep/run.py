@@ -167,7 +167,8 @@ def _jobs(
             rolling=pr.rolling,
             rolling_given=pr.rolling_given,
             role=pr.role,
-            also=src.also + pr.rolling_also,
+            also=src.also,
+            rolling_also=pr.rolling_also,
             friction=friction,
         )
         if src.error is not None or src.path is None:

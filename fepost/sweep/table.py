@@ -36,6 +36,7 @@ COLUMNS: tuple[Column, ...] = (
         "role", "str", "", "static (a load point) or rolling (an unpaired rolling map, not in the trends)"
     ),
     Column("also_as", "str", "", "other files of the same case (same stem, other formats), not read"),
+    Column("rolling_also_as", "str", "", "other files of the rolling map's case (other formats), not read"),
     Column("step", "int", "", "Exodus time step read (0-based); empty for files without time steps"),
     Column("time", "float", "s", "time value of that step (the solver's time unit)"),
     Column("status", "str", "", "ok or error"),
@@ -104,7 +105,7 @@ def normalise(row: Mapping) -> dict:
     for c in COLUMNS:
         v = row.get(c.name)
         if v is None or (isinstance(v, float) and math.isnan(v)):
-            v = "" if c.name in ("error", "warnings", "rolling", "also_as") else None
+            v = "" if c.name in ("error", "warnings", "rolling", "also_as", "rolling_also_as") else None
         elif c.kind == "float":
             v = float(v)
         elif c.kind == "int":

@@ -201,3 +201,30 @@ def load_trends(rows: Sequence[Mapping]) -> list[PowerLaw]:
                 )
             )
     return fits
+
+
+def _fraction(value: float) -> str:
+    """A Hertz exponent as the fraction it is (1/3, 4/3, -2/3), else to 3 decimals."""
+    for den in (1, 2, 3, 4, 6):
+        if abs(value * den - round(value * den)) < 1e-12:
+            num = round(value * den)
+            return f"{num}/{den}" if den > 1 else f"{num}"
+    return f"{value:.3f}"
+
+
+def trend_lines(fits: Sequence[PowerLaw]) -> list[str]:
+    """One plain-text line per fit, for a console: y ~ N^alpha, its 95 % interval, R² in log
+    space, the Hertz exponent; or why it was not fitted."""
+    lines = []
+    for f in fits:
+        label = f.label.replace("²", "^2")
+        where = "" if f.group == "all" else f" ({f.group})"
+        if not f.fitted or f.ci95 is None:
+            lines.append(f"trend{where}: {label}: no fit, {f.note}")
+            continue
+        hertz = "" if f.hertz is None else f", Hertz {_fraction(f.hertz)}"
+        lines.append(
+            f"trend{where}: {label} ~ N^{f.exponent:.3f}  (95 % {f.ci95[0]:.3f} to {f.ci95[1]:.3f}, "
+            f"r^2 = {f.r2:.4f}, {f.n} loads{hertz})"
+        )
+    return lines
