@@ -55,7 +55,8 @@ def summary_text(diag) -> str:
     if lof:
         verdict = "DETECTED" if lof["detected"] else "none"
         lines.append(
-            f"lack of fit: {verdict}: {lof['message']} ({lof['test']}, Holm p = {lof['p_value']:.2g})"
+            f"lack of fit: {verdict}: {lof['message']}. "
+            f"Strongest test: {lof['test']}, Holm p = {lof['p_value']:.2g}"
         )
     lines += _outlier_lines(diag)
     if diag.noise:
