@@ -2,7 +2,7 @@
 
 Each adapter is a `Contact`: ``forces(vx, vy, wz)`` gives the friction force
 (Fx, Fy in N) and torque (Mz in N·m about the patch origin) on one tire in its
-patch frame (x rolling direction, y lateral; THEORY §1, §3) for the sliding
+patch frame (x rolling direction, y lateral; docs/theory.md) for the sliding
 velocity (vx, vy) of the patch origin and the spin wz, as `fepost.friction.predict`
 evaluates them:
 
