@@ -144,3 +144,12 @@ def test_report_refuses_a_bad_gear_file_before_work(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "lateral_damping must be >= 0" in err and str(gear) in err
     assert not out.exists()
+
+
+def test_speed_range_must_increase(tmp_path, capsys):
+    argv = ["shimmy", str(STATIC), "--gear", str(EXAMPLE), "--out", str(tmp_path / "o")]
+    assert main([*argv, "--speed-min", "50", "--speed-max", "20"]) == 2
+    err = capsys.readouterr().err
+    assert err == "fepost: error: argument --speed-max: must be above --speed-min (50), got 20\n"
+    assert main([*argv, "--speeds", "1"]) == 2
+    assert "--speeds" in capsys.readouterr().err
