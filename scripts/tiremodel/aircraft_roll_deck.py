@@ -44,6 +44,7 @@ ROLL_TIME = 2.0  # analysis time of the rolling stage
 LOAD_TIME = 1.0  # analysis time of the vertical road travel
 MAX_INC = 0.05  # largest increment (analysis time)
 FIRST_INC = 0.02  # the first (inflation) increment: 0.05 diverged and was cut back twice
+DENSITY_RUBBER = 1150.0  # kg/m^3, tire materials (only written for the damped *DYNAMIC variant)
 TOLERANCES = (0.02, 0.5)  # CalculiX R_n, C_n: as the static sweep's fine runs
 
 
@@ -64,6 +65,8 @@ class RollPlan:
     road_length: float = 1.6  # m, along x; the block starts 0.4 m behind the axle
     road_half_width: float = 0.3  # m, along y (half model: y in [0, 0.3])
     drive_stiffness: float | None = None
+    damping_beta: float | None = None  # s: Rayleigh stiffness damping of the tread (*DYNAMIC step)
+    max_inc: float = MAX_INC  # largest increment (analysis time); larger only for quick test decks
 
 
 def output_times(plan: RollPlan) -> dict[str, float]:
@@ -108,7 +111,7 @@ def write_roll_deck(path, mesh: AircraftMesh, plan: RollPlan) -> dict:
         }
     )
     out += cx.contact_surfaces(mesh.hexes, mesh.contact_quads, road, table)
-    out += _materials(mesh)
+    out += _materials(mesh, plan.damping_beta)
     out.append(f"*RIGID BODY, NSET=BEAD, REF NODE={refn}, ROT NODE={rotn}")
     if plan.drive_stiffness is not None:
         out += [
@@ -150,15 +153,23 @@ def _elements(mesh: AircraftMesh, road: cx.Road) -> list[str]:
     return out
 
 
-def _materials(mesh: AircraftMesh) -> list[str]:
+def _materials(mesh: AircraftMesh, beta: float | None = None) -> list[str]:
+    """Materials and sections; with ``beta`` also densities (a *DYNAMIC step needs them)
+    and Rayleigh stiffness damping (``*DAMPING, BETA``) on the tread rubber."""
+    dens = [] if beta is None else ["*DENSITY", f"{DENSITY_RUBBER:g}"]
     out: list[str] = []
     for name, r in ad.RUBBER.items():
         out += [f"*MATERIAL, NAME={name}", "*HYPERELASTIC, NEO HOOKE"]
         out.append(f"{r['shear_modulus'] / 2:.6e}, {2.0 / r['bulk_modulus']:.6e}")
+        out += dens
+        if beta is not None and name == "TREAD":
+            out += [f"*DAMPING, ALPHA=0.0, BETA={beta:.6e}"]
     for name, c in ad.CARCASS.items():
         out += [f"*MATERIAL, NAME={name}", "*ELASTIC, TYPE=ENGINEERING CONSTANTS"]
         out += [", ".join(f"{v:.6e}" for v in c[:8]), f"{c[8]:.6e}"]
-    out += [*cx.ROAD_MATERIAL, "*SOLID SECTION, ELSET=ETREAD, MATERIAL=TREAD"]
+        out += dens
+    out += [*cx.ROAD_MATERIAL, *([] if beta is None else ["*DENSITY", "7850."])]
+    out += ["*SOLID SECTION, ELSET=ETREAD, MATERIAL=TREAD"]
     out += ["*SOLID SECTION, ELSET=ESIDEWALL, MATERIAL=SIDEWALL", cx.ROAD_SECTION]
     for e in np.flatnonzero(mesh.layer == 1):
         a, b = mesh.meridian[e], mesh.circumferential[e]
@@ -191,8 +202,8 @@ def _amplitudes_and_step(mesh: AircraftMesh, plan: RollPlan, times: dict[str, fl
         "DRVN, 1, 1",
         "DRVN, 3, 3",
         "*STEP, NLGEOM, INC=5000",
-        "*STATIC",
-        f"{FIRST_INC}, {t2:.6f}, 1e-8, {MAX_INC}",
+        "*STATIC" if plan.damping_beta is None else "*DYNAMIC",
+        f"{min(FIRST_INC, plan.max_inc)}, {t2:.6f}, 1e-8, {plan.max_inc}",
         "*CONTROLS, PARAMETERS=FIELD",
         f"{TOLERANCES[0]}, {TOLERANCES[1]}",
         "*CONTROLS, PARAMETERS=TIME INCREMENTATION",
