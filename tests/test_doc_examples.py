@@ -8,6 +8,8 @@ the markers, the options and the tolerances are explained). After a change of ou
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from tests import docexamples as dx
@@ -160,3 +162,104 @@ def test_update_rewrites_only_the_output_lines(tmp_path):
         dx.differences(list(dx.blocks("x.md", text)[0].commands()[0].expected), new, block.options, 1e-3, 110)
         == []
     )
+
+
+# ---------------------------------------------------------------- one accuracy figure per map
+PERCENT = re.compile(
+    r"within ([\d.]+)% of the exact integrals \(largest \|dF\|/F0 ([\d.]+)%, \|dMz\|/M0 ([\d.]+)%"
+)
+
+
+def _stated(text: str) -> set[tuple[float, ...]]:
+    return {tuple(float(v) for v in m) for m in PERCENT.findall(text)}
+
+
+@pytest.fixture(scope="module")
+def small_analysis():
+    import fepost
+
+    return fepost.analyse(str(dx.REPO / "meshes" / "static.vtu"), str(dx.REPO / "meshes" / "rolling.vtu"))
+
+
+def test_the_stated_accuracy_is_the_direct_error_map_on_the_same_grid(small_analysis):
+    """The turned sums of the stated accuracy give the direct `model_error_map`'s numbers."""
+    import numpy as np
+
+    from fepost.friction.law import FrictionLaw
+    from fepost.friction.summary import ACCURACY_GRID, model_error_map
+
+    a = small_analysis
+    turned = a.model_summary.rolling_errors
+    direct = model_error_map(
+        a.rolling_map,
+        a.coefficients,
+        FrictionLaw(f=a.coefficients.f),
+        model=a.model_summary.rolling,
+        rolling=True,
+        **ACCURACY_GRID,
+    )
+    assert turned.beta.shape == direct.beta.shape and np.allclose(
+        turned.beta, direct.beta, rtol=0, atol=1e-12
+    )
+    for name in direct.names:
+        assert np.allclose(turned.force[name], direct.force[name], rtol=0, atol=1e-12), name
+        assert np.allclose(turned.torque[name], direct.torque[name], rtol=0, atol=1e-12), name
+    # denser than the model's own check grid, so never below its largest errors by more than a grid step
+    acc = a.model_summary.accuracy
+    assert acc.model >= 0.9 * max(
+        a.model_summary.static.accuracy["model_force"], a.model_summary.static.accuracy["model_torque"]
+    )
+
+
+@pytest.mark.slow
+def test_coefficients_predict_and_report_state_one_figure_per_map(small_analysis, tmp_path, capsys):
+    """`fepost coefficients`, `fepost predict` (static and rolling) and the report state the same
+    figure for the same maps, all from the model summary's error maps."""
+    from fepost.cli import main
+    from fepost.report.build import _error_maps, quote_error_maps
+
+    static, rolling = (str(dx.REPO / "meshes" / f) for f in ("static.vtu", "rolling.vtu"))
+    summary = small_analysis.model_summary
+    kin = tmp_path / "kin.csv"
+    kin.write_text("vx,vy,wz\n0.1,0,1\n0,0.2,2\n")
+
+    def printed(*argv: str) -> str:
+        assert main(list(argv)) == 0
+        return capsys.readouterr().out
+
+    coef = printed("coefficients", static, "--rolling", rolling)
+    pred_static = printed("predict", static, "--kinematics", str(kin), "--out", str(tmp_path / "p.csv"))
+    pred_rolling = printed(
+        "predict", static, "--rolling", rolling, "--kinematics", str(kin), "--out", str(tmp_path / "q.csv")
+    )
+
+    def figures(acc) -> tuple[float, ...]:
+        return tuple(round(100 * v, 1) for v in (acc.model, acc.model_force, acc.model_torque))
+
+    both, alone, roll = summary.accuracy, summary.map_accuracy(), summary.map_accuracy(True)
+    assert _stated(coef) == {figures(both)}
+    assert _stated(pred_static) == {figures(alone)} and "over the static map on" in pred_static
+    assert _stated(pred_rolling) == {figures(roll)} and "over the rolling map on" in pred_rolling
+    assert f"{alone.model_force:.3f}, |dMz|/M0 {alone.model_torque:.3f}" in coef
+    assert f"{roll.model_force:.3f}, |dMz|/M0 {roll.model_torque:.3f}" in coef
+    # the report: its error maps are these, its recommendation the same sentence
+    _, docs = _error_maps(small_analysis, tmp_path)
+    assert docs["error_map"]["worst"]["model"]["force"] == alone.model_force
+    assert docs["error_map_rolling"]["worst"]["model"]["torque"] == roll.model_torque
+    ctx = {"model_rows": [], "model_recommendation": "placeholder"}
+    quote_error_maps(ctx, docs, summary)
+    assert _stated(ctx["model_recommendation"]) == {figures(both)}
+
+
+def test_the_pages_quote_the_figure_their_checked_output_states():
+    """Prose "within X %" and "miss by up to Y %" on a page equal the stated figure in the
+    page's checked `fepost coefficients` output (which the slow tests compare with a real run)."""
+    for page in ("docs/tutorial.md",):
+        text = (dx.REPO / page).read_text(encoding="utf-8")
+        block = next(b for b in dx.blocks(page) if "fepost coefficients" in "\n".join(b.body))
+        use = "\n".join(block.body)
+        (within,) = re.findall(r"within ([\d.]+)% of the exact integrals", use)
+        (paper,) = re.findall(r"miss by up to (\d+)%", use)
+        prose = text.replace("\n".join(block.body), "")
+        assert re.findall(r"within ([\d.]+) % of the exact", prose) == [within], page
+        assert re.findall(r"miss by up to (\d+) %", prose) == [paper], page

@@ -559,7 +559,7 @@ def test_report_error_maps_quote_their_json(report):
     for stem, tag in (("error_map", "static"), ("error_map_rolling", "rolling")):
         doc = json.loads((out / f"{stem}.json").read_text())
         assert alts[(out / f"{stem}.png").read_bytes()].startswith(f"Error map of the {tag} map")
-        assert (len(doc["beta_deg"]), len(doc["t"])) == (19, 33)
+        assert (len(doc["beta_deg"]), len(doc["t"])) == (33, 33)  # summary.ACCURACY_GRID
         for name in ("paper", "base", "model"):
             for q in ("force", "torque"):
                 quoted = page.values[f"{stem}.worst.{name}.{q}"]

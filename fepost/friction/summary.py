@@ -42,14 +42,17 @@ from .quadrature import PressureQuadrature
 
 #: Where the model and its export format are explained.
 DOCS = "docs/model.md"
-#: The grid of every stated accuracy (`model_error_map`'s n_beta, n_t): the report's error
-#: maps. 19 sliding directions 0–180° (10° steps) × both spin signs × 33 points from pure
-#: spin to pure sliding: 1254 kinematic points per map, denser than the model's check grid
-#: (1056), whose largest errors it exceeds (aircraft tire, static map: 0.68 % there,
-#: 0.81 % here). ~0.2–0.4 s per map.
-ACCURACY_GRID = {"n_beta": 19, "n_t": 33}
-#: How the sentences name that grid.
-ACCURACY_GRID_NAME = "error-map grid: sliding direction every 10°, both spin signs, 33 sliding/spin ratios"
+#: The grid of every stated accuracy (`accuracy_error_map`; n_beta, n_t as `model_error_map`'s):
+#: 33 sliding directions 0–180° (5.625° steps) × both spin signs × 33 points from pure spin to
+#: pure sliding, 2178 kinematic points per map: denser than the model's check grid (1056
+#: points), whose largest errors it exceeds (aircraft tire, static map: 0.68 % there, 0.81 %
+#: here). Its 2 (n_beta − 1) = 64 directions over a full turn divide the polar map's 128
+#: angles, so the exact integrals are turned sums (`fepost.friction.turns`): about 1/64 of
+#: the direct work.
+ACCURACY_GRID = {"n_beta": 33, "n_t": 33}
+ACCURACY_GRID_NAME = (
+    "error-map grid: 33 sliding directions 0-180 deg, both spin signs, 33 sliding/spin ratios"
+)
 
 
 def check_map_values(pmap, coefficients, law) -> None:
@@ -204,7 +207,7 @@ class ModelSummary:
         pmap, model = (rolling_map, self.rolling) if rolling else (static_map, self.static)
         if pmap is None or model is None:
             return None
-        return model_error_map(pmap, coefficients, law, model=model, rolling=rolling, **ACCURACY_GRID)
+        return accuracy_error_map(pmap, coefficients, law, model=model, rolling=rolling)
 
     @cached_property
     def static_errors(self):
@@ -393,4 +396,54 @@ def model_error_map(
         R=c.R,
         n_beta=n_beta,
         n_t=n_t,
+    )
+
+
+def accuracy_error_map(
+    pmap: PolarMap,
+    coefficients: Coefficients,
+    law: FrictionLaw,
+    *,
+    model: GeneralisedModel,
+    rolling: bool = False,
+):
+    """`model_error_map` on `ACCURACY_GRID`, its exact integrals as turned sums.
+
+    The grid's directions β (0–180°) are the first half of T = 2 (n_beta − 1) directions
+    over a full turn; each spin sign's T × n_t points are laid out as T turned groups
+    (`fepost.friction.exact.friction_resultants`' ``turns``), the same numbers as
+    `model_error_map` to round-off (tests/test_doc_examples.py compares them).
+    """
+    from .exact import friction_resultants
+    from .sphere import ErrorMap
+
+    check_map_values(pmap, coefficients, law)
+    if not isinstance(model, GeneralisedModel):
+        raise ArgumentError(f"model must be a GeneralisedModel, got {type(model).__name__}")
+    c = coefficients
+    quad = PressureQuadrature.from_polar(pmap)
+    models = {
+        "paper": paper_model(c.F0, c.M0, c.a, c.m, paper_k_x(c, rolling=rolling), c.R),
+        "base": model.without_correction(),
+        "model": model,
+    }
+    n_beta, n_t = ACCURACY_GRID["n_beta"], ACCURACY_GRID["n_t"]
+    turns = 2 * (n_beta - 1)
+    theta = np.arange(turns) * (2.0 * np.pi / turns)
+    t = np.linspace(0.0, 1.0, n_t)
+    speed, u = np.sin(0.5 * np.pi * t), np.where(t == 1.0, 0.0, np.cos(0.5 * np.pi * t))
+    vx, vy = np.outer(np.cos(theta), speed).ravel(), np.outer(np.sin(theta), speed).ravel()
+    force: dict[str, np.ndarray] = {}
+    torque: dict[str, np.ndarray] = {}
+    for sign in (1.0, -1.0):
+        wz = np.tile(sign * u / c.R, turns)
+        ex = friction_resultants(quad, vx, vy, wz, law, turns=turns)
+        for name, m in models.items():
+            fx, fy, mz = (np.asarray(a, float) for a in m(vx, vy, wz))
+            df = (np.hypot(fx - ex.Fx, fy - ex.Fy) / c.F0).reshape(turns, n_t)[:n_beta]
+            dm = (np.abs(mz - ex.Mz) / c.M0).reshape(turns, n_t)[:n_beta]
+            force[name] = np.maximum(force[name], df) if name in force else df
+            torque[name] = np.maximum(torque[name], dm) if name in torque else dm
+    return ErrorMap(
+        np.degrees(theta[:n_beta]), t, force, torque, float(c.F0), float(c.M0), float(c.R), quad.source
     )

@@ -7,9 +7,12 @@ shows (from the JSON documents written beside it, so page and files agree).
 
 from __future__ import annotations
 
+import hashlib
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
@@ -272,7 +275,7 @@ MODEL_ROWS = (
         "static.accuracy.model_force",
         "model: largest |ΔF|/F0",
         "fraction",
-        "generalised model against the exact integrals (check grid)",
+        "generalised model against the exact integrals",
     ),
     ("static.accuracy.model_torque", "model: largest |ΔMz|/M0", "fraction", "the same for the torque"),
     (
@@ -368,6 +371,27 @@ def error_map_context(docs: Mapping[str, Mapping[str, Any]]) -> list[dict]:
     return out
 
 
+#: Hex digits of an input's SHA-256 shown in the provenance table.
+HASH_DIGITS = 16
+
+
+def shown_input(path: str | os.PathLike) -> tuple[str, str]:
+    """An input as the provenance table names it: (its path relative to the working folder,
+    or its file name when it lies outside it, never the machine's absolute path; the first
+    `HASH_DIGITS` hex digits of its SHA-256, "" when it cannot be read)."""
+    p = Path(path)
+    try:
+        shown = str(p.resolve().relative_to(Path.cwd().resolve()))
+    except (ValueError, OSError):
+        shown = p.name
+    try:
+        with open(p, "rb") as fh:
+            digest = hashlib.file_digest(fh, "sha256").hexdigest()[:HASH_DIGITS]
+    except OSError:
+        digest = ""
+    return shown, digest
+
+
 def page_context(
     analysis: Analysis,
     coef: Mapping[str, Any],
@@ -415,7 +439,7 @@ def page_context(
     return {
         "version": version,
         "static": {
-            "source": a.static_field.source,
+            **dict(zip(("source", "sha256"), shown_input(a.static_field.source), strict=True)),
             "field": a.static_field.field,
             "location": p.location,
             "faces": len(p.triangles),
@@ -424,7 +448,7 @@ def page_context(
         "rolling": None
         if a.rolling_field is None
         else {
-            "source": a.rolling_field.source,
+            **dict(zip(("source", "sha256"), shown_input(a.rolling_field.source), strict=True)),
             "field": a.rolling_field.field,
             "load": coef.get("N_rolling"),
             "mismatch_allowed": coef["rolling"]["load_mismatch_allowed"],
