@@ -134,7 +134,7 @@ def tutorial(tmp_path_factory):
             cmd = [sys.executable, "-c", step]
         else:
             argv = shlex.split(step)
-            if argv == ["mkdir", "-p", TUTORIAL_OUT]:
+            if argv == ["mkdir", "-p", TUTORIAL_OUT] or argv[0] == "head":  # head: a look at a file
                 cmd = argv
             else:
                 assert argv[0] == "fepost", step
@@ -180,9 +180,9 @@ def test_tutorial_runs_and_says_what_happens(tutorial):
     d = coef["model"]["direction_coefficients"]
     assert f"a along x, y                {d['a'][0]:.6g}, {d['a'][1]:.6g}" in text
     assert f"m along x, y                {d['m'][0]:.6g}, {d['m'][1]:.6g}" in text
-    acc = coef["model"]["static"]["accuracy"]
+    acc = coef["model"]["stated_accuracy"]["all_maps"]  # the one stated figure (friction.summary)
     assert f"within {100 * max(acc['model_force'], acc['model_torque']):.1f} %" in text
-    assert f"miss by up to {100 * max(acc['compare_force'], acc['compare_torque']):.0f} %" in text
+    assert f"miss by up to {100 * max(acc['paper_force'], acc['paper_torque']):.0f} %" in text
     # the report of the demo's case, with its error maps and the sample sweep
     report = tutorial / "report"
     assert (report / "report.html").is_file() and (report / "error_map.json").is_file()
@@ -200,9 +200,8 @@ def test_tutorial_runs_and_says_what_happens(tutorial):
             assert 0.2 <= abs(mz[1] / mz[0] - 1) <= 0.31 and abs(mz[2] / mz[0] - 1) < 0.01
     # the sweep's trends as quoted
     fits = {f["quantity"]: f for f in json.loads((tutorial / "sweep" / "trends.json").read_text())["fits"]}
-    for q in ("R", "M0"):
-        lo, hi = fits[q]["ci95"]
-        assert f"{q} ∝ N^{fits[q]['exponent']:.3f}, 95 % interval [{lo:.3f}, {hi:.3f}]" in text, q
+    for q in ("R", "M0"):  # as fepost sweep prints them (all its output: tests/test_doc_examples.py)
+        assert f"trend: {q} ~ N^{fits[q]['exponent']:.3f}" in text, q
     assert fits["R"]["n"] == 6
     diag = json.loads((tutorial / "diagnosis" / "diagnosis.json").read_text())
     assert diag["cause"] == "friction_level"
