@@ -4,16 +4,20 @@ lack-of-fit sentence, and the report's provenance, grid phrase and curve figures
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 import fepost.sweep as sweep_pkg
 from fepost.cli import main
 from fepost.diagnose.summary import summary_text
+from fepost.figures.curves import BELOW_ZERO, SPEED_DEFINITIONS, CurveData, plot_curve
+from fepost.report.assemble import HASH_DIGITS, shown_input
 from fepost.rig import rig_table
 from fepost.sweep.trends import fit_power_law, load_trends, trend_lines
 from fepost.synthetic import write_map
@@ -217,3 +221,117 @@ def test_lack_of_fit_p_value_is_not_attached_to_the_drift_clause():
         "lack of fit: none: no structure left beyond the noise: the residuals do not drift with run "
         "order. Strongest test: residual structure of Fy (F-test on the predicted Fx, Fy, Mz), Holm p = 0.31"
     )
+
+
+# ---------------------------------------------------------------- Figures 4-6
+
+
+def _curve(**kw) -> CurveData:
+    x = np.linspace(0.0, 5.0, 11)
+    base = dict(
+        name="M_C",
+        title="Figure 5: friction torque M_C against υ = v/u",
+        x_name="upsilon",
+        x_label="υ = v / (ω_z R)",
+        y_label="M_C (N·m)",
+        unit="N·m",
+        x=x,
+        closed_form=1 / np.sqrt(1 + x**2),
+        exact=1 / np.sqrt(1 + 1.1 * x**2),
+        fit=1 / np.sqrt(1 + x**2),
+        band_lo=1 / np.sqrt(1 + x**2) - 0.1,
+        band_hi=1 / np.sqrt(1 + x**2) + 0.1,
+        test_x=np.linspace(0, 5, 7),
+        test_y=np.linspace(1.0, -0.05, 7),
+    )
+    base.update(kw)
+    return CurveData(**base)
+
+
+def _legend(fig) -> dict[str, str]:
+    """Legend texts of the test points and the band, by series."""
+    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    return {
+        "test": next(t for t in texts if "test points" in t),
+        "band": next(t for t in texts if "prediction band" in t),
+    }
+
+
+def test_curve_figures_define_u_and_v_under_the_speed_ratio_axis():
+    import matplotlib.pyplot as plt
+
+    for x_name in ("psi", "upsilon"):
+        fig = plot_curve(_curve(x_name=x_name))
+        label = fig.axes[0].xaxis.label.get_text()
+        assert label.endswith("\n" + SPEED_DEFINITIONS)
+        assert r"u = \omega_z R" in label and "sliding speed" in label
+        plt.close(fig)
+    fig = plot_curve(_curve(x_name="t"))  # another abscissa: no speed definitions
+    assert SPEED_DEFINITIONS not in fig.axes[0].xaxis.label.get_text()
+    plt.close(fig)
+
+
+def test_curve_figures_say_the_points_are_synthetic_and_why_they_cross_zero():
+    """Points and band reaching below zero while the noise-free curves do not: the legend says
+    the additive noise takes them there; the band is drawn as computed (not clipped)."""
+    import matplotlib.pyplot as plt
+
+    c = _curve()
+    fig = plot_curve(c)
+    legend = _legend(fig)
+    assert legend["test"].startswith("synthetic test points (the paper's 20 % noise)")
+    assert legend["test"].endswith(BELOW_ZERO) and legend["band"].endswith(BELOW_ZERO)
+    band = next(col for col in fig.axes[0].collections if col.get_gid() == "band")
+    assert band.get_paths()[0].vertices[:, 1].min() == pytest.approx(float(c.band_lo.min()))
+    plt.close(fig)
+    # all above zero: no such words
+    fig = plot_curve(_curve(test_y=np.linspace(1.0, 0.05, 7), band_lo=np.full(11, 0.01)))
+    assert not any(BELOW_ZERO in t for t in _legend(fig).values())
+    plt.close(fig)
+    # a curve that itself goes below zero: the noise is not the reason, nothing is said
+    fig = plot_curve(_curve(closed_form=np.linspace(1.0, -0.5, 11)))
+    assert not any(BELOW_ZERO in t for t in _legend(fig).values())
+    plt.close(fig)
+
+
+# ---------------------------------------------------------------- report
+
+
+def test_provenance_names_inputs_relative_or_by_name_with_a_hash(tmp_path, monkeypatch):
+    inside = tmp_path / "work" / "maps"
+    inside.mkdir(parents=True)
+    data = inside / "a.vtu"
+    data.write_bytes(b"fepost provenance")
+    digest = hashlib.sha256(b"fepost provenance").hexdigest()[:HASH_DIGITS]
+    monkeypatch.chdir(tmp_path / "work")
+    assert shown_input(data) == (str(Path("maps") / "a.vtu"), digest)  # absolute, inside the cwd
+    assert shown_input("maps/a.vtu") == (str(Path("maps") / "a.vtu"), digest)
+    monkeypatch.chdir(inside)
+    assert shown_input(tmp_path / "work" / "maps" / "a.vtu")[0] == "a.vtu"
+    other = tmp_path / "elsewhere"
+    other.mkdir()
+    monkeypatch.chdir(other)
+    assert shown_input(data) == ("a.vtu", digest)  # outside the cwd: the file name only
+    assert shown_input(other / "missing.vtu") == ("missing.vtu", "")
+
+
+@pytest.mark.slow
+def test_report_provenance_and_grid_phrase(tmp_path, monkeypatch):
+    """A report on maps outside the working folder: the provenance table names them by file name
+    and hash, never by their absolute path; the model rows' grid is said once."""
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    static = write_map(maps / "static.vtu", "tire", radius=0.15, peak=6e5, n_rings=16)
+    rolling = write_map(maps / "rolling.vtu", "tire", radius=0.15, peak=6e5, k_x=0.13, n_rings=16)
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    assert main(["report", str(static), str(rolling), "--out", "rep", "--seed", "3"]) == 0
+    html = (work / "rep" / "report.html").read_text(encoding="utf-8")
+    table = html.split('<h2 id="inputs">', 1)[1].split("</table>", 1)[0]
+    for path in (static, rolling):
+        sha = hashlib.sha256(path.read_bytes()).hexdigest()[:HASH_DIGITS]
+        assert f"<code>{path.name}</code> (SHA-256 {sha}…)" in table
+    assert str(maps) not in table
+    assert html.count("the densest evaluated") == 1
+    assert "model errors: the largest errors over the error map&#39;s grid, the densest evaluated" in html

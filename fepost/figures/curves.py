@@ -19,6 +19,13 @@ nothing physical: the report assembles the arrays.
 Labels are plain text with subscripts written as ``M_C``, ``F_y``, ``ω_z``
 (and ``F_{xy}`` for longer ones); `mathtext` turns them into matplotlib
 mathtext, so they render as subscripts, not as literal underscores.
+
+The figure states what its reader needs without the caption: under the ψ or υ
+axis, u and v (`SPEED_DEFINITIONS`, as docs/theory.md defines them); in the
+legend, that the test points are synthetic; and, where test points or the
+prediction band of a non-negative curve fall below zero, that the paper's
+additive noise takes them there (`BELOW_ZERO`): the band is drawn as computed,
+never clipped.
 """
 
 from __future__ import annotations
@@ -45,6 +52,10 @@ _TEX = {
     "ρ": r"\rho", "σ": r"\sigma", "τ": r"\tau", "υ": r"\upsilon", "φ": r"\varphi",
     "ψ": r"\psi", "ω": r"\omega", "∥": r"\parallel", "⊥": r"\perp",
 }  # fmt: skip
+#: The speeds of the ratios ψ = u/v and υ = v/u, written under their axis (docs/theory.md).
+SPEED_DEFINITIONS = r"$u = \omega_z R$ (spin speed at radius R), $v = |\mathbf{v}|$ (sliding speed)"
+#: Added to the legend entries of test points and band when they reach below a curve that is not.
+BELOW_ZERO = "below 0 by the additive noise"
 _SUBSCRIPT = re.compile(r"([A-Za-zα-ωΑ-Ω∥⊥]+)_(\{[^{}$]*\}|[A-Za-z0-9∥⊥]+)")
 
 
@@ -131,11 +142,14 @@ def plot_curve(data: CurveData, ax=None):
         "exact": "exact integral (FE map)",
         "closed_form": "closed form (1.8)",
         "model": "generalised model (FE map)",
-        "test": "test points (20 % noise)",
+        "test": "synthetic test points (the paper's 20 % noise)",
         "fit": "fitted (1.8)",
         "band": "95 % prediction band",
         **data.labels,
     }
+    if _noise_below_zero(data):
+        for key in ("test", "band"):
+            lab[key] += f"; {BELOW_ZERO}"
     lab = {k: mathtext(v) for k, v in lab.items()}
     with theme.mpl_style():
         if ax is None:
@@ -208,13 +222,24 @@ def plot_curve(data: CurveData, ax=None):
                 label=lab["fit"],
                 gid="fit",
             )
-        ax.set_xlabel(mathtext(data.x_label))
+        speeds = f"\n{SPEED_DEFINITIONS}" if data.x_name in ("psi", "upsilon") else ""
+        ax.set_xlabel(mathtext(data.x_label) + speeds)
         ax.set_ylabel(mathtext(data.y_label))
         ax.set_title(mathtext(data.title), fontsize=10)
         ax.set_xlim(float(data.x[0]), float(data.x[-1]))
         ax.axhline(0.0, color="black", lw=0.6)
         ax.legend(loc="best")
     return fig
+
+
+def _noise_below_zero(data: CurveData) -> bool:
+    """Whether test points or the band reach below zero where the noise-free curves (exact,
+    closed form) do not: only the additive noise of the synthetic points takes them there."""
+    noisy = [v for v in (data.test_y, data.band_lo) if v is not None and v.size]
+    clean = [v for v in (data.exact, data.closed_form) if v is not None and v.size]
+    return bool(noisy and clean) and min(float(v.min()) for v in noisy) < 0.0 <= min(
+        float(v.min()) for v in clean
+    )
 
 
 def curve_table(curves: Iterable[CurveData]) -> tuple[list[str], list[list]]:

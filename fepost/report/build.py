@@ -67,9 +67,11 @@ def quote_error_maps(ctx: dict, map_docs: dict, summary) -> None:
     densest grid fepost evaluates, denser than the model's own check grid), so the
     coefficient table's model errors are the largest errors the maps show, each row
     citing the error map's JSON key, and the recommendation is the summary's own
-    (the same sentence as ``fepost coefficients``).
+    (the same sentence as ``fepost coefficients``). Which grid those rows are from is
+    said once, in the table's group heading (``model_rows_grid``).
     """
     rows = []
+    quoted = False
     for row in ctx.get("model_rows", []):
         for stem, side in _MAP_SIDES:
             doc = map_docs.get(stem)
@@ -79,9 +81,12 @@ def quote_error_maps(ctx: dict, map_docs: dict, summary) -> None:
                         continue
                     value = doc["worst"][name][what]
                     row = {**row, "key": f"{stem}.worst.{name}.{what}", "value": value}
-                    row["definition"] += " (the error map's grid: the densest evaluated)"
+                    quoted = True
         rows.append(row)
     ctx["model_rows"] = rows
+    ctx["model_rows_grid"] = (
+        "the largest errors over the error map's grid, the densest evaluated" if quoted else ""
+    )
     if ctx.get("model_recommendation"):
         ctx["model_recommendation"] = summary.recommendation()
 
