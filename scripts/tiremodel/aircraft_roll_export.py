@@ -76,13 +76,33 @@ def _write_text(path: Path, text: str) -> None:
     os.replace(part, path)
 
 
+def projected_integral(points: np.ndarray, quads: np.ndarray, values: np.ndarray) -> float:
+    """Integral of the bilinear nodal field over the faces projected on the road plane (2x2 Gauss).
+
+    The vertical force of a pressure p acting normal to a deformed face is the
+    integral of p over the face's projection on the road; this is the load that
+    the road's reaction measures (and the one fepost's N_fe integrates).
+    """
+    g = np.array([-1.0, 1.0]) / np.sqrt(3.0)
+    x, v, total = points[quads], values[quads], 0.0
+    for a in g:
+        for b in g:
+            shape = 0.25 * np.array(
+                [(1 - a) * (1 - b), (1 + a) * (1 - b), (1 + a) * (1 + b), (1 - a) * (1 + b)]
+            )
+            ta = np.einsum("k,fkj->fj", 0.25 * np.array([-(1 - b), 1 - b, 1 + b, -(1 + b)]), x)
+            tb = np.einsum("k,fkj->fj", 0.25 * np.array([-(1 - a), -(1 + a), 1 + a, 1 - a]), x)
+            jac = np.abs(ta[:, 0] * tb[:, 1] - ta[:, 1] * tb[:, 0])
+            total += float(np.sum(jac * (v @ shape)))
+    return total
+
+
 def centre_of_pressure(mesh: AircraftMesh, state: RollState) -> tuple[float, float]:
-    """(N, x) of the deformed surface: the CPRESS integral and its centre's x (m, axle frame)."""
+    """(N, x): the vertical load of the CPRESS field and its centre's x (m, axle frame)."""
     pts, quads, cp, disp = mirror_surface(mesh, state)
     deformed = pts + disp
-    n = quad_integral(deformed, quads, cp)
-    nx = quad_integral(deformed, quads, cp * deformed[:, 0])
-    return n, nx / n
+    n = projected_integral(deformed, quads, cp)
+    return n, projected_integral(deformed, quads, cp * deformed[:, 0]) / n
 
 
 def steady_turn_rate(result: RollResult) -> float:
@@ -108,10 +128,12 @@ def patch_nodes(mesh: AircraftMesh, state: RollState) -> dict:
 def write_map(mesh: AircraftMesh, state: RollState, out: Path, name: str) -> dict:
     """The surface file of one state; returns its figures (CPRESS integral, patch)."""
     pts, quads, cp, disp = mirror_surface(mesh, state)
+    out.mkdir(parents=True, exist_ok=True)
     _write_vtu(out / f"{name}.vtu", pts, quads, cp, disp)
     deformed = pts + disp
     return {
         "cpress_integral": quad_integral(deformed, quads, cp),
+        "cpress_integral_projected": projected_integral(deformed, quads, cp),
         "patch": patch_metrics(deformed, quads, cp),
         "surface_points": int(pts.shape[0]),
         "surface_faces": int(quads.shape[0]),
@@ -127,7 +149,9 @@ def common_keys(mesh: AircraftMesh, result: RollResult, state: RollState, figure
         "rated_load": ad.RATED_LOAD,
         "load_fraction": float(state.road_force[2]) / ad.RATED_LOAD,
         "cpress_integral": figures["cpress_integral"],
-        "cpress_integral_note": "exact integral of the bilinear CPRESS field over the deformed faces",
+        "cpress_integral_projected": figures["cpress_integral_projected"],
+        "cpress_integral_note": "exact integral of the bilinear CPRESS field over the deformed faces "
+        "(cpress_integral_projected: over their projection on the road, the vertical load)",
         "inflation_pressure": ad.PRESSURE,
         "rim_travel_z": float(state.road_z),
         "friction": ad.FRICTION,
@@ -233,8 +257,9 @@ def write_rolling(
         "static_cpress_integral": n0,
         "samples": samples,
         "samples_note": "the written times along the roll: centre-of-pressure shift = x of the "
-        "CPRESS centre on the deformed faces minus the static one's (an integral of its own, beside "
-        "fepost's x_c); steady when it stops changing",
+        "CPRESS centre on the deformed faces projected on the road, minus the static one's (an "
+        "exact face integral of its own, beside fepost's x_c from its polar resampling); steady "
+        "when it stops changing",
         "history": {
             "axle_travel_m": h.axle_travel.tolist(),
             "rim_rotation_rad": h.rotation.tolist(),

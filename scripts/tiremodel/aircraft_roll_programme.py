@@ -48,13 +48,16 @@ class Setup:
     radius_guess: float = 0.556  # m, estimate of R_e for the free run's driver
     drive_stiffness: float = 3.0e4  # N m/rad, half model: the free run's torsion spring
 
+    slip_max_inc: float = 0.1  # the slip runs' largest increment (38 mm of travel; free run 0.05)
+
     def plan(self, rotation: float | None) -> rdk.RollPlan:
         """Imposed turn ``rotation``; None: the free run's elastic drive."""
         if rotation is None:
             turn, k = self.travel / self.radius_guess, self.drive_stiffness
-        else:
-            turn, k = rotation, None
-        return rdk.RollPlan(self.rim_travel, self.travel, turn, self.samples, self.road_length, 0.3, k)
+            return rdk.RollPlan(self.rim_travel, self.travel, turn, self.samples, self.road_length, 0.3, k)
+        return rdk.RollPlan(
+            self.rim_travel, self.travel, rotation, self.samples, self.road_length, max_inc=self.slip_max_inc
+        )
 
 
 AIRCRAFT = Setup()

@@ -1,0 +1,112 @@
+"""The rolling runs side by side: slip, longitudinal force, torque and fepost's k_x.
+
+``python -m scripts.tiremodel.aircraft_roll_table [DIR]`` reads every
+``roll_*.json`` in DIR (default meshes/rig-aircraft), analyses each rolled map
+with fepost as the rolling partner of ``roll_static.vtu`` and prints a
+Markdown table, with the sliding stand-in (meshes/aircraft: static_100 /
+rolling_100) and the paper's k_x = 0.13 as the last rows.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+PAPER_KX = 0.13
+
+
+@dataclass(frozen=True)
+class Row:
+    name: str
+    slip: float | None
+    fx_over_n: float
+    torque: float | None
+    k_x: float
+    x_c: float
+    x_c_own: float | None  # the sidecar's exact face integral of the centre shift
+    x_c_steady: tuple[float, ...]  # the own shift at the last three written times
+    load_ratio: float  # N_rolling / N (fepost)
+
+
+def analyse_run(static: Path, run_json: Path) -> Row:
+    from fepost import analyse
+
+    side = json.loads(run_json.read_text())
+    res = analyse(static, run_json.with_suffix(".vtu"))
+    c = res.coefficients
+    force = side["reaction"]["force"]
+    shifts = tuple(s["centre_of_pressure_shift_m"] for s in side["samples"][-3:])
+    return Row(
+        name=run_json.stem,
+        slip=side["longitudinal_slip"],
+        fx_over_n=force[0] / force[2],
+        torque=side["axle_torque_Nm"],
+        k_x=float(c.k_x),
+        x_c=float(c.x_c),
+        x_c_own=shifts[-1],
+        x_c_steady=shifts,
+        load_ratio=float(c.N_rolling / c.N),
+    )
+
+
+def rows(folder: Path) -> list[Row]:
+    static = folder / "roll_static.vtu"
+    runs = sorted(p for p in folder.glob("roll_*.json") if p.stem != "roll_static")
+    out = [analyse_run(static, p) for p in runs]
+    return sorted(out, key=lambda r: (r.slip is None, r.slip or 0.0))
+
+
+def standin_row() -> Row:
+    from fepost import analyse
+
+    air = REPO / "meshes" / "aircraft"
+    side = json.loads((air / "rolling_100.json").read_text())
+    res = analyse(air / "static_100.vtu", air / "rolling_100.vtu")
+    force = side["reaction_force_road"]
+    c = res.coefficients
+    return Row(
+        "aircraft/rolling_100 (slide)",
+        None,
+        force[0] / force[2],
+        None,
+        float(c.k_x),
+        float(c.x_c),
+        None,
+        (),
+        1.0,
+    )
+
+
+def markdown(table: list[Row]) -> str:
+    head = "| run | slip κ | Fx/N | axle torque (kN m) | x_c fepost (mm) | x_c faces (mm) | k_x | N_roll/N |"
+    lines = [head, "|---|---|---|---|---|---|---|---|"]
+    for r in table:
+        slip = "–" if r.slip is None else f"{r.slip:+.3f}"
+        torque = "–" if r.torque is None else f"{r.torque / 1e3:+.2f}"
+        own = "–" if r.x_c_own is None else f"{1e3 * r.x_c_own:+.2f}"
+        lines.append(
+            f"| `{r.name}` | {slip} | {r.fx_over_n:+.3f} | {torque} | {1e3 * r.x_c:+.2f} | {own} "
+            f"| {r.k_x:+.3f} | {r.load_ratio:.3f} |"
+        )
+    lines.append(f"| paper (steady rolling, its tire) | – | – | – | – | – | {PAPER_KX:+.3f} | – |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    folder = Path(args[0]) if args else REPO / "meshes" / "rig-aircraft"
+    table = [*rows(folder), standin_row()]
+    print(markdown(table))
+    print()
+    print("centre shift at the last three written times (mm, faces):")
+    for r in table:
+        if r.x_c_steady:
+            print(f"  {r.name}: " + ", ".join(f"{1e3 * v:+.2f}" for v in r.x_c_steady))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
