@@ -111,3 +111,17 @@ def test_linear_and_nonlinear_verdicts_agree_on_both_sides(aircraft):
         assert below.verdict == "decays", contact.name
         assert above.verdict in ("grows", "limit_cycle"), contact.name
         assert above.final_amplitude > 1.5 * above.perturbation, contact.name
+
+
+def test_trail_map_reuses_the_contact_jacobian_faithfully():
+    from fepost.shimmy.linear import trail_map
+
+    cf = closed_forms_contact(**COEF)
+    lin = Linearisation.of(GEAR, cf)
+    other = GEAR.replace(trail=0.2)
+    reused, fresh = lin.for_gear(other, cf).jacobian(70.0), Linearisation.of(other, cf).jacobian(70.0)
+    np.testing.assert_allclose(reused, fresh, rtol=ROUND_OFF, atol=ROUND_OFF)
+    speeds = np.linspace(1.0, 150.0, 60)
+    tm = trail_map(lin, cf, [0.0, GEAR.trail], speeds)
+    assert tm.critical_speeds[0] is None, "no trail: the coupling through e vanishes, no shimmy"
+    assert tm.critical_speeds[1] == pytest.approx(stability_map(lin, speeds).critical_speed, rel=1e-9)

@@ -78,6 +78,13 @@ def add_parser(sub) -> None:
         metavar="T",
         help="simulated seconds (default 10)",
     )
+    p.add_argument(
+        "--trails",
+        type=v.integer_in(0, 1000),
+        default=16,
+        metavar="N",
+        help="boundary over speed x trail at N trails from 0 to 3 x the gear's (default 16; 0: none)",
+    )
     p.add_argument("--no-simulation", action="store_true", help="linear stability only (no time histories)")
     p.add_argument("--no-intervals", action="store_true", help="skip the coefficients' intervals (Table 1)")
     add_friction_option(p)
@@ -112,6 +119,7 @@ def run(args: argparse.Namespace) -> int:
         intervals=not args.no_intervals,
         simulate_motion=not args.no_simulation,
         duration=args.duration,
+        trails=args.trails,
     )
     write_shimmy(study, args.out, force=args.force, protect=inputs)
     for m in study.models:

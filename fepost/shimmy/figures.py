@@ -123,11 +123,29 @@ def amplitude_figure(result: ShimmyResult, ax=None):
     return ax
 
 
+def trail_figure(result: ShimmyResult, ax=None):
+    """The stability boundary over speed × trail: the critical speed at each trail, per model."""
+    ax = _axes(ax)
+    for m in result.models:
+        if m.trail_map is None:
+            continue
+        tm = m.trail_map
+        v = np.array([np.nan if c is None else c for c in tm.critical_speeds])
+        ax.plot(tm.trails, v, "o-", ms=3, color=COLOURS.get(m.name, "k"), label=LABELS.get(m.name, m.name))
+    ax.axvline(result.gear.trail, color="k", ls=":", lw=1, label="the gear's trail")
+    ax.set_xlabel("trail e (m)")
+    ax.set_ylabel("critical speed (m/s): unstable above")
+    ax.set_title("Shimmy boundary over speed × trail (no point: stable over the sweep)")
+    ax.legend()
+    return ax
+
+
 FIGURES = {
     "stability_map": stability_figure,
     "eigenvalue_paths": eigenvalue_figure,
     "time_histories": time_history_figure,
     "limit_cycle_amplitude": amplitude_figure,
+    "stability_plane": trail_figure,
 }
 
 
@@ -142,6 +160,8 @@ def save_figures(result: ShimmyResult, folder: Path) -> list[str]:
     with matplotlib.rc_context(STYLE):  # type: ignore[arg-type]  # matplotlib types keys as Literal
         for name, draw in FIGURES.items():
             if name in ("time_histories", "limit_cycle_amplitude") and not result.simulations:
+                continue
+            if name == "stability_plane" and all(m.trail_map is None for m in result.models):
                 continue
             fig, ax = plt.subplots()
             draw(result, ax)

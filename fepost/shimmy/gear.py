@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -92,7 +92,7 @@ class Gear:
 
     def replace(self, **changes) -> Gear:
         """A copy with ``changes`` (validated again)."""
-        d = {k: v for k, v in asdict(self).items() if k != "sources"}
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
         d["sources"] = dict(self.sources)
         d.update(changes)
         return Gear(**d)

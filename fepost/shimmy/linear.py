@@ -25,6 +25,10 @@ from .contact import COMPLEX_STEP, Contact
 from .equations import equilibrium, kinematics, rhs
 from .gear import Gear
 
+#: Largest change of the steady kinematics (m/s at V = 1, so a turn of the sliding direction in
+#: rad) for which a contact Jacobian is reused: the Jacobian then changes by about this fraction.
+REUSE_TOL = 1e-5
+
 
 @dataclass(frozen=True)
 class Linearisation:
@@ -43,6 +47,16 @@ class Linearisation:
         grads = np.array([contact.jacobian(*k[:, j]) for j in range(k.shape[1])])
         forces = tuple(np.asarray(f, float) for f in contact(*k))
         return cls(gear, x0, forces, k, grads)  # type: ignore[arg-type]
+
+    def for_gear(self, gear: Gear, contact: Contact) -> Linearisation:
+        """The linearisation of another ``gear`` on the same ``contact``: the steady state is
+        solved again; the contact's gradients are reused when the wheels' steady kinematics
+        are those of this linearisation (to `REUSE_TOL` m/s at V = 1), else recomputed."""
+        x0 = equilibrium(gear, contact)
+        k = np.array(kinematics(x0, 1.0, gear), float)
+        if k.shape != self.kinematics.shape or np.max(np.abs(k - self.kinematics)) > REUSE_TOL:
+            return Linearisation.of(gear, contact)
+        return Linearisation(gear, x0, self.forces, self.kinematics, self.gradients)
 
     def scaled(self, factor: float, contact: Contact) -> Linearisation:
         """The linearisation of ``contact.scaled(factor)`` (a friction level f'/f): forces and
@@ -130,3 +144,29 @@ def stability_map(lin: Linearisation, speeds) -> StabilityMap:
 def critical_speed(lin: Linearisation, lo: float, hi: float, n: int = 60) -> float | None:
     """The lowest critical speed in [lo, hi] (coarse sweep of ``n`` speeds, then Brent), or None."""
     return stability_map(lin, np.linspace(lo, hi, n)).critical_speed
+
+
+@dataclass(frozen=True)
+class TrailMap:
+    """The stability boundary over speed × trail: the lowest critical speed at each trail."""
+
+    trails: np.ndarray
+    critical_speeds: tuple[float | None, ...]
+    speeds: tuple[float, float]
+
+    def rows(self) -> list[dict]:
+        return [
+            {"trail": float(t), "critical_speed": v}
+            for t, v in zip(self.trails, self.critical_speeds, strict=True)
+        ]
+
+
+def trail_map(lin: Linearisation, contact: Contact, trails, speeds) -> TrailMap:
+    """Lowest critical speed over ``speeds`` for each of ``trails`` (m), the gear otherwise
+    ``lin``'s (the contact's Jacobian reused, `Linearisation.for_gear`)."""
+    speeds = np.asarray(speeds, float)
+    crit = []
+    for t in np.asarray(trails, float):
+        other = lin.for_gear(lin.gear.replace(trail=float(t)), contact)
+        crit.append(stability_map(other, speeds).critical_speed)
+    return TrailMap(np.asarray(trails, float), tuple(crit), (float(speeds[0]), float(speeds[-1])))

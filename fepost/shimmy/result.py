@@ -8,7 +8,7 @@ from types import MappingProxyType
 from typing import Any
 
 from .gear import Gear
-from .linear import StabilityMap
+from .linear import StabilityMap, TrailMap
 from .simulate import TimeHistory
 
 #: The model's name and reference (the ``model`` key).
@@ -38,6 +38,7 @@ class ModelStability:
     critical_speed_ci95: tuple[float, float] | None
     ci_method: str
     contact: Mapping[str, Any] = field(default_factory=dict)
+    trail_map: TrailMap | None = None
 
     def to_dict(self) -> dict:
         crit = list(self.stability.critical_speeds)
@@ -51,6 +52,7 @@ class ModelStability:
             "frequency_hz": None if not freq else (freq[0] if len(freq) == 1 else freq),
             "contact": dict(self.contact),
             "stability": self.stability.rows(),
+            "trail_map": None if self.trail_map is None else self.trail_map.rows(),
         }
 
 

@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import ArgumentError
 from .contact import MODEL_NAMES, Contact, closed_forms_contact, exact_contact, model_contact
 from .gear import Gear
-from .linear import Linearisation, stability_map
+from .linear import Linearisation, stability_map, trail_map
 from .result import ModelStability, ShimmyResult, Simulation
 from .simulate import DURATION, simulate
 from .table import DirectionTable
@@ -40,6 +40,9 @@ from .table import DirectionTable
 DEFAULT_SPEEDS = (1.0, 150.0, 200)
 #: Friction levels across f's interval at which the map-based models' V_c is recomputed.
 F_POINTS = 9
+#: The speed × trail map: trails from 0 to `TRAIL_SPAN` times the gear's (0.3 m for no trail),
+#: and speeds over the sweep's range.
+TRAIL_SPAN, TRAIL_SPEEDS = 3.0, 60
 #: Speeds of the time simulations, as fractions of each critical speed.
 SIMULATION_FRACTIONS = (0.8, 1.2)
 
@@ -119,6 +122,7 @@ def shimmy_study(
     simulate_motion: bool = True,
     duration: float = DURATION,
     anchor: bool = True,
+    trails: int = 16,
 ) -> ShimmyResult:
     """Stability of ``gear`` on the tire of ``analysis`` with each friction model (module docstring).
 
@@ -126,6 +130,7 @@ def shimmy_study(
     from 1 to 150 m/s). ``intervals``: carry Table 1's intervals to the critical
     speeds. ``simulate_motion``: time histories at 0.8 and 1.2 times each critical
     speed (at the top speed when there is none), ``duration`` seconds each.
+    ``trails``: the boundary over speed × trail at that many trails (`TRAIL_SPAN`; 0: none).
     """
     from .anchor import anchor_record
 
@@ -153,7 +158,15 @@ def shimmy_study(
         elif smap.critical_speed is None:
             method = "no critical speed in the sweep"
         info = {k: float(v) for k, v in contact.info.items() if isinstance(v, int | float)}
-        results.append(ModelStability(name, smap, ci, method, {"F0": contact.F0, "M0": contact.M0, **info}))
+        tmap = None
+        if trails:
+            t0 = time.perf_counter()
+            top = TRAIL_SPAN * gear.trail if gear.trail > 0 else 0.3
+            tspeeds = np.linspace(speeds[0], speeds[-1], TRAIL_SPEEDS)
+            tmap = trail_map(lin, contact, np.linspace(0.0, top, trails), tspeeds)
+            timings[f"{name}_trail_map"] = time.perf_counter() - t0
+        stab = ModelStability(name, smap, ci, method, {"F0": contact.F0, "M0": contact.M0, **info}, tmap)
+        results.append(stab)
         if simulate_motion:
             t0 = time.perf_counter()
             sim_contact = (
