@@ -13,6 +13,7 @@ documented cause hidden in it (`fepost.diagnose.example`).
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from ..diagnose.causenames import CAUSES  # a light module: no numpy
@@ -72,6 +73,27 @@ def add_parser(sub) -> None:
         help="recording column numbering the test points: holds are its runs (default: steady kinematics)",
     )
     p.add_argument(
+        "--steady-window",
+        type=_seconds,
+        default=v.LibraryDefault("fepost.diagnose.holds", "WINDOW_SECONDS"),
+        metavar="SECONDS",
+        help="recording: a sample is steady when vx, vy, wz stayed within their tolerance over this "
+        "trailing window (default %(default)s s, whatever the logging rate)",
+    )
+    p.add_argument(
+        "--settle",
+        type=_seconds,
+        default=v.LibraryDefault("fepost.diagnose.holds", "SETTLE_SECONDS"),
+        metavar="SECONDS",
+        help="recording: settling left out at each end of a hold (default %(default)s s)",
+    )
+    p.add_argument(
+        "--strict-recording",
+        action="store_true",
+        help="recording: refuse a non-finite sample (a dropout) or a clock that goes back, "
+        "instead of leaving them out of the holds and reporting them",
+    )
+    p.add_argument(
         "--layout",
         choices=("auto", "points", "recording"),
         default="auto",
@@ -110,6 +132,17 @@ def add_parser(sub) -> None:
     )
     add_input_options(p)
     p.set_defaults(func=run)
+
+
+def _seconds(text: str) -> float:
+    """A duration in seconds: a finite number >= 0."""
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds, got {text!r}") from None
+    if not (math.isfinite(x) and x >= 0):
+        raise argparse.ArgumentTypeError(f"must be a number of seconds >= 0, got {text!r}")
+    return x
 
 
 def _make_example(args: argparse.Namespace) -> int:
@@ -165,6 +198,14 @@ def run(args: argparse.Namespace) -> int:
     from ..diagnose.recording import Columns
     from ..diagnose.writer import write_diagnosis
 
+    if args.steady_window <= 0:
+        raise ArgumentError(f"--steady-window must be a number of seconds > 0, got {args.steady_window!r}")
+    rule = HoldRule(
+        window=args.steady_window,
+        settle=args.settle,
+        use_point=bool(args.point_column),
+        strict=args.strict_recording,
+    )
     columns = Columns.parse(args.columns, args.channel_units)
     if args.point_column:
         columns = Columns({**columns.names, "point": args.point_column}, columns.units)
@@ -177,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
         n_folds=args.folds,
         analyse_kwargs={"options": analysis_options(args)},
         columns=columns,
-        hold_rule=HoldRule(use_point=bool(args.point_column)),
+        hold_rule=rule,
         layout=args.layout,
     )
     out = write_diagnosis(result, args.out, force=args.force)

@@ -17,7 +17,9 @@
 * `plot_recording` — for a rig recording: the kinematics and forces
   against time (a decimated copy, `fepost.diagnose.holds.TRACE_POINTS` samples
   at most), the steady holds shaded and each hold's mean drawn on it, the rows
-  left out (transitions) in red.
+  left out (transitions) in red, dropouts shaded grey, clock resets as dashed
+  lines and the ends of holds cut for drifting as dotted lines; the title states
+  the hold rule in seconds.
 
 Each function takes an optional figure or axes and returns it; none calls show().
 """
@@ -43,6 +45,9 @@ def display_units(values: np.ndarray, unit: str) -> tuple[float, str]:
     top = float(np.max(np.abs(values))) if np.size(values) else 0.0
     return (1e3, "k" + unit) if top >= KILO_FROM else (1.0, unit)
 
+
+#: Most dropouts, resets and drift cuts drawn on the recording figure (each kind).
+MAX_MARKS = 200
 
 BEFORE = "0.55"
 AFTER = "tab:blue"
@@ -292,16 +297,34 @@ def plot_recording(diag: Diagnosis, fig: Figure | None = None) -> Figure:
                       label="hold mean" if k == 0 else None)  # fmt: skip
         ax.fill_between(t, 0, 1, where=inside, transform=ax.get_xaxis_transform(), color="tab:green",
                         alpha=0.12, lw=0, label="steady hold")  # fmt: skip
+        _mark_gaps(ax, holds, 0.002 * (t[-1] - t[0]) if t.size else 0.0)
         ax.set_ylabel(f"{', '.join(names)} ({shown})", fontsize=9)
         ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
         ax.legend(fontsize=7, loc="upper right", ncol=4)
-    axes[-1].set_xlabel("time (s)")
+    axes[-1].set_xlabel("time (s)" if not holds.resets else "time (s, run clock: resets taken out)")
     d = holds.to_dict()
+    gaps = holds.gaps_text()
     fig.suptitle(
         f"recording: {d['count']} steady holds, {d['rows_used']} of {d['rows']} rows used, "
-        f"{d['rows_left_out']} left out as transitions"
+        f"{d['rows_left_out']} left out\nholds: kinematics steady over {holds.window:g} s windows and over "
+        f"the whole hold, {holds.settle:g} s settling left out at each end" + (f"\n{gaps}" if gaps else ""),
+        fontsize=10,
     )
     return fig
+
+
+def _mark_gaps(ax, holds, least: float) -> None:
+    """Dropouts shaded grey (at least ``least`` s wide), clock resets dashed, the ends of drift-cut
+    holds dotted; the first `MAX_MARKS` of each."""
+    for k, drop in enumerate(holds.dropouts[:MAX_MARKS]):
+        a, b = drop.time
+        ax.axvspan(a, max(b, a + least), color="0.4", alpha=0.35, lw=0,
+                   label="dropout (left out)" if k == 0 else None)  # fmt: skip
+    for k, reset in enumerate(holds.resets[:MAX_MARKS]):
+        ax.axvline(reset.clock, color="k", ls="--", lw=0.9, label="clock reset" if k == 0 else None)
+    for k, (a, b, _) in enumerate(holds.splits[:MAX_MARKS]):
+        ax.axvline(a, color="tab:purple", ls=":", lw=0.9, label="hold cut for drift" if k == 0 else None)
+        ax.axvline(b, color="tab:purple", ls=":", lw=0.9)
 
 
 def save_figures(diag: Diagnosis, folder) -> list[str]:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from .causes import MEANING
 from .measured import CHANNELS
 
@@ -44,9 +46,28 @@ def _outlier_lines(diag) -> list[str]:
     return ["outliers: none (no row lies beyond the outlier threshold under every candidate)"]
 
 
+def _recording_lines(holds) -> list[str]:
+    """How a recording became test points: holds, the rule in seconds, dropouts, resets, splits."""
+    rate = holds.rate
+    known = math.isfinite(rate)
+    at = f" at {rate:.4g} Hz" if known else ""
+    lines = [
+        f"recording: {holds.count} steady holds from {holds.rows_total} rows{at} ({holds.rows_used} rows "
+        f"used, {holds.rows_total - holds.rows_used} left out as transitions"
+        + (f", {holds.segments} segments" if holds.segments > 1 else "")
+        + ")"
+    ]
+    samples = f" ({holds.window * rate:.3g} samples at {rate:.4g} Hz)" if known else ""
+    lines.append(f"  hold rule: {holds.rule}; window {holds.window:g} s{samples}")
+    gaps = holds.gaps_text()
+    lines.append(f"  gaps: {gaps}" if gaps else "  gaps: no dropouts, clock resets or drifting holds")
+    return lines
+
+
 def summary_text(diag) -> str:
     g = diag.gain
-    lines = _cause_lines(diag)
+    lines = _recording_lines(diag.holds) if diag.holds is not None else []
+    lines += _cause_lines(diag)
     lines.append(
         f"held-out RMSE (scaled, {diag.info.get('folds', 5)}-fold): before {g['rmse_before']:.4g}, "
         f"after {g['rmse_after']:.4g}; delta BIC vs the simulation {g['delta_bic']:.1f}"
