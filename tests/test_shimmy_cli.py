@@ -95,6 +95,8 @@ def test_shimmy_end_to_end_writes_the_contract(tmp_path, capsys):
             "60",
             "--duration",
             "3",
+            "--trails",
+            "4",
         ]
     )
     assert status == 0, capsys.readouterr().err
@@ -105,6 +107,7 @@ def test_shimmy_end_to_end_writes_the_contract(tmp_path, capsys):
         assert {"critical_speed", "critical_speed_ci95", "frequency_hz", "stability"} <= set(fm), name
         assert len(fm["stability"]) == 60
         assert set(fm["stability"][0]) == {"speed", "growth_rate", "frequency_hz"}
+        assert [r["trail"] for r in fm["trail_map"]] == pytest.approx([0.0, 0.1, 0.2, 0.3])
     for row in data["simulations"]:
         assert {"speed", "friction_model", "csv", "verdict", "amplitude"} <= set(row)
         assert row["verdict"] in ("decays", "grows", "limit_cycle")
@@ -117,6 +120,7 @@ def test_shimmy_end_to_end_writes_the_contract(tmp_path, capsys):
         "eigenvalue_paths.png",
         "time_histories.png",
         "limit_cycle_amplitude.png",
+        "stability_plane.png",
     ):
         assert (out / fig).stat().st_size > 1000, fig
 
