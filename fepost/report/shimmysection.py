@@ -39,7 +39,7 @@ def shimmy_section(data: ReportData, folder: Path) -> Section | None:
     from .sections import Section
 
     gear = load_gear(gear_path)
-    result = shimmy_study(data.analysis, gear, simulate_motion=False)
+    result = shimmy_study(data.analysis, gear, simulate_motion=False, trails=0)
     sub = Path(folder) / "shimmy"
     sub.mkdir(exist_ok=True)
     (sub / "shimmy.json").write_text(to_json(result.to_dict()) + "\n", encoding="utf-8")
