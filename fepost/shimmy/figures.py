@@ -23,6 +23,8 @@ STYLE = {
 }
 #: Line colour of each friction model.
 COLOURS = {"closed_forms": "#2ca02c", "generalised": "#c0392b", "exact": "#1f4e99"}
+#: Line style of each model (the generalised model dashed: it lies on the exact integrals).
+STYLES = {"closed_forms": "-", "generalised": "--", "exact": "-"}
 LABELS = {
     "closed_forms": "paper's closed forms",
     "generalised": "generalised model",
@@ -44,7 +46,7 @@ def stability_figure(result: ShimmyResult, ax=None):
     for m in result.models:
         s = m.stability
         col = COLOURS.get(m.name, "k")
-        ax.plot(s.speeds, s.growth_rate, color=col, label=LABELS.get(m.name, m.name))
+        ax.plot(s.speeds, s.growth_rate, STYLES.get(m.name, "-"), color=col, label=LABELS.get(m.name, m.name))
         for v in s.critical_speeds:
             ax.axvline(v, color=col, ls=":", lw=1)
         if m.critical_speed_ci95 is not None:
@@ -131,7 +133,8 @@ def trail_figure(result: ShimmyResult, ax=None):
             continue
         tm = m.trail_map
         v = np.array([np.nan if c is None else c for c in tm.critical_speeds])
-        ax.plot(tm.trails, v, "o-", ms=3, color=COLOURS.get(m.name, "k"), label=LABELS.get(m.name, m.name))
+        style = "o" + STYLES.get(m.name, "-")
+        ax.plot(tm.trails, v, style, ms=3, color=COLOURS.get(m.name, "k"), label=LABELS.get(m.name, m.name))
     ax.axvline(result.gear.trail, color="k", ls=":", lw=1, label="the gear's trail")
     ax.set_xlabel("trail e (m)")
     ax.set_ylabel("critical speed (m/s): unstable above")
