@@ -46,7 +46,8 @@ def stability_figure(result: ShimmyResult, ax=None):
     for m in result.models:
         s = m.stability
         col = COLOURS.get(m.name, "k")
-        ax.plot(s.speeds, s.growth_rate, STYLES.get(m.name, "-"), color=col, label=LABELS.get(m.name, m.name))
+        ax.plot(s.speeds, s.growth_rate, STYLES.get(m.name, "-"), color=col, label=LABELS.get(m.name, m.name),
+                zorder=3 if m.name == "generalised" else 2)  # fmt: skip
         for v in s.critical_speeds:
             ax.axvline(v, color=col, ls=":", lw=1)
         if m.critical_speed_ci95 is not None:
@@ -134,7 +135,8 @@ def trail_figure(result: ShimmyResult, ax=None):
         tm = m.trail_map
         v = np.array([np.nan if c is None else c for c in tm.critical_speeds])
         style = "o" + STYLES.get(m.name, "-")
-        ax.plot(tm.trails, v, style, ms=3, color=COLOURS.get(m.name, "k"), label=LABELS.get(m.name, m.name))
+        ax.plot(tm.trails, v, style, ms=3, color=COLOURS.get(m.name, "k"), label=LABELS.get(m.name, m.name),
+                zorder=3 if m.name == "generalised" else 2)  # fmt: skip
     ax.axvline(result.gear.trail, color="k", ls=":", lw=1, label="the gear's trail")
     ax.set_xlabel("trail e (m)")
     ax.set_ylabel("critical speed (m/s): unstable above")
