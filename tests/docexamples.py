@@ -356,7 +356,11 @@ def main(argv: list[str] | None = None) -> int:
     changed = 0
     with tempfile.TemporaryDirectory(prefix="fepost-docexamples-") as tmp:
         for i, page in enumerate(chosen):
-            problems = update(page, Path(tmp) / str(i), args.update)
+            try:
+                problems = update(page, Path(tmp) / str(i), args.update)
+            except (RuntimeError, subprocess.TimeoutExpired) as exc:  # a documented command failed
+                print(f"{page}: not updated: {str(exc).splitlines()[0]}", file=sys.stderr)
+                return 2
             changed += bool(problems)
             verb = "rewritten" if args.update and problems else "differs" if problems else "up to date"
             print(f"{page}: {verb}")
