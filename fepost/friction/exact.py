@@ -23,7 +23,7 @@ with ρ_max(θ) the distance from p0 to the domain boundary along θ:
     ∬ (α x ê_θ,y − y ê_θ,x) dA = α p0_x I_x + p0_y I_y + ∫ (α cos²θ + sin²θ) ρ_max³/3 dθ.
 
 ρ_max is analytic and periodic, so the periodic trapezoid converges spectrally;
-its strip of analyticity narrows like √δ as p0 nears the boundary (δ = |1 − q|,
+its strip of analyticity narrows like √δ as p0 nears the boundary (δ = 1 − q,
 q the ellipse level of p0), and the number of θ nodes grows accordingly
 (`_theta_nodes`).
 
@@ -35,8 +35,9 @@ just inside. Such centres are subtracted too, L the constant g at the boundary
 point c + (p0 − c)/q, with ρ_maxⁿ replaced by ρ_outⁿ − ρ_inⁿ over the directions
 [θ_c − Δ, θ_c + Δ] that meet the domain; with θ = θ_c + Δ cos φ the integrand is
 smooth and even in φ (ρ_out − ρ_in ∝ sin φ), so the midpoint rule in φ converges
-spectrally. Near a square-root edge (Hertz) g's gradient grows like δ^(−1/2) and
-its term cost 1.9e-4 of fN at δ = 1e-6: inside, it is scaled by
+spectrally, `OUTSIDE_NODES` at any distance. Near a square-root edge (Hertz)
+g's gradient grows like δ^(−1/2) and its term cost 1.9e-4 of fN at δ = 1e-6:
+inside, it is scaled by
 min(1, δ/`GRADIENT_TAPER`). The integrals do not depend on L, only the error
 does: below 2e-5 of fN on either side (tests/test_friction_continuity.py).
 """
@@ -64,6 +65,9 @@ THETA_MIN = 64
 THETA_MAX = 1 << 16
 #: ... and enough for exp(−THETA_DECAY) relative error given the analytic strip.
 THETA_DECAY = 25.0
+#: Midpoints in φ about a centre on or outside the boundary: round-off (~1e-15 of the
+#: moments) at every distance from it, also on it (64 give ≤ 7e-13; aspect 2.5 tried).
+OUTSIDE_NODES = 256
 #: Finite-difference step for ∇(μσ) at the ICR, relative to the larger semi-axis.
 FD_STEP = 1e-4
 #: Centres of rotation outside the domain up to this ellipse level are subtracted too
@@ -123,13 +127,13 @@ def checked_kinematics(vx, vy, wz) -> tuple[np.ndarray, np.ndarray, np.ndarray, 
 
 
 def _theta_nodes(domain: Ellipse, level: np.ndarray) -> np.ndarray:
-    """Trapezoid (inside) or midpoint (outside) node counts, powers of two, for p0 at
-    ellipse level q."""
-    delta = np.maximum(np.abs(1.0 - level), 1e-300)
+    """Trapezoid node counts (powers of two) for p0 at ellipse level q < 1; `OUTSIDE_NODES`
+    midpoints for q ≥ 1."""
+    delta = np.maximum(1.0 - level, 1e-300)
     aspect = max(domain.ax, domain.ay) / min(domain.ax, domain.ay)
     need = THETA_DECAY * aspect / np.sqrt(2.0 * delta)
-    n = np.exp2(np.ceil(np.log2(np.maximum(need, THETA_MIN))))
-    return np.minimum(n, THETA_MAX).astype(int)
+    n = np.minimum(np.exp2(np.ceil(np.log2(np.maximum(need, THETA_MIN)))), THETA_MAX)
+    return np.where(level < 1.0, n, OUTSIDE_NODES).astype(int)
 
 
 def ray_integrals(domain: Ellipse, px: np.ndarray, py: np.ndarray) -> np.ndarray:
