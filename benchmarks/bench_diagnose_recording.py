@@ -4,6 +4,9 @@ A synthetic recording (:mod:`fepost.diagnose.synthetic_recording`: the default
 rig programme's test points with a hidden ``pressure_dependent_friction``, each
 held ``--hold`` s at ``--rate`` Hz with ``--ramp`` s ramps between, AR(1)
 noise) of each size in ``--rows`` is written once per format into ``--dir``.
+``--gaps K`` writes the recording with K dropouts of 50 samples (NaN in one
+channel each, drawn at random) and one clock reset half-way instead, so the cost
+of leaving them out can be compared.
 Then, ``--repeat`` times each, in fresh processes:
 
 * ``fepost diagnose --simulation SIM --measured FILE --out DIR --force`` (the
@@ -46,7 +49,7 @@ def _make(folder: Path, rows: int, suffix: str, args) -> tuple[Path, Path]:
     sim = folder / "sim.vtu"
     if not sim.exists():
         write_map(sim, "hertz", radius=0.1, peak=3.0e5)
-    path = folder / f"rec_{rows}{suffix}"
+    path = _path(folder, rows, suffix, args)
     if path.exists():
         return sim, path
     per = int(round((args.hold + args.ramp) * args.rate))
@@ -58,18 +61,28 @@ def _make(folder: Path, rows: int, suffix: str, args) -> tuple[Path, Path]:
     syn = synthesize(pmap, "pressure_dependent_friction", {"c_p": 0.3}, noise=0.0, seed=1, kinematics=kin)
     rec = synthetic_recording(syn, rate=args.rate, hold=args.hold, ramp=args.ramp, sd=(60, 60, 3), seed=2)
     rec = {k: v[:rows] for k, v in rec.items()}
+    if args.gaps:
+        rng = np.random.default_rng(3)
+        starts, channels = rng.integers(0, rows - 50, args.gaps), rng.choice(list(rec)[:7], args.gaps)
+        for at, ch in zip(starts, channels, strict=True):
+            rec[ch][at : at + 50] = np.nan
+        rec["time"][rows // 2 :] -= rec["time"][rows // 2]  # a logger restart: the clock starts again at 0
     write_recording(rec, path)
     return sim, path
+
+
+def _path(folder: Path, rows: int, suffix: str, args) -> Path:
+    return folder / (f"rec_{rows}_gaps{args.gaps}{suffix}" if args.gaps else f"rec_{rows}{suffix}")
 
 
 def _ensure(folder: Path, rows: int, suffix: str, args) -> tuple[Path, Path]:
     """The files, generated in a child process when missing: a child's peak RSS counts its parent's
     memory at fork, so this process must stay small while it times the others."""
-    sim, path = folder / "sim.vtu", folder / f"rec_{rows}{suffix}"
+    sim, path = folder / "sim.vtu", _path(folder, rows, suffix, args)
     if not (sim.exists() and path.exists()):
         cmd = [sys.executable, __file__, "--generate-only", "--rows", str(rows), "--formats", suffix[1:],
                "--rate", str(args.rate), "--hold", str(args.hold), "--ramp", str(args.ramp),
-               "--dir", str(folder)]  # fmt: skip
+               "--gaps", str(args.gaps), "--dir", str(folder)]  # fmt: skip
         subprocess.run(cmd, check=True)
     return sim, path
 
@@ -95,6 +108,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--rate", type=float, default=1000.0)
     parser.add_argument("--hold", type=float, default=5.0)
     parser.add_argument("--ramp", type=float, default=1.0)
+    parser.add_argument("--gaps", type=int, default=0, help="dropouts of 50 samples, and one clock reset")
     parser.add_argument("--dir", default="/tmp/fepost-bench-recording")
     parser.add_argument("--generate-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -105,8 +119,9 @@ def main(argv: list[str] | None = None) -> None:
             for fmt in args.formats:
                 _make(folder, rows, "." + fmt, args)
         return
+    gaps = f", {args.gaps} dropouts and a clock reset" if args.gaps else ""
     print(f"load average {os.getloadavg()}; {os.cpu_count()} CPUs; {args.rate:g} Hz, holds {args.hold:g} s, "
-          f"ramps {args.ramp:g} s")  # fmt: skip
+          f"ramps {args.ramp:g} s{gaps}")  # fmt: skip
     for rows in (int(r) for r in args.rows):
         for fmt in args.formats:
             suffix = "." + fmt

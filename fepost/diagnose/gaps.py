@@ -112,7 +112,7 @@ class GapTracker:
     def scan(self, chunk: Chunk) -> Scan:
         chans = [c for c in READ if c in chunk.values]
         badm = np.column_stack([~np.isfinite(chunk.values[c]) for c in chans])
-        bad = badm.any(axis=1)
+        bad: np.ndarray = np.any(badm, axis=1)
         if self.strict and bad.any():
             i = int(np.flatnonzero(bad)[0])
             ch = chans[int(np.argmax(badm[i]))]
@@ -157,9 +157,9 @@ class GapTracker:
         offset = self._offset + np.cumsum(jump)
         clock[idx] = tf + offset
         reset[idx[back]] = True
-        for k in np.flatnonzero(back):
+        for j in np.flatnonzero(back).tolist():
             self.resets.append(
-                Reset(chunk.start + int(idx[k]), float(prev[k]), float(tf[k]), float(clock[idx[k]]))
+                Reset(chunk.start + int(idx[j]), float(prev[j]), float(tf[j]), float(clock[idx[j]]))
             )
         self._offset, self._last_t = float(offset[-1]), float(tf[-1])
         return clock, reset
