@@ -37,9 +37,9 @@ point c + (p0 − c)/q, with ρ_maxⁿ replaced by ρ_outⁿ − ρ_inⁿ over t
 smooth and even in φ (ρ_out − ρ_in ∝ sin φ), so the midpoint rule in φ converges
 spectrally, `OUTSIDE_NODES` at any distance. Near a square-root edge (Hertz)
 g's gradient grows like δ^(−1/2) and its term cost 1.9e-4 of fN at δ = 1e-6:
-inside, it is scaled by
-min(1, δ/`GRADIENT_TAPER`). The integrals do not depend on L, only the error
-does: below 2e-5 of fN on either side (tests/test_friction_continuity.py).
+inside, it is scaled by min(1, δ/`GRADIENT_TAPER`). The integrals do not depend
+on L, only the error does: below 2e-5 of fN on either side of the boundary, the
+uniform disc's to round-off (tests/test_friction_continuity.py).
 """
 
 from __future__ import annotations
