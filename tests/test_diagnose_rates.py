@@ -223,6 +223,28 @@ def test_a_clock_reset_starts_a_new_segment(plain, tmp_path):
         find_holds(path, rule=HoldRule(strict=True))
 
 
+def test_chunks_change_nothing(plain, tmp_path, monkeypatch):
+    """Read in chunks of 997 rows, with dropouts and a reset across chunk ends: the same holds and gaps."""
+    rec, _ = plain
+    gappy = {k: np.asarray(v, float).copy() for k, v in rec.items()}
+    # across the ends of chunks 3, 6 and 9, and one ending with chunk 7 (rows 6960 … 6978)
+    for at, n, ch in ((2990, 40, "Fy"), (5970, 40, "vx"), (6960, 19, "Mz"), (8950, 40, "time")):
+        gappy[ch][at : at + n] = np.nan
+    gappy["time"][4000:] -= 7.0
+    path = write_recording(gappy, tmp_path / "gappy.parquet")
+    with pytest.warns(RecordingWarning):
+        whole = find_holds(path)
+    monkeypatch.setattr("fepost.diagnose.recording.CHUNK_ROWS", 997)
+    with pytest.warns(RecordingWarning):
+        parts = find_holds(path)
+    assert len(whole.dropouts) == 4 and len(whole.resets) == 1
+    assert parts.dropouts == whole.dropouts and parts.resets == whole.resets
+    np.testing.assert_array_equal(parts.row_spans, whole.row_spans)
+    np.testing.assert_array_equal(parts.data.forces, whole.data.forces)
+    np.testing.assert_array_equal(parts.se, whole.se)
+    assert parts.left_out == whole.left_out
+
+
 def test_recordings_mostly_non_finite_or_without_holds_are_refused(plain, tmp_path):
     rec, _ = plain
     empty = {k: np.full(400, np.nan) for k in CHANNELS}

@@ -178,6 +178,10 @@ class GapTracker:
         firsts, lasts = edges[::2], edges[1::2] - 1
         if idx.size:
             self._last_clock = float(clock[idx[-1]])
+        if self._open is not None and not bad[0]:  # the previous chunk's dropout ended with it
+            first, last, t0, t1, mask = self._open
+            self._open = (first, last, t0, float(clock[0]) if np.isnan(t1) else t1, mask)
+            self._close()
         for a, b in zip(firsts, lasts, strict=True):
             chans_bad = badm[a : b + 1].any(axis=0)
             if a == 0 and self._open is not None:
@@ -186,7 +190,7 @@ class GapTracker:
             else:
                 first, t0, mask = start + int(a), float(last_finite[a]), np.zeros(len(chans), bool)
             k = np.searchsorted(idx, b)  # the first finite time at or after the run's last row
-            t1 = float(clock[idx[k]]) if k < idx.size else float(last_finite[b])
+            t1 = float(clock[idx[k]]) if k < idx.size else np.nan  # NaN: in a later chunk
             self._open = (first, start + int(b), t0, t1, mask | chans_bad)
             if b + 1 < bad.size:
                 self._close()
@@ -198,6 +202,7 @@ class GapTracker:
             return
         first, last, t0, t1, mask = self._open
         self._open = None
+        t1 = self._last_clock if np.isnan(t1) else t1  # a dropout to the end: the last time known
         t0 = t1 if np.isnan(t0) else t0
         names = tuple(c for c, m in zip(self._chans, mask, strict=True) if m)
         self.dropouts.append(Dropout(first, last, (t0, t1), names))
