@@ -201,6 +201,18 @@ def test_a_dropout_is_left_out_and_reported(syn, plain, tmp_path, channels):
         find_holds(path, rule=HoldRule(strict=True))
 
 
+def test_point_column_holds_are_cut_by_dropouts(plain, tmp_path):
+    rec, ref = plain
+    at = _inside_hold(rec, 7, 0.5)
+    bad = {k: np.asarray(v, float).copy() for k, v in rec.items()}
+    bad["point"] = np.where(rec["hold_id"] >= 0, rec["hold_id"], np.nan)
+    bad["Mz"][at : at + 20] = np.nan
+    with pytest.warns(RecordingWarning, match=r"1 dropout\(s\), 20 rows non-finite \(Mz 20\)"):
+        h = find_holds(write_recording(bad, tmp_path / "p.parquet"), rule=HoldRule(use_point=True))
+    assert h.count == ref.count + 1 and h.rows_used == np.count_nonzero(rec["hold_id"] >= 0) - 20
+    assert not any(a <= at <= b for a, b in h.row_spans)
+
+
 def test_a_clock_reset_starts_a_new_segment(plain, tmp_path):
     rec, ref = plain
     at = _inside_hold(rec, 9, 0.4)
