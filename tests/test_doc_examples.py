@@ -10,9 +10,8 @@ from __future__ import annotations
 
 import re
 
+import docexamples as dx  # tests/docexamples.py (the folder is on sys.path, as for the other helpers)
 import pytest
-
-from tests import docexamples as dx
 
 CHECKED = [
     (page, b.name) for page in dx.pages_with_examples() for b in dx.blocks(page) if b.kind == "checked"
