@@ -73,8 +73,9 @@ EXTENSION = {
 
 
 def _runs(rig: Path) -> list[Path]:
+    """The slide/spin runs of the folder (``d<direction>_*``, ``spin_*``; not other runs beside them)."""
     out = []
-    for side in sorted(rig.glob("*.json")):
+    for side in sorted([*rig.glob("d[0-9][0-9][0-9]_*.json"), *rig.glob("spin_*.json")]):
         data = json.loads(side.read_text())
         if "kinematics" in data:
             out.append(side.with_suffix(".vtu"))

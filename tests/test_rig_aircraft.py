@@ -23,8 +23,9 @@ FRICTION = 0.3
 
 
 def _runs() -> list[Path]:
+    """The slide/spin runs (the rolling runs ``roll_*`` beside them are not this programme's)."""
     out = []
-    for side in sorted(RIG.glob("*.json")):
+    for side in sorted([*RIG.glob("d[0-9][0-9][0-9]_*.json"), *RIG.glob("spin_*.json")]):
         data = json.loads(side.read_text())
         if "kinematics" in data and side.with_suffix(".vtu").exists():
             out.append(side.with_suffix(".vtu"))

@@ -77,12 +77,15 @@ def _mesh(kind: str):
     return build_rig_mesh(kind)
 
 
-def base_task(setup: Setup):
-    """Inflation pre-run and base run, reused from the work folder: (rim travel, clearance, Base)."""
+def base_task(setup: Setup, mesh):
+    """Inflation pre-run and base run, reused from the work folder: (rim travel, clearance, Base).
+
+    The mesh comes from the client (gmsh meshes only in a main thread, Dask runs tasks in others).
+    """
     from .rig_run import inflation_rim_travel, solve_base
     from .solve import find_ccx
 
-    mesh, exe, work = _mesh(setup.mesh_kind), find_ccx(), Path(setup.work)
+    exe, work = find_ccx(), Path(setup.work)
     rim_travel, clearance, _ = inflation_rim_travel(mesh, work, exe, AIRCRAFT)
     return rim_travel, clearance, solve_base(mesh, rim_travel, work / "base", exe, AIRCRAFT)
 
@@ -106,13 +109,13 @@ def is_done(out: Path, name: str, sha: str) -> bool:
         return False
 
 
-def run_task(setup: Setup, spec: RunSpec, info: dict) -> dict[str, bytes]:
+def run_task(setup: Setup, spec: RunSpec, info: dict, mesh) -> dict[str, bytes]:
     """Solve one run (reusing a finished solve in the work folder) and export it: {file name: bytes}."""
     from .rig_export import write_run
     from .rig_run import inflation_rim_travel, solve_base, solve_run
     from .solve import find_ccx
 
-    mesh, exe, work = _mesh(setup.mesh_kind), find_ccx(), Path(setup.work)
+    exe, work = find_ccx(), Path(setup.work)
     rim_travel, _, _ = inflation_rim_travel(mesh, work, exe, AIRCRAFT)
     base = solve_base(mesh, rim_travel, work / "base", exe, AIRCRAFT)
     kin = rd.kinematics(spec.direction, spec.angle, spec.sign, AIRCRAFT)
@@ -251,7 +254,8 @@ def run_programme(
     with Cluster(workers=None if scheduler else workers, scheduler=scheduler) as cluster:
         client = cluster.client
         t0 = time.perf_counter()
-        rim_travel, clearance, base = client.submit(base_task, setup, pure=False).result()
+        shared = client.scatter(mesh, broadcast=True)
+        rim_travel, clearance, base = client.submit(base_task, setup, shared, pure=False).result()
         _log(
             f"base (inflation + {AIRCRAFT.deflection * 1e3:.1f} mm): "
             f"load {base.static_load[2] / 1e3:.1f} kN, "
@@ -267,6 +271,8 @@ def run_programme(
 
         def submit(spec: RunSpec):
             # earlier runs first: a higher priority for each earlier place in the order
-            return client.submit(run_task, setup, spec, info, pure=False, priority=n - specs.index(spec))
+            return client.submit(
+                run_task, setup, spec, info, shared, pure=False, priority=n - specs.index(spec)
+            )
 
         return drive(specs, shas, out, submit, cluster.as_completed)
