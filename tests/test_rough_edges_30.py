@@ -335,3 +335,12 @@ def test_report_provenance_and_grid_phrase(tmp_path, monkeypatch):
     assert str(maps) not in table
     assert html.count("the densest evaluated") == 1
     assert "model errors: the largest errors over the error map&#39;s grid, the densest evaluated" in html
+
+
+def test_table1_json_dash_is_standard_output(small_map, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["table1", "--static", str(small_map), "--json", "-", "--n-points", "20"]) == 0
+    cap = capsys.readouterr()
+    doc = json.loads(cap.out)
+    assert doc["inputs"]["static"] == str(small_map)
+    assert "static map:" in cap.err and not (tmp_path / "-").exists()
