@@ -144,3 +144,33 @@ def test_the_read_budget_counts_the_heavy_data(mesh, tmp_path):
     meshio.write(path, mesh)
     xml, h5 = path.stat().st_size, path.with_suffix(".h5").stat().st_size
     assert data_size(path, xml) == xml + h5
+
+
+def test_a_time_series_step_linked_outside_the_folder_is_refused(mesh, tmp_path):
+    """A dolfinx time series whose step of the pressure is an HDF5 external link to a file
+    outside the folder (h5py would follow it): refused naming the .h5 and the dataset; the
+    same link to a file in the folder is read (the linked values, twice the step's)."""
+    from fepost.errors import InputFileError
+
+    folder = tmp_path / "run"
+    folder.mkdir()
+    path = write_dolfinx_like(folder / "solution.xdmf", mesh, times=(0.25, 1.0))
+    h5 = path.with_suffix(".h5")
+    for where in (folder / "near.h5", tmp_path / "far.h5"):
+        with h5py.File(where, "w") as f:
+            f["p"] = (2 * mesh.point_data["CPRESS"])[:, None]
+    with h5py.File(h5, "a") as f:
+        del f["Function/p/1"]
+        f["Function/p/1"] = h5py.ExternalLink("near.h5", "/p")
+    assert analyse(path, grid=GRID, field="p").static_patch.N_fe == pytest.approx(
+        2 * analyse(SAMPLE, grid=GRID).static_patch.N_fe, rel=TOL
+    )
+    with h5py.File(h5, "a") as f:
+        del f["Function/p/1"]
+        f["Function/p/1"] = h5py.ExternalLink("../far.h5", "/p")
+    with pytest.raises(InputFileError) as err:
+        read_contact(path, field="p")
+    assert str(err.value) == (
+        f"{path}: refused .xdmf file (heavy-data file 'solution.h5': dataset '/Function/p/1' reaches "
+        "'../far.h5' through an HDF5 external link, which lies outside the file's folder)"
+    )

@@ -26,6 +26,11 @@ and binary with ``*NODE OUTPUT`` / ``*ELEMENT OUTPUT`` / ``*CONTACT OUTPUT``
 The file is memory-mapped and walked once; every count is checked against the
 bytes left before anything is allocated, and result blocks are only located
 here (their values are read on demand by `block_values`).
+A block's records must hold exactly the values its ``-5`` lines declare stored
+(ASCII: the values of each record are counted; binary: the records must end where
+the next line starts): a wrong ``IEXIST`` flag would otherwise shift every column.
+Whether the closing ``9999`` line was found is kept (`FrdFile.complete`): a file
+cut off while written ends without it.
 """
 
 from __future__ import annotations

@@ -65,7 +65,7 @@ from .names import ArrayInfo, needed_point_arrays
 from .raw import RawMesh, defer_point_arrays
 from .transfer import fresh_array
 from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
-from .xmlcheck import NUMPY_TYPES, DataArray, Xml
+from .xmlcheck import NUMPY_TYPES, DataArray, Xml, text_end
 
 #: Suffixes the direct decoder may take (serial unstructured grids and polygonal data).
 DIRECT_SUFFIXES = (".vtu", ".vtp")
@@ -187,7 +187,10 @@ def _format(xml: Xml) -> _Format:
     if compressor and compressor not in _INFLATE:
         raise _NotHere  # LZ4 and unknown compressors: VTK's
     endian: Literal["<", ">"] = ">" if xml.endian == ">" else "<"
-    return _Format(xml.path, xml.header_size, endian, _INFLATE.get(compressor), xml.appended, xml.text_end)
+    ends = None
+    if xml.appended is not None:  # plain numbers only: the format travels with the lazy loaders
+        ends = partial(text_end, xml.appended[0], xml.offsets, xml.stream_end)
+    return _Format(xml.path, xml.header_size, endian, _INFLATE.get(compressor), xml.appended, ends)
 
 
 def _piece(xml: Xml):

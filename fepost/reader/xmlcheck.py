@@ -279,12 +279,7 @@ class Xml:
         """Where the base64 text of the appended array at ``offset`` ends: at the next array's
         offset, or at the end of the AppendedData text."""
         assert self.appended is not None
-        k = bisect.bisect_right(self.offsets, offset)
-        return (
-            min(self.appended[0] + self.offsets[k], self.stream_end)
-            if k < len(self.offsets)
-            else self.stream_end
-        )
+        return text_end(self.appended[0], self.offsets, self.stream_end, offset)
 
     def _check_refs(self, refs: list[str], suffixes: tuple[str, ...], what: str) -> Counts:
         if self.depth >= MAX_VTM_DEPTH:
@@ -518,6 +513,13 @@ class Xml:
                 self.path,
                 f"the header disagrees with the data: the piece declares {declared} but {what} holds {held}",
             )
+
+
+def text_end(base: int, offsets: tuple[int, ...], stream_end: int, offset: int) -> int:
+    """Where the text of the appended array at ``offset`` ends (``base``: the first byte of the
+    AppendedData text, ``offsets``: every appended array's, sorted; ``stream_end``: its end)."""
+    k = bisect.bisect_right(offsets, offset)
+    return min(base + offsets[k], stream_end) if k < len(offsets) else stream_end
 
 
 def check_xml(path: Path, depth: int = 0) -> Counts:
