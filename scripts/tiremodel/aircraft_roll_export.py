@@ -267,7 +267,8 @@ def write_rolling(
             "Fz": h.fz.tolist(),
             "axle_torque_Nm": h.torque.tolist(),
         },
-        "history_note": "every converged increment (full tire; vertical travel first, then the roll)",
+        "history_note": "every written time (CalculiX prints the .dat at the deck's TIME POINTS only): "
+        "inflation, end of the vertical travel, then the samples along the roll; full tire",
         **common_keys(mesh, result, state, figures),
     }
     _write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")

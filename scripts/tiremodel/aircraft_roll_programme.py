@@ -31,7 +31,8 @@ from . import aircraft_roll_deck as rdk
 from .aircraft_geometry import AircraftMesh
 from .aircraft_roll_mesh import RollMeshSpec, build_roll_mesh
 
-SLIPS = (-0.20, 0.20, -0.04, 0.04, -0.01, 0.01)  # run order after free rolling
+# run order after free rolling: the largest levels, then the small ones that bracket Fx = 0
+SLIPS = (-0.20, 0.20, -0.01, 0.01, -0.04, 0.04)
 STATIC_NAME = "roll_static"
 
 

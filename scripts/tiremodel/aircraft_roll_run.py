@@ -45,7 +45,9 @@ class RollState:
 
 @dataclass(frozen=True)
 class RollHistory:
-    """Every converged increment (full tire): time, axle travel, turn, Fx, Fz, axle torque."""
+    """Every written time (full tire): time, axle travel, turn, Fx, Fz, axle torque, road rise.
+
+    CalculiX prints the .dat records at the deck's TIME POINTS only, like the .frd."""
 
     time: np.ndarray
     axle_travel: np.ndarray
@@ -121,7 +123,7 @@ def _by_time(blocks, kind: str, nset: str) -> dict[float, np.ndarray]:
 
 
 def read_history(dat: Path, plan: rdk.RollPlan) -> RollHistory:
-    """The per-increment records of the .dat file (road force, road travel, rim turn, torque)."""
+    """The printed records of the .dat file (road force, road travel, rim turn, torque)."""
     blocks = read_dat_blocks(dat)
     force = _by_time(blocks, "total force", "ROADN")
     road_u = _by_time(blocks, "displacements", "ROADREF")
