@@ -69,10 +69,12 @@ demo: $(DEMO_STAMP) system-deps-demo
 	@echo "== open $(OUT)/report.html"
 
 # FEPOST_REQUIRE_DOCS: tests/test_docs.py fails (instead of skipping) without the docs
-# tooling, so the strict docs build always runs here.
+# tooling, so the strict docs build always runs here. Every test, in TEST_WORKERS pytest-xdist
+# processes (one per core; pyproject.toml adds -q, --durations=15 and --dist loadfile).
+TEST_WORKERS ?= auto
 test: $(TEST_STAMP) system-deps-test
-	@echo "== running the test suite (includes the strict docs build)"
-	FEPOST_REQUIRE_DOCS=1 $(PY) -m pytest; rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; rc=0; fi; exit $$rc
+	@echo "== running the test suite on $(TEST_WORKERS) workers (includes the strict docs build)"
+	FEPOST_REQUIRE_DOCS=1 $(PY) -m pytest -n $(TEST_WORKERS); rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; rc=0; fi; exit $$rc
 
 # The documentation site (MkDocs, warnings are errors) -> site/
 docs: $(TEST_STAMP)

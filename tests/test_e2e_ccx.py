@@ -8,7 +8,6 @@ from __future__ import annotations
 import json
 import shutil
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -30,16 +29,10 @@ def _integral(vtu) -> float:
 
 
 @pytest.fixture(scope="module")
-def coarse_static(tmp_path_factory):
-    if not HAVE_CCX:
-        pytest.skip("CalculiX 'ccx' is not on PATH")
-    from scripts.tiremodel.__main__ import main
-
-    out = tmp_path_factory.mktemp("coarse")
-    t0 = time.perf_counter()
-    rc = main(["build", "--case", "static", "--coarse", "--out", str(out)])
-    elapsed = time.perf_counter() - t0
-    assert rc == 0
+def coarse_static(coarse_static_tire):
+    """The coarse static tire solved once per session (tests/conftest.py; the .frd tests read
+    the same solve): its exported folder and the build's wall time."""
+    out, _, elapsed = coarse_static_tire
     return out, elapsed
 
 
@@ -59,7 +52,7 @@ def test_coarse_model_cpress_integral_matches_reaction(coarse_static):
 @pytest.mark.ccx
 @pytest.mark.slow
 @needs_ccx
-def test_coarse_model_through_fepost_coefficients(coarse_static, tmp_path):
+def test_coarse_model_through_fepost_coefficients(coarse_static, tmp_path, small_accuracy_grid):
     try:
         import fepost.cli.coefficients  # noqa: F401
     except ImportError:

@@ -254,16 +254,13 @@ def test_double_precision_results(cases, tmp_path):
 
 
 @pytest.mark.slow
-def test_sample_tire_frd_against_its_reaction_and_export(tmp_path):
+def test_sample_tire_frd_against_its_reaction_and_export(coarse_static_tire):
     """The coarse sample tire of scripts/tiremodel (8-node bricks, node-to-surface penalty contact,
     16 increments; ~2 min): its .frd read directly against CalculiX's reaction and against the VTU
     the scripts export from the same file. Measured: N_fe 2.4e-4 from the reaction (the bilinear
     interpolation of CPRESS over the half-open faces at the contact rim, bound 1e-3); N, M0, R, F0
     within 2e-6 of the export (both read the same five-digit values; bound 1e-5)."""
-    from scripts.tiremodel.__main__ import main as build
-
-    out, keep = tmp_path / "out", tmp_path / "keep"
-    assert build(["build", "--case", "static", "--coarse", "--out", str(out), "--keep", str(keep)]) == 0
+    out, keep, _ = coarse_static_tire  # solved once per session (tests/conftest.py), as test_e2e_ccx's
     frd = keep / "static" / "static.frd"
     side = json.loads((out / "static.json").read_text())
     steps = time_steps(frd)
