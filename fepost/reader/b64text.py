@@ -39,7 +39,8 @@ def chars(nbytes: int) -> int:
 def describe(text: bytes, start: int = 0, skip: bytes = b"", base: int = 0) -> str:
     """Why ``text[start:]`` is not base64: its first byte outside the alphabet, the padding
     and ``skip`` (named by its place in the array's text, ``text[0]`` being character ``base``)."""
-    k = next(k for k in range(start, len(text)) if text[k] not in ALPHABET + b"=" + skip)
+    odd = text[start:].translate(None, ALPHABET + b"=" + skip)  # in order: the first is the culprit
+    k = text.index(odd[:1], start)
     if text[k] in SPACE:
         return f"whitespace at character {base + k}, which VTK's reader misreads"
     return f"invalid character {chr(text[k])!r} at character {base + k}"
