@@ -244,7 +244,7 @@ def _mutate(data: bytes, rng: random.Random) -> tuple[str, bytes]:
 
 
 @pytest.fixture(autouse=True)
-def _bounded(monkeypatch):
+def _bounded(monkeypatch, small_accuracy_grid):
     monkeypatch.setenv("FEPOST_READ_TIMEOUT", "20")  # a hang costs at most this, and fails the case
 
 

@@ -28,7 +28,7 @@ MUTATIONS = 16
 
 
 @pytest.fixture(autouse=True)
-def _bounded(monkeypatch):
+def _bounded(monkeypatch, small_accuracy_grid):
     monkeypatch.setenv("FEPOST_READ_TIMEOUT", "20")
 
 

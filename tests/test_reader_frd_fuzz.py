@@ -27,7 +27,11 @@ from test_reader_frd import HAVE_CCX, solve
 
 from fepost.cli import main
 
-pytestmark = [pytest.mark.ccx, pytest.mark.skipif(not HAVE_CCX, reason="CalculiX 'ccx' is not on PATH")]
+pytestmark = [
+    pytest.mark.ccx,
+    pytest.mark.skipif(not HAVE_CCX, reason="CalculiX 'ccx' is not on PATH"),
+    pytest.mark.usefixtures("small_accuracy_grid"),  # the checks are N_fe and the errors (conftest.py)
+]
 SEED = 20261125
 ARGS = ("--nr", "16", "--nphi", "32")
 #: A read of these small files takes well under a second; a hang would take the reader's deadline.
