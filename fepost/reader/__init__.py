@@ -33,7 +33,8 @@ crashes or hangs a C library becomes a one-line
 Modules, one concern each: `vtkassemble` (a VTK data set's arrays into
 element blocks, for both VTK paths), `transfer` (the child's answer to the
 caller), `cells` (element types, faces, boundary),
-`b64text` (base64 text checked and decoded as VTK decodes it),
+`b64text` (base64 text checked and decoded as VTK decodes it), `xmlarrays`
+(the lengths of a VTK XML file's arrays, from their headers),
 `surface` (which body's faces carry the pressure), `names`
 (which array is the pressure), `units` (unit systems, scale checks),
 `sidecar` (the ``<stem>.json`` beside a file), `quadratic`

@@ -65,7 +65,8 @@ from .names import ArrayInfo, needed_point_arrays
 from .raw import RawMesh, defer_point_arrays
 from .transfer import fresh_array
 from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
-from .xmlcheck import NUMPY_TYPES, DataArray, Xml, text_end
+from .xmlarrays import NUMPY_TYPES, DataArray, text_end
+from .xmlcheck import Xml
 
 #: Suffixes the direct decoder may take (serial unstructured grids and polygonal data).
 DIRECT_SUFFIXES = (".vtu", ".vtp")
