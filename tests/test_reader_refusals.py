@@ -65,3 +65,25 @@ def test_two_contact_names_are_an_error_listing_them(tmp_path):
         f"{path}: several candidate contact-pressure arrays: CPRESS (point), contact_pressure (point), "
         "pressure (point); choose one with --field"
     )
+
+
+def test_a_block_that_is_a_directory_is_not_a_regular_file_not_missing(tmp_path):
+    """A multi-block file naming a directory where a block file belongs: the refusal says what
+    the path is, not that it is missing; the same file naming the real block reads."""
+    from fepost.errors import InputFileError
+
+    _quad(tmp_path, {"CPRESS": [1e5] * 4}, name="block.vtu")
+    (tmp_path / "odd.vtu").mkdir()
+    body = (
+        '<?xml version="1.0"?>\n<VTKFile type="vtkMultiBlockDataSet" version="1.0">\n'
+        '<vtkMultiBlockDataSet><DataSet index="0" file="{}"/></vtkMultiBlockDataSet>\n</VTKFile>\n'
+    )
+    good, odd = tmp_path / "good.vtm", tmp_path / "odd.vtm"
+    good.write_text(body.format("block.vtu"))
+    odd.write_text(body.format("odd.vtu"))
+    assert np.all(read_contact(good).values == 1e5)
+    with pytest.raises(InputFileError) as err:
+        read_contact(odd)
+    assert str(err.value) == (
+        f"{odd}: refused .vtm file (multi-block piece 'odd.vtu' is not a regular file but a directory)"
+    )
