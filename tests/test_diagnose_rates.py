@@ -84,8 +84,8 @@ def test_holds_do_not_depend_on_the_logging_rate(syn, by_rate):
 
 
 def test_hidden_effect_found_at_every_rate(pmap, by_rate):
-    """The cause is named and both 95 % intervals hold the truth at every rate (this seed; over 30
-    seeds per rate the f interval's coverage is reported in docs/diagnose.md)."""
+    """The cause is named and both 95 % intervals hold the truth at every rate (this seed; the
+    coverage over many seeds per rate is in docs/diagnose.md, "Rig recordings")."""
     for rate, (_, h) in by_rate.items():
         d = diagnose(pmap, h, friction=0.3, pairs=False)  # the single causes: what the rate could change
         assert d.cause == "pressure_dependent_friction", rate
