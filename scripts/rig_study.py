@@ -405,6 +405,17 @@ def steady_lines(rows: list[tuple[str, float, float]], limit: float = 0.005) -> 
     ]
 
 
+def _shifted_forces(quad, kin, h, scale, friction: float) -> np.ndarray:
+    """(n, 3) Fx, Fy, Mz of the static map shifted by the law with heights ``h`` (m), at each run's load."""
+    from fepost.friction.law import FrictionLaw
+    from fepost.rig.extension import ShiftLaw, predict_shifted
+
+    hx, hy = float(h[0]), float(h[1])
+    law = ShiftLaw(hx, hy, 0.0, 0.0, (hx, hx), (hy, hy), 0.0, 0.0, 0.0, 0.0, len(scale))
+    r = predict_shifted(quad, *kin, law=law, friction=FrictionLaw(f=friction)).resultants
+    return np.column_stack([r.Fx, r.Fy, r.Mz]) * scale[:, None]
+
+
 def _fit_heights(quad, kin, target, scale, R: float, friction: float) -> tuple[float, float]:
     """(h_x, h_y) (m) that make the shifted static map reproduce ``target`` (n, 3) best.
 
@@ -414,34 +425,34 @@ def _fit_heights(quad, kin, target, scale, R: float, friction: float) -> tuple[f
     """
     from scipy.optimize import least_squares
 
-    from fepost.friction.law import FrictionLaw
-    from fepost.rig.extension import ShiftLaw, predict_shifted
-
-    law = FrictionLaw(f=friction)
     n0 = float(np.sum(quad.sigma * quad.dA))
     unit = np.array([1.0, 1.0, 1.0 / R]) / (friction * n0 * scale[:, None])
 
     def residual(h):
-        shift = ShiftLaw(h[0], h[1], 0.0, 0.0, (h[0], h[0]), (h[1], h[1]), 0.0, 0.0, 0.0, 0.0, len(scale))
-        r = predict_shifted(quad, *kin, law=shift, friction=law).resultants
-        pred = np.column_stack([r.Fx, r.Fy, r.Mz]) * scale[:, None]
-        return ((pred - target) * unit).ravel()
+        return ((_shifted_forces(quad, kin, h, scale, friction) - target) * unit).ravel()
 
     sol = least_squares(residual, x0=np.array([0.01, 0.01]), bounds=([-0.5, -0.5], [0.5, 0.5]), x_scale=0.01)
     return float(sol.x[0]), float(sol.x[1])
 
 
 def heights(table, static, preds, shifts, shift_law, friction: float, diagnosis: Path | None) -> list[str]:
-    """Markdown: the load-transfer heights from the maps and from three force targets (module docstring)."""
+    """Markdown: the load-transfer heights from the maps and from three force targets (module docstring).
+
+    Each row also says what its h does with the other data: the RMS force and
+    torque misfit against the FE (in-sample) and the RMS error of the
+    centre-of-pressure shift h F / N against the runs' own maps.
+    """
     from fepost.friction.law import FrictionLaw
     from fepost.friction.quadrature import PressureQuadrature
     from fepost.rig.extension import shifted_resultants
 
     quad = PressureQuadrature.from_polar(static.static_map)
     kin = tuple(np.array([getattr(r, k) for r in table.runs]) for k in ("vx", "vy", "wz"))
-    scale = np.array([r.reaction.N for r in table.runs]) / static.coefficients.N
+    n_run = np.array([r.reaction.N for r in table.runs])
+    scale = n_run / static.coefficients.N
     moved = shifted_resultants(quad, *kin, dx=shifts[:, 0], dy=shifts[:, 1], law=FrictionLaw(f=friction))
     fe = np.array([[r.reaction.Fx, r.reaction.Fy, r.reaction.Mz] for r in table.runs])
+    force = np.array([[r.shear.Fx / r.shear.N, r.shear.Fy / r.shear.N] for r in table.runs])
     R = static.coefficients.R
     rows = [("the runs' maps: centre-of-pressure shift against F / N (as (e))", shift_law.h_x, shift_law.h_y)]
     for label, target in (
@@ -464,13 +475,25 @@ def heights(table, static, preds, shifts, shift_law, friction: float, diagnosis:
                     float(values["h_y"]["value"]),
                 )
             )
+    lines = []
+    for label, hx, hy in rows:
+        d = (_shifted_forces(quad, kin, (hx, hy), scale, friction) - fe) / (friction * n_run[:, None])
+        rms_f = float(np.sqrt(np.mean(d[:, 0] ** 2 + d[:, 1] ** 2)))
+        rms_m = float(np.sqrt(np.mean((d[:, 2] / R) ** 2)))
+        err = shifts - force * np.array([hx, hy])
+        rms_d = float(np.sqrt(np.mean(np.sum(err**2, axis=1))))
+        lines.append(
+            f"| {label} | {hx * 1e3:.1f} | {hy * 1e3:.1f} | {rms_f:.4f} | {rms_m:.4f} | {rms_d * 1e3:.2f} |"
+        )
     return [
         "",
-        "Load-transfer heights found in different ways (h / mm):",
+        "Load-transfer heights found in different ways (h / mm), and what each does: RMS misfit of the "
+        "shifted static map against the FE forces (in-sample; fN, fNR) and RMS error of the "
+        "centre-of-pressure shift h F / N against the runs' maps (mm):",
         "",
-        "| from | h_x | h_y |",
-        "|---|---|---|",
-        *(f"| {label} | {hx * 1e3:.1f} | {hy * 1e3:.1f} |" for label, hx, hy in rows),
+        "| from | h_x | h_y | RMS \\|dF\\| / fN | RMS dMz / fNR | RMS shift error / mm |",
+        "|---|---|---|---|---|---|",
+        *lines,
     ]
 
 

@@ -236,6 +236,8 @@ def run_programme(
     scheduler: str | None = None,
 ) -> dict[str, dict]:
     """Solve (or skip, when finished) and export the runs ``only`` (default: the whole programme)."""
+    import dask
+
     from fepost.sweep.engine import Cluster
 
     from .rig_export import write_static
@@ -251,6 +253,9 @@ def run_programme(
         specs = [s for s in specs if s.name in only]
     mesh = _mesh(mesh_kind)
     _log(f"mesh aircraft-{mesh_kind}: {mesh.nodes.shape[0]} nodes, {mesh.hexes.shape[0]} hexahedra")
+    # tasks wait on the scheduler until a worker is free, so they start in the programme's order
+    # (assigned to workers at once, a busy worker's queue would hold back its early runs)
+    dask.config.set({"distributed.scheduler.worker-saturation": 1.0})
     with Cluster(workers=None if scheduler else workers, scheduler=scheduler) as cluster:
         client = cluster.client
         t0 = time.perf_counter()
