@@ -12,9 +12,10 @@ instead of ``rho`` (ρ = exp(−1/(rate·τ)), the same noise in time at every r
 causal second-order Butterworth low-pass, Hz, started at rest on the first
 sample; the commanded kinematics are digital and are written as they are), and
 ``repeat`` holds each written value of every channel for that many samples (a
-logger that writes faster than its converter and the controller update). `write_recording` writes it as CSV, Parquet,
-MATLAB v5 or v7.3, or TYDEX, with the rig's own channel names and units when
-asked (so the reading side's mapping is exercised).
+logger that writes faster than its converter and the controller update).
+`write_recording` writes it as CSV, Parquet, MATLAB v5 or v7.3, or TYDEX, with
+the rig's own channel names and units when asked (so the reading side's mapping
+is exercised).
 """
 
 from __future__ import annotations
