@@ -275,6 +275,8 @@ def test_mutated_csvs_through_the_cli(capsys, data):
 VALUES = ["", "-1", "0", "1e999", "nan", "abc", "9" * 5000, "-1e-300", "1,2,3,4", "\x00"]
 #: Options not fuzzed: a value could make the command wait on the network.
 SKIP_OPTIONS = {("sweep", "--scheduler")}
+# a valid gear file, so that the shimmy command reaches the option under test
+GEAR_EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "gear_a320_main.json"
 
 
 def _required(command: str, folder: Path) -> list[str]:
@@ -288,6 +290,7 @@ def _required(command: str, folder: Path) -> list[str]:
         "predict": [missing, "--kinematics", folder / "good.csv", "--out", folder / "pred.csv"],
         "sweep": [missing, "--out", folder / "out-sweep"],
         "rig": [missing, "--out", folder / "rig.csv"],
+        "shimmy": [missing, "--gear", GEAR_EXAMPLE, "--out", folder / "out-shimmy"],
     }.get(command, [])
 
 
@@ -306,7 +309,7 @@ def test_hostile_option_values(capsys, data, command, monkeypatch):
     folder, _, _ = data
     # a hostile --out value is a relative folder (``--out=abc``): keep what it writes in the scratch folder
     monkeypatch.chdir(folder)
-    if command not in ("coefficients", "table1", "report", "diagnose", "predict", "sweep", "rig"):
+    if command not in ("coefficients", "table1", "report", "diagnose", "predict", "sweep", "rig", "shimmy"):
         pytest.fail(f"new command {command!r}: add its required arguments to _required()")
     base = _required(command, folder)
     missing = folder / "missing.vtu"

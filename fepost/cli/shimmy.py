@@ -40,7 +40,7 @@ def add_parser(sub) -> None:
             "lateral bending, wheels sliding with multi-component dry friction) and find where straight "
             "rolling with longitudinal sliding turns unstable: eigenvalues over a speed sweep and time "
             "simulations, for the paper's closed forms, the generalised model and the exact integrals, "
-            "with the coefficients' 95 %% intervals carried to the critical speed. Writes DIR/shimmy.json, "
+            "with the coefficients' 95 % intervals carried to the critical speed. Writes DIR/shimmy.json, "
             "time histories (CSV) and figures. Model and gear file: docs/shimmy.md."
         ),
     )
