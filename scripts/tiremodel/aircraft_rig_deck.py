@@ -69,4 +69,6 @@ AIRCRAFT = rd.RigTire(
     controls=CONTROLS,
     friction=ad.FRICTION,
     one_step=True,
+    # on a shared, loaded machine the base took 20 min and the fine mesh's base over 30
+    timeout=6 * 3600.0,
 )

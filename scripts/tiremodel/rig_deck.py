@@ -89,6 +89,7 @@ class RigTire:
     controls: tuple[str, ...] = ()
     friction: float = dk.FRICTION
     one_step: bool = False  # base and slide each one step, driven by amplitudes (below)
+    timeout: float = 1800.0  # s, wall time allowed to one CalculiX run
 
     @property
     def slide_start(self) -> float:

@@ -83,7 +83,7 @@ def inflation_rim_travel(
         dk.write_deck(inp, mesh, dk.CASES["static"], 0.0, inflation_only=True)
     else:
         rd.write_base_deck(inp, mesh, 0.0, (0.0, 0.0), tire, inflation_only=True)
-    t = _solve_once(exe, inp, "")
+    t = _solve_once(exe, inp, "", tire.timeout)
     r0 = read_frd(inp.with_suffix(".frd"))
     _, u0 = r0.field(max(r0.last), "U")
     slave = np.unique(mesh.contact_quads)
@@ -93,14 +93,14 @@ def inflation_rim_travel(
     return z + tire.deflection, z, t
 
 
-def _solve_once(exe: str, inp: Path, key: str) -> float:
+def _solve_once(exe: str, inp: Path, key: str, timeout: float = 1800.0) -> float:
     """Run ccx unless a finished solution of this deck (and ``key``) is there; return its wall time."""
     digest = hashlib.sha256(inp.read_bytes() + key.encode()).hexdigest()
     stamp = inp.with_suffix(".done")
     if stamp.exists() and stamp.read_text().split()[0] == digest and inp.with_suffix(".frd").exists():
         return float(stamp.read_text().split()[1])
     stamp.unlink(missing_ok=True)
-    t = run_ccx(exe, inp, threads=1)
+    t = run_ccx(exe, inp, threads=1, timeout=timeout)
     stamp.write_text(f"{digest} {t:.1f}\n")
     return t
 
@@ -123,7 +123,7 @@ def solve_base(
     workdir.mkdir(parents=True, exist_ok=True)
     inp = workdir / "base.inp"
     nodes = rd.write_base_deck(inp, mesh, rim_travel, (0.0, 0.0), tire)
-    t = _solve_once(exe, inp, "")
+    t = _solve_once(exe, inp, "", tire.timeout)
     contact, u = _nodal(mesh, inp.with_suffix(".frd"), 1 if tire.one_step else 2)
     recs = [r for r in read_dat_blocks(inp.with_suffix(".dat")) if r[0] == "forces" and r[1] == "REFN"]
     load = next(arr[-1, -3:] for _, _, t_, arr in recs if abs(t_ - tire.slide_start) < 1e-9)
@@ -186,7 +186,7 @@ def solve_run(
     inp = workdir / f"{name}.inp"
     rd.write_slide_deck(inp, mesh, kin, rim_travel, base.nodes.ref_xy, inc, tire)
     shutil.copyfile(base.restart, inp.with_suffix(".rin"))
-    runtime = _solve_once(exe, inp, base.deck_sha256)
+    runtime = _solve_once(exe, inp, base.deck_sha256, tire.timeout)
     contact, u = _nodal(mesh, inp.with_suffix(".frd"))
     return RunResult(
         name=name,
