@@ -244,3 +244,12 @@ def test_programme_order_and_slip_plans():
     with pytest.raises(ValueError, match="effective radius"):
         specs[1].plan(None, setup)
     assert np.isclose(free.rotation, setup.travel / setup.radius_guess)
+
+
+def test_cli_refuses_an_unknown_run(tmp_path, capsys):
+    from scripts.tiremodel.__main__ import main
+
+    assert main(["roll", "--work", str(tmp_path), "--only", "roll_nope"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "roll_nope" in err and "roll_free" in err
+    assert not any(tmp_path.iterdir())  # nothing written

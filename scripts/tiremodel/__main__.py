@@ -166,6 +166,12 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "roll":
             from .aircraft_roll_programme import programme, run_programme
 
+            names = [s.name for s in programme()]
+            unknown = sorted(set(args.only or ()) - set(names))
+            if unknown:
+                msg = f"--only: no run {unknown[0]!r} (runs: {', '.join(names)})"
+                print(f"tiremodel: error: {msg}", file=sys.stderr)
+                return 2
             specs = [s for s in programme() if args.only is None or s.name in args.only]
             run_programme(args.out, args.work, specs, scheduler=args.scheduler)
             return 0
