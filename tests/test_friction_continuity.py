@@ -259,3 +259,19 @@ def test_fe_map_continuous_across_its_rim(aircraft):
     steps = np.abs(np.diff(v, axis=1))
     assert float(steps.max()) < 2e-3
     np.testing.assert_allclose(steps[:, 0], steps[:, 3], atol=JUMP)
+
+
+@pytest.mark.parametrize("wz", [1e-300, -1e-300, 5e-320, 1e-200])
+def test_vanishing_spin_is_pure_sliding(wz):
+    """A spin so small that |v|/|wz| overflows (the centre of rotation at infinity) gives the
+    pure-sliding resultants, F = −fN v/|v| and M_z of the sliding patch, with no floating-point
+    warning (the tests turn RuntimeWarning into an error)."""
+    quad, law = disc("hertz", radius=0.2), FrictionLaw(f=0.6)
+    vx, vy = np.array([0.8, -0.3]), np.array([0.6, 0.4])
+    tiny = friction_resultants(quad, vx, vy, np.full(2, wz), law)
+    slide = friction_resultants(quad, vx, vy, np.zeros(2), law)
+    got, ref = normalised(quad, tiny, law), normalised(quad, slide, law)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12)
+    speed = np.hypot(vx, vy)
+    np.testing.assert_allclose(got[0], -vx / speed, atol=1e-9)
+    np.testing.assert_allclose(got[1], -vy / speed, atol=1e-9)

@@ -424,7 +424,12 @@ def _centres(setting: _Setting, *, vx, vy, wz) -> tuple[np.ndarray, np.ndarray, 
     without it)."""
     if not setting.order:
         return np.empty(0, np.int64), np.empty(0), np.empty(0)
-    spin = wz != 0
+    # only centres that can lie within the band are computed: |p0| = |v|/|wz| is bounded by the
+    # band's reach, so a spin so small that the centre is far away (or |v|/|wz| overflows) is none
+    dom = setting.quad.domain
+    reach = 2.0 * (np.hypot(dom.cx, dom.cy) + OUTSIDE_BAND * max(dom.ax, dom.ay))
+    spin = np.abs(wz) * reach >= np.hypot(vx, vy)
+    spin &= wz != 0
     p0x = np.zeros(vx.size)
     p0y = np.zeros(vx.size)
     p0x[spin] = -vy[spin] / wz[spin]
