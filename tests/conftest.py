@@ -123,3 +123,71 @@ def coarse_static_tire(made_once):
 
     folder = made_once("coarse-static-tire", build)
     return folder / "out", folder / "keep", float((folder / "seconds").read_text())
+
+
+# ----------------------------------------------------------------------------- the files' order
+# Under xdist (--dist loadfile --no-loadscope-reorder, pyproject.toml) a worker that runs out of
+# work takes the next file in collection order. The longest files go first, so that no worker
+# starts a long file when the other is nearly done: by their seconds in the last run recorded in
+# pytest's cache (.pytest_cache), else by SECONDS, measured on a quiet 2-core machine.
+
+_ORDER = pytest.StashKey[dict]()
+#: Seconds of the longest files (the sum of their tests' durations) when no run was recorded.
+SECONDS = {
+    "test_docs.py": 45,
+    "test_e2e_ccx.py": 35,
+    "test_reader_frd.py": 35,
+    "test_report.py": 30,
+    "test_fuzz_files.py": 25,
+    "test_rig_ccx.py": 20,
+    "test_rig_extension.py": 20,
+    "test_diagnose_rig.py": 20,
+    "test_sweep.py": 20,
+    "test_diagnose_selection.py": 15,
+    "test_reader_frd_fuzz.py": 15,
+    "test_diagnose_recording.py": 15,
+}
+_CACHE_KEY = "fepost/seconds-per-file"
+_seconds: dict[str, float] = {}
+
+
+def _file_of(nodeid: str) -> str:
+    return nodeid.split("::", 1)[0].rsplit("/", 1)[-1]
+
+
+def pytest_configure(config):
+    """Read once, in the controller: every worker must collect the tests in the same order."""
+    if not hasattr(config, "workerinput"):
+        cache = getattr(config, "cache", None)
+        config.stash[_ORDER] = (cache.get(_CACHE_KEY, None) if cache is not None else None) or SECONDS
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):  # pytest-xdist's controller, for each worker
+    node.workerinput[_CACHE_KEY] = node.config.stash[_ORDER]
+
+
+def pytest_collection_modifyitems(config, items):
+    seconds = config.workerinput[_CACHE_KEY] if hasattr(config, "workerinput") else config.stash[_ORDER]
+    first: dict[str, int] = {}
+    for k, item in enumerate(items):
+        first.setdefault(_file_of(item.nodeid), k)
+    items.sort(key=lambda it: (-seconds.get(_file_of(it.nodeid), 0.0), first[_file_of(it.nodeid)]))
+
+
+def pytest_runtest_logreport(report):
+    name = _file_of(report.nodeid)
+    _seconds[name] = _seconds.get(name, 0.0) + report.duration
+
+
+def pytest_sessionfinish(session):
+    """Record the files' seconds after a whole run (no file, -k or -m chosen), in the controller."""
+    config = session.config
+    cache = getattr(config, "cache", None)
+    whole = config.args_source == pytest.Config.ArgsSource.TESTPATHS
+    whole = whole and not config.option.keyword and not config.option.markexpr
+    if cache is None or hasattr(config, "workerinput") or not whole or not _seconds:
+        return
+    recorded = dict(cache.get(_CACHE_KEY, None) or {})
+    recorded.update({name: round(s, 1) for name, s in _seconds.items()})
+    cache.set(_CACHE_KEY, recorded)
