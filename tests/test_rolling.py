@@ -21,6 +21,7 @@ from fepost import analyse
 from scripts.tiremodel import aircraft_roll_programme as prog
 from scripts.tiremodel.aircraft_roll_deck import RollPlan
 from scripts.tiremodel.aircraft_roll_mesh import build_roll_mesh, tiny_roll_spec
+from scripts.tiremodel.aircraft_roll_table import moment_shift
 
 ROLL = Path(__file__).resolve().parents[1] / "meshes" / "rig-aircraft"
 RUNS = sorted(p for p in ROLL.glob("roll_*.json") if p.stem != prog.STATIC_NAME)
@@ -101,8 +102,12 @@ def test_rolled_maps_pair_with_the_static_map():
         res = analyse(static, run.with_suffix(".vtu"))
         c = res.coefficients
         assert c.N_rolling / c.N == pytest.approx(1.0, abs=0.03)
-        own = json.loads(run.read_text())["samples"][-1]["centre_of_pressure_shift_m"]
+        side = json.loads(run.read_text())
+        own = side["samples"][-1]["centre_of_pressure_shift_m"]
         assert c.x_c == pytest.approx(own, abs=5e-4)
+        # the solver's own reactions: the axle torque balances h Fx + x_p Fz about the axle;
+        # nodal contact forces against their bilinear interpolation over 20 mm faces: 1 mm
+        assert moment_shift(side) == pytest.approx(own, abs=1e-3)
 
 
 @pytest.mark.skipif(

@@ -27,6 +27,7 @@ class Row:
     k_x: float
     x_c: float
     x_c_own: float | None  # the sidecar's exact face integral of the centre shift
+    x_c_moment: float | None  # the shift from the solver's reactions: (T - h Fx) / Fz - static centre
     x_c_steady: tuple[float, ...]  # the own shift at the last three written times
     load_ratio: float  # N_rolling / N (fepost)
 
@@ -47,9 +48,24 @@ def analyse_run(static: Path, run_json: Path) -> Row:
         k_x=float(c.k_x),
         x_c=float(c.x_c),
         x_c_own=shifts[-1],
+        x_c_moment=moment_shift(side),
         x_c_steady=shifts,
         load_ratio=float(c.N_rolling / c.N),
     )
+
+
+def moment_shift(side: dict) -> float:
+    """Centre-of-pressure shift (m) from the moment balance of the tire about the axle.
+
+    The road's force acts at the road plane, h = axle height above it below the axle:
+    the axle torque T balances h Fx + x_p Fz, so the pressure centre is at
+    x_p = (T - h Fx) / Fz (axle frame); minus the static map's centre.
+    """
+    from .aircraft_geometry import AircraftParams
+
+    h = AircraftParams().axle_z - side["rim_travel_z"]
+    fx, _, fz = side["reaction"]["force"]
+    return (side["axle_torque_Nm"] - h * fx) / fz - side["static_centre_of_pressure_x_m"]
 
 
 def rows(folder: Path) -> list[Row]:
@@ -68,30 +84,35 @@ def standin_row() -> Row:
     force = side["reaction_force_road"]
     c = res.coefficients
     return Row(
-        "aircraft/rolling_100 (slide)",
-        None,
-        force[0] / force[2],
-        None,
-        float(c.k_x),
-        float(c.x_c),
-        None,
-        (),
-        1.0,
+        name="aircraft/rolling_100 (slide)",
+        slip=None,
+        fx_over_n=force[0] / force[2],
+        torque=None,
+        k_x=float(c.k_x),
+        x_c=float(c.x_c),
+        x_c_own=None,
+        x_c_moment=None,
+        x_c_steady=(),
+        load_ratio=float(c.N_rolling / c.N),
     )
 
 
 def markdown(table: list[Row]) -> str:
-    head = "| run | slip κ | Fx/N | axle torque (kN m) | x_c fepost (mm) | x_c faces (mm) | k_x | N_roll/N |"
-    lines = [head, "|---|---|---|---|---|---|---|---|"]
+    head = (
+        "| run | slip κ | Fx/N | axle torque (kN m) | x_c fepost (mm) | x_c faces (mm) | x_c moments (mm) "
+        "| k_x | N_roll/N |"
+    )
+    lines = [head, "|---|---|---|---|---|---|---|---|---|"]
     for r in table:
         slip = "–" if r.slip is None else f"{r.slip:+.3f}"
         torque = "–" if r.torque is None else f"{r.torque / 1e3:+.2f}"
         own = "–" if r.x_c_own is None else f"{1e3 * r.x_c_own:+.2f}"
+        mom = "–" if r.x_c_moment is None else f"{1e3 * r.x_c_moment:+.2f}"
         lines.append(
-            f"| `{r.name}` | {slip} | {r.fx_over_n:+.3f} | {torque} | {1e3 * r.x_c:+.2f} | {own} "
+            f"| `{r.name}` | {slip} | {r.fx_over_n:+.3f} | {torque} | {1e3 * r.x_c:+.2f} | {own} | {mom} "
             f"| {r.k_x:+.3f} | {r.load_ratio:.3f} |"
         )
-    lines.append(f"| paper (steady rolling, its tire) | – | – | – | – | – | {PAPER_KX:+.3f} | – |")
+    lines.append(f"| paper (steady rolling, its tire) | – | – | – | – | – | – | {PAPER_KX:+.3f} | – |")
     return "\n".join(lines)
 
 
