@@ -132,6 +132,10 @@ def test_free_rolling_kx_is_close_to_zero():
     slope, intercept = np.polyfit(fx, shift, 1)
     assert slope > 0  # a driving force moves the centre forward
     assert abs(per_metre * intercept) < FREE_KX_TOL
+    # the drive's torque is the driver node's reaction: the spring's k (theta_driver - theta)
+    setup = prog.Setup()
+    lag = setup.travel / setup.radius_guess - math.radians(side["rim_rotation_deg"])
+    assert side["axle_torque_Nm"] == pytest.approx(2 * setup.drive_stiffness * lag, rel=1e-3)
     # the map's own k_x is that line at the run's final force (fepost against the face integral)
     assert c.k_x == pytest.approx(per_metre * (intercept + slope * fx[-1]), rel=0.15)
 
