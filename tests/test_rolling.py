@@ -104,7 +104,8 @@ def test_rolled_maps_pair_with_the_static_map():
         assert c.N_rolling / c.N == pytest.approx(1.0, abs=0.03)
         side = json.loads(run.read_text())
         own = side["samples"][-1]["centre_of_pressure_shift_m"]
-        assert c.x_c == pytest.approx(own, abs=5e-4)
+        # fepost's polar resampling of the 20 mm faces against their exact integral
+        assert c.x_c == pytest.approx(own, rel=0.05, abs=3e-4)
         # the solver's own reactions: the axle torque balances h Fx + x_p Fz about the axle;
         # nodal contact forces against their bilinear interpolation over 20 mm faces: 1 mm
         assert moment_shift(side) == pytest.approx(own, abs=1e-3)
