@@ -13,6 +13,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from .._mplrc import MPL_RC
+
 #: Window size of the 3-D renders, pixels (width, height).
 WINDOW_SIZE = (1200, 900)
 #: Colour map of pressure, everywhere.
@@ -29,24 +31,7 @@ EXACT_COLOUR = "#1f4e99"
 CLOSED_COLOUR = "#2ca02c"
 FIT_COLOUR = "#c0392b"
 TEST_COLOUR = "#555555"
-#: matplotlib figure size (inches) and resolution of the PNGs (dpi).
-MPL_FIGSIZE = (7.0, 4.6)
-MPL_DPI = 130
-
-_MPL_RC: dict[str, Any] = {
-    "figure.figsize": MPL_FIGSIZE,
-    "figure.dpi": 100,
-    "savefig.dpi": MPL_DPI,
-    "font.size": 10,
-    "axes.grid": True,
-    "grid.alpha": 0.3,
-    "axes.spines.top": False,
-    "axes.spines.right": False,
-    "legend.fontsize": 8.5,
-    "legend.frameon": False,
-    "svg.fonttype": "none",
-    "svg.hashsalt": "fepost",
-}
+_MPL_RC: dict[str, Any] = {**MPL_RC, "svg.fonttype": "none", "svg.hashsalt": "fepost"}
 
 
 def use_headless_vtk() -> None:

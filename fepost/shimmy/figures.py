@@ -7,20 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .._mplrc import MPL_RC
 from .result import ShimmyResult
 
-#: matplotlib settings of these figures (fepost's figure look: size, grid, no top/right spines).
-STYLE = {
-    "figure.figsize": (7.0, 4.6),
-    "savefig.dpi": 130,
-    "font.size": 10,
-    "axes.grid": True,
-    "grid.alpha": 0.3,
-    "axes.spines.top": False,
-    "axes.spines.right": False,
-    "legend.fontsize": 8.5,
-    "legend.frameon": False,
-}
+#: matplotlib settings of these figures: fepost's figure look.
+STYLE = MPL_RC
 #: Line colour of each friction model.
 COLOURS = {"closed_forms": "#2ca02c", "generalised": "#c0392b", "exact": "#1f4e99"}
 #: Line style of each model (the generalised model dashed: it lies on the exact integrals).
