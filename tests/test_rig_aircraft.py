@@ -278,3 +278,34 @@ def test_shear_integral_agrees_with_the_reactions():
         assert r.shear is not None
         assert math.hypot(r.reaction.Fx - r.shear.Fx, r.reaction.Fy - r.shear.Fy) < 1e-2 * fn, r.source
         assert abs(r.reaction.N - r.shear.N) < 1e-2 * r.reaction.N, r.source
+
+
+def _repeats() -> list[tuple[Path, Path]]:
+    """(programme run, the same run repeated on the finer mesh or with half the increment)."""
+    pairs = []
+    for sub in ("fine", "inc05"):
+        for side in sorted((RIG / sub).glob("*.json")):
+            base = RIG / side.with_suffix(".vtu").name
+            if "kinematics" in json.loads(side.read_text()) and base.exists():
+                pairs.append((base, side.with_suffix(".vtu")))
+    return pairs
+
+
+@needs_static
+def test_repeated_runs_agree_with_the_programme():
+    """Convergence: a run repeated on the finer mesh (``fine/``) or with half the largest
+    increment (``inc05/``) agrees with the programme's within 0.01 fN (forces) and 0.01 fNR
+    (torque about the patch origin), each in its own load; R = r_max of the static map."""
+    from fepost.analysis import analyse
+
+    pairs = _repeats()
+    if not pairs:
+        pytest.skip("no repeated run in meshes/rig-aircraft/fine or inc05 yet")
+    radius = analyse(RIG / "static.vtu").coefficients.R
+    for base, again in pairs:
+        a, b = (rig_table([p], shear=False).runs[0].reaction for p in (base, again))
+        ua, ub = FRICTION * a.N, FRICTION * b.N
+        dF = math.hypot(b.Fx / ub - a.Fx / ua, b.Fy / ub - a.Fy / ua)
+        dM = abs(b.Mz / (ub * radius) - a.Mz / (ua * radius))
+        assert dF < 0.01 and dM < 0.01, (again.relative_to(RIG), dF, dM)
+    assert {p.parent.name for _, p in pairs} == {"fine", "inc05"}
