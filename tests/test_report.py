@@ -518,12 +518,15 @@ def test_report_optional_sections(tmp_path, small_map):
 # ------------------------------------ the demo's case, the generalised model and the sample sweep
 def test_default_inputs_are_the_aircraft_tire():
     """`fepost report` without inputs, and so `make demo`, reports on the aircraft tire at its
-    rated load, static and rolling."""
+    rated load: the static map and the rolled map (free rolling), not the sliding stand-in."""
+    from fepost.reader.sidecar import read_sidecar
     from fepost.report.samples import sample_inputs
 
     static, rolling = sample_inputs()
     assert static == REPO / "meshes" / "aircraft" / "static_100.vtu"
-    assert rolling == REPO / "meshes" / "aircraft" / "rolling_100.vtu"
+    assert rolling == REPO / "meshes" / "rig-aircraft" / "roll_free.vtu"
+    side = read_sidecar(rolling)
+    assert side is not None and side["kind"] == "rolling run" and side["longitudinal_slip"] == 0
     make = (REPO / "Makefile").read_text()
     demo = re.search(r"^demo:.*\n((?:\t.*\n)+)", make, re.M)
     assert demo is not None
@@ -546,6 +549,47 @@ def test_report_default_case_is_the_aircraft_tire(report):
     assert coef["N"] == pytest.approx(side["reaction_z"], rel=0.005)  # the solver's own reaction
     text = "".join(_page(out).text)
     assert f"{side['inflation_pressure'] / 1e3:g}{NNBSP}kPa (sidecar)" in text
+
+
+@pytest.mark.slow
+def test_report_labels_the_rolling_map(report):
+    """What the rolling map is, from its sidecar, said in the provenance, the k_x row and
+    Figure 2 (caption and title); a rolled map's k_x with its own-mesh static map beside."""
+    from dataclasses import replace
+
+    from fepost.figures.units import normalise
+    from fepost.reader.sidecar import read_sidecar
+    from fepost.report.rollinglabel import rolling_label
+
+    _, out, _, inputs = report
+    coef = json.loads((out / "coefficients.json").read_text())
+    rolling = Path(coef["rolling"]["source"])
+    label = rolling_label(read_sidecar(rolling))
+    # the page's unit style (a narrow no-break space in 0.75 m), whitespace made one space
+    label = replace(label, text=" ".join(normalise(label.text).split()))
+    page = _page(out)
+    text = " ".join(" ".join(page.text).split())
+    provenance = text.split("Inputs and provenance", 1)[1].split("friction coefficient f", 1)[0]
+    assert provenance.count(label.text) == 1
+    assert f"k_x {coef['k_x']:.6g} R·x_c/⟨x²⟩: the centre-of-pressure shift of the {label.text}" in text
+    figure2 = text.split("Figure 2.", 1)[1].split("Figure 3.", 1)[0]
+    assert figure2.count(label.text) == 1
+    assert f"Figure 2: contact pressure, {label.short}" in [alt for _, alt in page.images]
+    if inputs:
+        assert label.kind == "unstated" and "own-mesh" not in text
+        return
+    assert label.kind == "rolled" and "free rolling" in label.text and "stand-in" not in provenance
+    import fepost
+    from fepost.report.assemble import shown_input
+
+    partner = rolling.parent / "roll_static.vtu"
+    k_own = fepost.analyse(partner, rolling, friction=coef["f"]).coefficients.k_x
+    assert (
+        f"k_x = {coef['k_x']:.4f} pairs the static map with the rolled map, which was solved on a mesh "
+        f"of its own; with its own-mesh static partner {shown_input(partner)[0]} the same "
+        f"rolled map gives k_x = {k_own:.4f}."
+    ) in text
+    assert page.values["coefficients.k_x"] == coef["k_x"]
 
 
 @pytest.mark.slow
@@ -608,17 +652,22 @@ def test_figures_4_6_show_the_generalised_model(report):
         assert len(model) == len(exact) > 100
         want = expected_table.generalised.form.curves(model[:, 0])[key]
         np.testing.assert_allclose(model[:, 1], want, rtol=1e-12, atol=0)
-        # the quoted gap is the gap of these curves, and within the 3 % goal
+        # the quoted gap is the gap of these curves, and within the 3 % goal of the error maps,
+        # whose force scale is F0: F⊥'s own scale |k_x| M0/(2R) vanishes in free rolling (the
+        # rolled map's k_x = 0.034 makes it 0.9 % of F0), so there the goal is taken in F0
         gap = np.max(np.abs(model[:, 1] - exact[:, 1])) / errors[key]["scale"]
-        assert gap == pytest.approx(errors[key]["model_max_abs_relative"], rel=1e-9) and gap < 0.03
+        assert gap == pytest.approx(errors[key]["model_max_abs_relative"], rel=1e-9)
+        goal_scale = errors["f_parallel"]["scale"] if key == "f_perp" else errors[key]["scale"]
+        assert gap * errors[key]["scale"] / goal_scale < 0.03
         assert 'id="model"' in (out / f"{stem}.svg").read_text(encoding="utf-8")  # the line is drawn
 
 
 @pytest.mark.slow
 def test_report_sample_sweep_section(report):
     """The report of the sample tire shows its load sweep: 6 loads, the power law of R with
-    its 95 % interval (equal to an independent fit of the table), and the report's own case
-    taken from its analysis, equal to a fresh computation of that row."""
+    its 95 % interval (equal to an independent fit of the table), and the report's own case,
+    whose row pairs it with the sweep's rolling map (the sliding stand-in, labelled so)
+    rather than the report's rolled map: equal to a fresh computation of that row."""
     from scipy import stats
 
     from fepost.options import AnalysisOptions
@@ -645,21 +694,64 @@ def test_report_sample_sweep_section(report):
     quoted = [float(g.replace("−", "-")) for g in m.groups()]
     assert quoted == pytest.approx([fit.slope, fit.slope - half, fit.slope + half], abs=6e-4)
     assert 0.3 < fit.slope < 0.7
-    # the rated-load row is the report's own analysis (not computed again: no worker time) ...
+    # the rated-load row pairs static_100 with the sweep's rolling map, the sliding stand-in,
+    # not the report's rolled map: computed by the sweep, its static coefficients the report's ...
     coef = json.loads((out / "coefficients.json").read_text())
     own = rows[3]
-    assert own["seconds"] is None and all(r["seconds"] is not None for i, r in enumerate(rows) if i != 3)
-    for key in ("N", "R", "M0", "a", "m", "k_x", "x_c", "aR2", "m_over_R2"):
+    assert Path(own["rolling"]).name == "rolling_100.vtu"
+    assert all(r["seconds"] is not None for r in rows)
+    for key in ("N", "R", "M0", "a", "m", "aR2", "m_over_R2"):
         assert own[key] == coef[key], key
-    # ... and equals the row a sweep computes for that file
-    static, rolling = sample_paths()
+    # ... and equal to the row a sweep computes for that pair, the stand-in's k_x included
+    static = sample_paths()[0]
+    stand_in = REPO / "meshes" / "aircraft" / "rolling_100.vtu"
     job = Job(own["source"], str(static.resolve()), None, AnalysisOptions(), friction=0.3,
-              rolling=str(rolling.resolve()), rolling_given=own["rolling"])  # fmt: skip
+              rolling=str(stand_in.resolve()), rolling_given=own["rolling"])  # fmt: skip
     fresh = run_job(job)
     assert fresh["status"] == "ok", fresh["error"]
     for key in ("N", "R", "M0", "a", "m", "k_x", "aspect", "circular", "load", "case", "deflection"):
         assert own[key] == fresh[key], key
-    assert "The report above is the case static_100 of this sweep." in section
+    assert own["k_x"] != coef["k_x"]
+    # the pairing is labelled for what it is, and the report's own rolling map named
+    text = " ".join(" ".join(_page(out).text).split())
+    assert (
+        "The k_x of static_100 is from its rolling partner rolling_100.vtu, a sliding stand-in (the "
+        "rim slid along x, no rotation): its k_x is the shift of a sliding patch, not of rolling."
+    ) in text
+    assert (
+        "The report above is the case static_100 of this sweep, with another rolling map: the report "
+        f"pairs it with roll_free.vtu, a rolled map (quasi-static free rolling, slip κ = 0.000, rim "
+        f"turned 75.5° over 0.75 m of axle travel) (k_x = {coef['k_x']:.4f}); the sweep's row keeps "
+        "the sweep's pairing."
+    ) in text
+
+
+@pytest.mark.slow
+def test_sample_sweep_reuses_the_report_row_of_the_same_pair(tmp_path):
+    """A report of static_100 with the sweep's own rolling map (the stand-in): the sweep takes
+    that row from the report's analysis (no worker time) and says the report is that case."""
+    from types import SimpleNamespace
+
+    import fepost
+    from fepost.options import AnalysisOptions
+    from fepost.report.sweepsection import sample_sweep_section
+    from fepost.sweep.table import read_table
+
+    air = REPO / "meshes" / "aircraft"
+    if not (air / "static_100.vtu").is_file():
+        pytest.skip("the sample meshes are absent: no sample sweep")
+    a = fepost.analyse(air / "static_100.vtu", air / "rolling_100.vtu", friction=0.3)
+    data = SimpleNamespace(analysis=a, friction=0.3, options=AnalysisOptions())
+    section = sample_sweep_section(data, tmp_path)
+    assert section is not None
+    rows = read_table(tmp_path / "sweep" / "coefficients.csv")
+    own = rows[3]
+    assert own["seconds"] is None and all(r["seconds"] is not None for i, r in enumerate(rows) if i != 3)
+    coef = a.to_dict()
+    for key in ("N", "R", "M0", "a", "m", "k_x", "x_c", "aR2", "m_over_R2"):
+        assert own[key] == coef[key], key
+    assert "The report above is the case static_100 of this sweep." in section.paragraphs[0]
+    assert any("rolling_100.vtu, a sliding stand-in" in p for p in section.paragraphs)
 
 
 @pytest.mark.slow
@@ -707,3 +799,130 @@ def test_a_map_without_inflation_pressure_warns_and_says_so(small_map):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert inflation_pressure_of(1.38e6, a) == (1.38e6, "option")
+
+
+# ------------------------------------ what the rolling map is (fepost.report.rollinglabel)
+ROLL = REPO / "meshes" / "rig-aircraft"
+
+
+def test_rolling_label_of_a_rolled_map():
+    from fepost.report.rollinglabel import rolling_label
+
+    side = {
+        "kind": "rolling run",
+        "longitudinal_slip": 0.0,
+        "rim_rotation_deg": 75.49635683320805,
+        "axle_travel_m": 0.75,
+    }
+    label = rolling_label(side)
+    assert label.kind == "rolled"
+    assert label.text == (
+        "rolled map (quasi-static free rolling, slip κ = 0.000, rim turned 75.5° over 0.75 m of axle travel)"
+    )
+    assert label.short == "rolled map, free rolling"
+    braked = rolling_label({**side, "longitudinal_slip": -0.2000000130, "rim_rotation_deg": 60.3798})
+    assert braked.text == (
+        "rolled map (quasi-static braking, slip κ = -0.200, rim turned 60.4° over 0.75 m of axle travel)"
+    )
+    assert rolling_label({**side, "longitudinal_slip": 0.04}).short == "rolled map, driving κ = 0.040"
+    # what the sidecar does not give is not said
+    assert rolling_label({"kind": "rolling run"}).text == "rolled map (quasi-static rolling)"
+
+
+def test_rolling_label_of_a_sliding_standin():
+    from fepost.report.rollinglabel import rolling_label
+
+    label = rolling_label({"rolling_standin": {"direction": "+x"}, "description": "a slide"})
+    assert label.kind == "standin" and label.short == "sliding stand-in"
+    assert label.text == (
+        "sliding stand-in (the rim slid along x, no rotation): its k_x is the shift of a sliding "
+        "patch, not of rolling"
+    )
+
+
+def test_rolling_label_without_a_kind():
+    from fepost.report.rollinglabel import rolling_label
+
+    for side in (None, {}, {"reaction_z": 1.0}):
+        label = rolling_label(side)
+        assert (label.kind, label.text, label.short) == (
+            "unstated",
+            "rolling map (kind not stated)",
+            "rolling map",
+        )
+    assert rolling_label({"kind": "static map"}).text == "rolling map (its sidecar's kind: static map)"
+
+
+def test_rolling_labels_of_the_shipped_maps():
+    """The shipped sidecars: the rolled runs, the sliding stand-ins of both tires."""
+    from fepost.reader.sidecar import read_sidecar
+    from fepost.report.rollinglabel import rolling_label
+
+    cases = {
+        ROLL / "roll_free.vtu": "rolled",
+        ROLL / "roll_brake20.vtu": "rolled",
+        REPO / "meshes" / "aircraft" / "rolling_100.vtu": "standin",
+        REPO / "meshes" / "rolling.vtu": "standin",
+    }
+    cases = {p: k for p, k in cases.items() if p.is_file()}
+    if not cases:
+        pytest.skip("no shipped rolling maps")
+    for path, kind in cases.items():
+        assert rolling_label(read_sidecar(path)).kind == kind, path
+    if (ROLL / "roll_free.vtu").is_file():
+        side = read_sidecar(ROLL / "roll_free.vtu")
+        turned = f"{side['rim_rotation_deg']:.1f}°"
+        assert turned in rolling_label(side).text and "free rolling" in rolling_label(side).text
+
+
+def test_own_mesh_static_partner(tmp_path):
+    """A rolled map's static partner: the one static map beside it on the same mesh."""
+    from fepost.report.rollinglabel import own_mesh_static
+
+    mesh = {"model_nodes": 10}
+    roll = {"kind": "rolling run", "mesh": mesh}
+
+    def put(name, side):
+        (tmp_path / f"{name}.vtu").write_bytes(b"")
+        (tmp_path / f"{name}.json").write_text(json.dumps(side))
+        return tmp_path / f"{name}.vtu"
+
+    r = put("roll_a", roll)
+    put("other_mesh", {"kind": "static map", "mesh": {"model_nodes": 11}})
+    put("slide", {"rolling_standin": {}, "mesh": mesh})
+    assert own_mesh_static(r, roll) is None  # no static map on that mesh yet
+    s = put("roll_static", {"kind": "static map", "mesh": mesh})
+    assert own_mesh_static(r, roll) == s
+    assert own_mesh_static(r, {"rolling_standin": {}, "mesh": mesh}) is None  # not a rolled map
+    assert own_mesh_static(r, None) is None
+    put("roll_static2", {"kind": "static map", "mesh": mesh})
+    assert own_mesh_static(r, roll) is None  # two candidates: none chosen
+    if (ROLL / "roll_free.vtu").is_file():
+        from fepost.reader.sidecar import read_sidecar
+
+        free = ROLL / "roll_free.vtu"
+        assert own_mesh_static(free, read_sidecar(free)) == ROLL / "roll_static.vtu"
+
+
+def test_own_mesh_k_x_is_the_pair_analysed_directly():
+    """The report's second k_x is the rolled map with its own-mesh static map, analysed
+    directly; none for a pair that already is that one, or for a stand-in."""
+    import fepost
+    from fepost.report.rollinglabel import own_mesh_k_x
+
+    static, free = REPO / "meshes" / "aircraft" / "static_100.vtu", ROLL / "roll_free.vtu"
+    if not (static.is_file() and free.is_file()):
+        pytest.skip("the sample meshes are absent")
+    a = fepost.analyse(static, free)
+    got = own_mesh_k_x(a, friction=0.3)
+    assert got is not None and got.static == ROLL / "roll_static.vtu"
+    direct = fepost.analyse(ROLL / "roll_static.vtu", free).coefficients.k_x
+    assert got.k_x == direct and abs(got.k_x - a.coefficients.k_x) < 0.02
+    # the k_x of the rolling run's centre-of-pressure shift from the sidecar's face integral
+    side = json.loads(free.with_suffix(".json").read_text())
+    shift = side["samples"][-1]["centre_of_pressure_shift_m"]
+    c = fepost.analyse(ROLL / "roll_static.vtu", free).coefficients
+    assert c.x_c == pytest.approx(shift, abs=1e-3)
+    assert own_mesh_k_x(fepost.analyse(ROLL / "roll_static.vtu", free), friction=0.3) is None
+    stand_in = REPO / "meshes" / "aircraft" / "rolling_100.vtu"
+    assert own_mesh_k_x(fepost.analyse(static, stand_in), friction=0.3) is None

@@ -8,6 +8,8 @@ point array.
 from __future__ import annotations
 
 import json
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -205,6 +207,27 @@ def test_cli_uses_sample_meshes_by_default(meshes, capsys, monkeypatch):
     assert main(["table1"]) == 0
     out = capsys.readouterr().out
     assert "rolling map, k_x" in out and str(meshes[0]) in out and str(meshes[1]) in out
+    assert f"rolling map: {meshes[1]}: rolling map (kind not stated)" in out  # no sidecar
+
+
+@pytest.mark.parametrize(
+    ("sidecar", "said"),
+    [
+        (
+            {"kind": "rolling run", "longitudinal_slip": 0.0, "rim_rotation_deg": 75.5, "axle_travel_m": 1},
+            "rolled map (quasi-static free rolling, slip κ = 0.000, rim turned 75.5° over 1 m of axle "
+            "travel)",
+        ),
+        ({"rolling_standin": {"direction": "+x"}}, "sliding stand-in (the rim slid along x, no rotation)"),
+    ],
+)
+def test_cli_says_what_the_rolling_map_is(meshes, tmp_path, capsys, sidecar, said):
+    """The rolling map's line names what its sidecar says it is."""
+    rolling = Path(shutil.copy(meshes[1], tmp_path / "rolling.vtu"))
+    rolling.with_suffix(".json").write_text(json.dumps(sidecar))
+    assert main(["table1", "--static", str(meshes[0]), "--rolling", str(rolling)]) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("rolling map:")]
+    assert len(lines) == 1 and lines[0].startswith(f"rolling map: {rolling}: {said}")
 
 
 def test_cli_unwritable_json_exits_2(meshes, tmp_path, capsys):

@@ -1,12 +1,14 @@
 """``fepost table1 [--static S] [--rolling R] [--seed N] [--json PATH] [--source SRC] ...``.
 
 Without ``--static`` and ``--rolling`` the report's sample pair is used: the
-aircraft tire at its rated load, ``meshes/aircraft/static_100.vtu`` and
-``meshes/aircraft/rolling_100.vtu`` (a one-line error names a missing file), so
-that ``fepost table1`` and ``fepost report`` show the same table. With
-``--static`` alone no rolling map is used (the sample rolling map belongs to
-another tire): k_x is then assumed (``--k-x``, default the paper's 0.130) and the
-table says so.
+aircraft tire at its rated load, ``meshes/aircraft/static_100.vtu`` and the rolled
+map ``meshes/rig-aircraft/roll_free.vtu`` (`fepost.report.samples`; a one-line
+error names a missing file), so that ``fepost table1`` and ``fepost report`` show
+the same table. With ``--static`` alone no rolling map is used (the sample rolled
+map belongs to the sample tire only): k_x is then assumed (``--k-x``, default the
+paper's 0.130) and the table says so. The rolling map is printed with what its
+sidecar says it is (`fepost.report.rollinglabel.rolling_label`): a rolled map, a
+sliding stand-in, or not stated.
 """
 
 from __future__ import annotations
@@ -38,7 +40,8 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--rolling",
         metavar="ROLLING",
-        help="rolling contact map (default: meshes/aircraft/rolling_100.vtu when --static is not given)",
+        help="rolling contact map (default: the rolled map meshes/rig-aircraft/roll_free.vtu "
+        "when --static is not given)",
     )
     p.add_argument("--seed", type=v.seed, default=SEED, metavar="S", help="noise seed (default %(default)s)")
     p.add_argument("--json", metavar="PATH", help="write the table as JSON (- for standard output)")
@@ -84,6 +87,7 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis import analyse
     from ..output import write_json_atomic
+    from ..report.rollinglabel import rolling_label
     from ..report.samples import sample_inputs
     from ..table1 import format_table, table1
 
@@ -106,7 +110,8 @@ def run(args: argparse.Namespace) -> int:
     say = summary_stream(args.json)
     print(f"static map: {result.static_field.source}", file=say)
     if result.rolling_field is not None:
-        print(f"rolling map: {result.rolling_field.source}", file=say)
+        rf = result.rolling_field
+        print(f"rolling map: {rf.source}: {rolling_label(rf.sidecar).text}", file=say)
     print(format_table(t), file=say)
     if args.json:
         d = t.to_dict()

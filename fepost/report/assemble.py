@@ -22,6 +22,7 @@ from .. import identify
 from ..analysis import Analysis
 from ..errors import ArgumentError
 from ..table1 import Table1
+from .rollinglabel import OwnMeshKx, RollingLabel, rolling_label
 
 if TYPE_CHECKING:
     from ..figures.curves import CurveData
@@ -338,6 +339,15 @@ def _dig(doc: Any, dotted: str) -> Any:
     return doc
 
 
+def _k_x_definition(key: str, definition: str, label: RollingLabel | None) -> str:
+    """The k_x row's definition, naming what the rolling map is (`rolling_label`)."""
+    if key != "k_x" or label is None:
+        return definition
+    from ..figures.units import normalise
+
+    return normalise(f"R·x_c/⟨x²⟩: the centre-of-pressure shift of the {label.text}")
+
+
 def model_rows(coef: Mapping[str, Any]) -> list[dict]:
     """Rows of the generalised model (`MODEL_ROWS`) present in ``coef["model"]``."""
     model = coef.get("model")
@@ -403,19 +413,24 @@ def page_context(
     seed: int | None,
     version: str,
     error_maps: Mapping[str, Mapping[str, Any]] | None = None,
+    own_mesh: OwnMeshKx | None = None,
 ) -> dict:
     """Every value ``report.html`` shows, from the JSON documents written beside it.
 
     ``coef``, ``table``, ``errors``: the parsed ``coefficients.json``,
     ``table1.json`` and ``closed_form_vs_exact.json``; ``error_maps``: the parsed
     ``error_map*.json`` by file stem (so the page shows exactly what the files
-    hold). Figures, files, sections and timings are added by the caller.
+    hold). Figures, files, sections and timings are added by the caller. What the
+    rolling map is comes from its sidecar (`fepost.report.rollinglabel`): said once in
+    the provenance, in the k_x row and in Figure 2; ``own_mesh`` (a rolled map's k_x with
+    its own-mesh static partner) is quoted beside the k_x of the pair.
     """
     a = analysis
     p = a.static_patch
+    label = None if a.rolling_field is None else rolling_label(a.rolling_field.sidecar)
     coefficient_rows = [
-        _row(key, label, kind, d, coef[key], "coefficients")
-        for key, label, kind, d in COEFFICIENT_ROWS
+        _row(key, label_, kind, _k_x_definition(key, d, label), coef[key], "coefficients")
+        for key, label_, kind, d in COEFFICIENT_ROWS
         if coef.get(key) is not None
     ]
     coefficient_rows += [
@@ -452,6 +467,12 @@ def page_context(
             "field": a.rolling_field.field,
             "load": coef.get("N_rolling"),
             "mismatch_allowed": coef["rolling"]["load_mismatch_allowed"],
+            "k_x": coef.get("k_x"),
+            "label": label.text if label else "",
+            "kind": label.kind if label else "",
+            "own_mesh": None
+            if own_mesh is None
+            else {"source": shown_input(own_mesh.static)[0], "k_x": own_mesh.k_x},
         },
         "friction": a.coefficients.f,
         "p_star": p_star,

@@ -25,6 +25,7 @@ from . import samples
 from .assemble import friction_curves, page_context, resolve_inflation_pressure
 from .figures import Figure, save_matplotlib, save_plotter
 from .providers import DEFAULT_SECTIONS
+from .rollinglabel import own_mesh_k_x, rolling_label
 from .sections import ReportData, SectionProvider, run_providers
 
 Progress = Callable[[int, int, str, float], None]
@@ -231,7 +232,9 @@ def build_report(
             a, t, fc, p_star, seed, a.coefficients.f, options=opts, gear=None if gear is None else str(gear)
         )
         extra = steps.run("optional sections", run_providers, sections, data, tmp)
-        page = _Page(a, t, fc, map_docs, figs, [*vtk_names, *(f for x in extra for f in x.files)], extra)
+        page = _Page(
+            a, t, fc, map_docs, figs, [*vtk_names, *(f for x in extra for f in x.files)], extra, opts
+        )
         written = steps.run("write HTML, JSON and CSV", _write_page, page, tmp, steps, p_star, p_src, seed)
     return ReportResult(Path(out), tuple(written), tuple(steps.done), p_star, p_src)
 
@@ -263,9 +266,10 @@ def _pressure_figures(steps: _Steps, a, tmp: Path, p_star: float) -> dict[str, F
         render, a.static_patch, "fig1_static", "fig1", "Figure 1: static contact pressure",
     )  # fmt: skip
     if a.rolling_patch is not None:
+        label = rolling_label(a.rolling_field.sidecar if a.rolling_field is not None else None)
         figs["fig2"] = steps.run(
             "render Figure 2 (rolling pressure)",
-            render, a.rolling_patch, "fig2_rolling", "fig2", "Figure 2: rolling contact pressure",
+            render, a.rolling_patch, "fig2_rolling", "fig2", f"Figure 2: contact pressure, {label.short}",
         )  # fmt: skip
     figs["fig3"] = steps.run("Figure 3 (diameter sections)", fig3)
     figs["patch"] = steps.run(
@@ -331,6 +335,7 @@ class _Page:
     figures: dict
     files: list
     sections: list
+    options: AnalysisOptions | None = None
 
 
 def _write_data(page: _Page, tmp: Path) -> dict[str, str]:
@@ -373,6 +378,7 @@ def _write_page(page: _Page, tmp: Path, steps: _Steps, p_star, p_src, seed) -> l
         seed=seed,
         version=__version__,
         error_maps={stem: json.loads(texts[f"{stem}.json"]) for stem in page.map_docs},
+        own_mesh=own_mesh_k_x(a, friction=a.coefficients.f, options=page.options),
     )
     quote_error_maps(ctx, page.map_docs, a.model_summary)
     ctx.update(

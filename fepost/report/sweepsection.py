@@ -111,6 +111,51 @@ def _report_case(data: ReportData, pairings) -> tuple[int | None, bool]:
     return None, False
 
 
+def _rolling_pairs_text(pairings) -> list[str]:
+    """One sentence per static map the sweep pairs with a rolling map: what that map is
+    (`fepost.report.rollinglabel.rolling_label`, from its sidecar), as the k_x column
+    shows its centre-of-pressure shift."""
+    from ..errors import InputFileError
+    from ..figures.units import normalise
+    from ..reader.sidecar import read_sidecar
+    from .rollinglabel import rolling_label
+
+    out = []
+    for pr in pairings:
+        if pr.rolling is None or pr.static.path is None:
+            continue
+        try:
+            side = read_sidecar(Path(pr.rolling))
+        except InputFileError:
+            side = None  # the sweep's row says why the file cannot be read
+        label = rolling_label(side).text
+        out.append(
+            normalise(
+                f"The k_x of {Path(str(pr.static.given)).stem} is from its rolling partner "
+                f"{Path(str(pr.rolling)).name}, a {label}."
+            )
+        )
+    return out
+
+
+def _other_rolling_map(data: ReportData, pairing) -> str:
+    """The end of the intro's sentence: "." when the report pairs its static map with the
+    sweep's rolling map, else which rolling map the report uses and what it is."""
+    from ..figures.units import normalise
+    from .rollinglabel import rolling_label
+
+    rf = data.analysis.rolling_field
+    if _same_file(None if rf is None else rf.source, pairing.rolling):
+        return "."
+    if rf is None:
+        return ", without a rolling map (its k_x column is the sweep's pairing)."
+    return normalise(
+        f", with another rolling map: the report pairs it with {Path(str(rf.source)).name}, a "
+        f"{rolling_label(rf.sidecar).text} (k_x = {data.analysis.coefficients.k_x:.4f}); the "
+        "sweep's row keeps the sweep's pairing."
+    )
+
+
 def sweep_provider(
     inputs: Sequence[str],
     rolling_pairs: str | None = None,
@@ -194,12 +239,13 @@ def sweep_provider(
         )
         if own is not None:
             name = _cell(rows[own], "case") if own < len(rows) else pairings[own].static.given
-            intro += f" The report above is the case {name} of this sweep."
+            intro += f" The report above is the case {name} of this sweep"
+            intro += "." if same else _other_rolling_map(data, pairings[own])
         table = (tuple(h for _, h in TABLE), *(tuple(_cell(r, k) for k, _ in TABLE) for r in rows))
         return Section(
             key=key,
             title=title,
-            paragraphs=(intro, *(_exponent_text(f) for f in fits)),
+            paragraphs=(intro, *_rolling_pairs_text(pairings), *(_exponent_text(f) for f in fits)),
             table=table,
             figures=tuple(figures),
             captions=captions,
