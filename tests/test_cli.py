@@ -122,7 +122,7 @@ def test_defaults_resolved_before_the_command_runs(monkeypatch, small_map, capsy
 
 def test_table1_without_inputs_uses_the_reports_sample_pair(monkeypatch, tmp_path, capsys):
     """`fepost table1` and `fepost report` without inputs read the same maps (the aircraft
-    tire at rated load), so the two show the same table."""
+    tire at rated load, static and rolled freely), so the two show the same table."""
     import fepost.analysis
     from fepost.report.samples import sample_inputs
 
@@ -137,7 +137,7 @@ def test_table1_without_inputs_uses_the_reports_sample_pair(monkeypatch, tmp_pat
     static, rolling = sample_inputs()
     assert seen == [(static, rolling)]
     assert static.name == "static_100.vtu" and static.parent.name == "aircraft"
-    assert rolling is not None and rolling.name == "rolling_100.vtu"
+    assert rolling is not None and rolling.name == "roll_free.vtu" and rolling.parent.name == "rig-aircraft"
 
 
 # --- light start -------------------------------------------------------------------------

@@ -22,14 +22,22 @@ def add_parser(sub) -> None:
             "Write DIR/report.html (self-contained, figures embedded) with the figures beside it (PNG, "
             "and SVG/PDF for the plots), coefficients.json, table1.json, curves.csv and VTK files of the "
             "polar maps and patches, and the error maps of the closed forms and the generalised model. "
-            "With no inputs, uses the sample aircraft tire at its rated load (meshes/aircraft/static_100.vtu "
-            "and rolling_100.vtu), whose report also shows its load sweep. File formats: docs/formats.md."
+            "With no inputs, uses the sample aircraft tire at its rated load: the static map "
+            "meshes/aircraft/static_100.vtu and the rolled map meshes/rig-aircraft/roll_free.vtu (free "
+            "rolling); the report also shows the tire's load sweep. The report says what the rolling map "
+            "is, from its sidecar (a rolled map, a sliding stand-in, or not stated). "
+            "File formats: docs/formats.md."
         ),
     )
     p.add_argument(
         "static", metavar="STATIC", nargs="?", help="static contact map (default: the sample aircraft tire)"
     )
-    p.add_argument("rolling", metavar="ROLLING", nargs="?", help="rolling contact map at the same deflection")
+    p.add_argument(
+        "rolling",
+        metavar="ROLLING",
+        nargs="?",
+        help="rolling contact map at the same load (default with no inputs: the sample rolled map)",
+    )
     p.add_argument("--out", metavar="DIR", required=True, help="output folder (created; must be empty)")
     p.add_argument(
         "--force",
