@@ -50,7 +50,8 @@ The subpackage, by job: `.assemble` (the data the page shows),
 the report registers), `.sweepsection` (a sweep as a section),
 `.sweeppage` and `.sweepembed` (a sweep's trends page and its
 embeddable HTML section), `.html` (the Jinja2 templates in
-``templates/``), `.build` (the steps), `.samples` (the default inputs).
+``templates/``), `.build` (the steps), `.samples` (the default inputs),
+`.rollinglabel` (what the rolling map is, from its sidecar).
 Names are imported on first use, so ``import fepost.report`` stays cheap.
 """
 
