@@ -18,8 +18,8 @@ from functools import cached_property
 from pathlib import Path
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from ._blas import one_blas_thread
 from .coefficients import Coefficients, coefficients_from_moments
 from .errors import ArgumentError, PatchWarning, ScaleError, ScaleWarning
 from .field import ContactField
@@ -309,7 +309,7 @@ def analyse(
             _warm_up()
         # one BLAS thread: the patch step's products are thin (n × 3, chunk-long dots), where
         # BLAS threads only spin, and on a busy machine they stall it (2-5x slower)
-        with threadpool_limits(limits=1, user_api="blas"), float_range(pending[0].what):
+        with one_blas_thread(), float_range(pending[0].what):
             return _pipeline(pending, with_rolling=rolling is not None, friction=f, options=opts)
     finally:
         for p in pending:

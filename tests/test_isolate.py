@@ -429,3 +429,21 @@ def test_an_error_raised_from_an_unpicklable_one_crosses_with_tblib_installed():
     pytest.importorskip("tblib")
     out = subprocess.run([sys.executable, "-c", _CHAINED], capture_output=True, text=True, timeout=120)
     assert out.stdout.strip() == "x.vtu: array 'P': block 1 does not decompress", out.stdout + out.stderr
+
+
+def _imports_tabnanny() -> str:
+    import tabnanny
+
+    return tabnanny.__name__
+
+
+def test_modules_a_child_imported_are_imported_here_before_the_next_fork():
+    """A process reading many files pays a parser's import once, not once per child."""
+    import sys
+
+    if "tabnanny" in sys.modules:
+        pytest.skip("tabnanny already imported in this process")
+    assert isolate.call(_imports_tabnanny, what="first") == "tabnanny"
+    assert "tabnanny" in isolate._CHILD_IMPORTS and "tabnanny" not in sys.modules
+    assert isolate.call(len, "ab", what="second") == 2
+    assert "tabnanny" in sys.modules

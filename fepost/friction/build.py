@@ -30,8 +30,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from .._blas import one_blas_thread
 from ..errors import ArgumentError
 from . import basis
 from .exact import friction_resultants
@@ -180,7 +180,7 @@ def build_model(
         ]
     )
     y = np.concatenate([(exact.Fx - bx) / F0, (exact.Fy - by) / F0, (exact.Mz - bm) / M0])
-    with threadpool_limits(limits=1, user_api="blas"):  # small problem: threads only cost
+    with one_blas_thread():  # small problem: threads only cost
         sol = np.linalg.lstsq(A, y, rcond=None)[0]
     correction = sol.reshape(2 * K + 1, L)
 
@@ -191,7 +191,7 @@ def build_model(
         g_base = base.lateral_moment(vx, vy, wz)
         w2, _ = basis.weight(t, *DIRECT_WEIGHT)
         A2 = w2[:, None] * G * (F0 * R / M0)
-        with threadpool_limits(limits=1, user_api="blas"):
+        with one_blas_thread():
             sol2 = np.linalg.lstsq(A2, (g_exact - g_base) / M0, rcond=None)[0]
         correction_g = sol2.reshape(2 * K + 1, L)
     model = replace(base, correction=correction, correction_g=correction_g)

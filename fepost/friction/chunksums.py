@@ -19,8 +19,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from .._blas import one_blas_thread
 from .law import FrictionLaw
 from .quadrature import PressureQuadrature
 
@@ -175,6 +175,6 @@ def numpy_sums(nodes: Nodes, law: FrictionLaw, vx, vy, wz, workers: int) -> tupl
 
     # Parallel over chunks, one BLAS thread each: a multi-threaded BLAS under our
     # own thread pool oversubscribes the cores (5x slower on a busy 2-core machine).
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         in_parallel(work, range(0, k, block), workers)
     return sx, sy

@@ -50,9 +50,9 @@ from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from .._arrays import frozen
+from .._blas import one_blas_thread
 from ..errors import ArgumentError
 from . import chunksums, nodesums
 from . import turns as turns_mod
@@ -257,7 +257,7 @@ def _turned_sums(setting: _Setting, *, vx, vy, wz, layout, turns: int) -> tuple[
     ``vx``, ``vy``, ``wz`` are the first group's kinematics."""
     law = setting.law
     nodes = chunksums.node_matrices(setting.quad, law, setting.sigma_ref)
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         wx, wy, speed = chunksums.directions(nodes, law, vx, vy, wz)
         fields: tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]] = ((wx,), (wy,))
         if speed is not None:  # columns 0, 1 with the speed factor, the others without
@@ -386,7 +386,7 @@ def friction_resultants(
             r = rays.result()
         elif centres[0].size:
             r = moments(quad.domain, centres[0], centres[1], centres[2])
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         fx, fy, mz = _finish(setting, vx=vx, vy=vy, wz=wz, sx=sx, sy=sy, centres=centres, rays=r)
     return Resultants(fx.reshape(shape), fy.reshape(shape), mz.reshape(shape))
 
