@@ -64,7 +64,7 @@ system-deps-test:
 	$(call apt_install,$(TEST_PACKAGES))
 
 demo: $(DEMO_STAMP) system-deps-demo
-	@echo "== fepost report on the sample aircraft tire (meshes/aircraft/, rated load) -> $(OUT)/"
+	@echo "== fepost report on the sample aircraft tire at its rated load (meshes/aircraft/static_100, rolled map meshes/rig-aircraft/roll_free) -> $(OUT)/"
 	$(VENV)/bin/fepost report --out $(OUT) --force
 	@echo "== open $(OUT)/report.html"
 

@@ -34,7 +34,10 @@ def analytic_mesh(tmp_path):
 
 @pytest.fixture(scope="session")
 def aircraft():
-    """The demo's case: the aircraft tire at its rated load, static and rolling, analysed."""
+    """The aircraft tire at its rated load, analysed: ``static_100`` with the sliding stand-in
+    ``rolling_100`` as its rolling partner (k_x 0.24; the demo pairs it with the rolled map
+    ``meshes/rig-aircraft/roll_free`` instead): the figures, shimmy and continuity tests and the
+    shimmy speeds the docs quote stand on this pair."""
     from fepost import analyse
 
     static, rolling = AIRCRAFT / "static_100.vtu", AIRCRAFT / "rolling_100.vtu"
