@@ -9,10 +9,11 @@ numbers, bit for bit, on one thread or two.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import TypeVar
+
+from ._threads import default_threads
 
 T = TypeVar("T")
 #: From this many chunks on, two threads share them (below, a thread costs more than it saves).
@@ -26,14 +27,14 @@ def slices(n: int, size: int) -> list[slice]:
 
 def map_chunks(work: Callable[[slice], T], chunks: Sequence[slice]) -> list[T]:
     """``[work(c) for c in chunks]``, the second half on a second thread from `SPLIT`
-    chunks on (when the machine has more than one CPU)."""
+    chunks on (when more than one thread is allowed: `fepost._threads.default_threads`)."""
     out: list = [None] * len(chunks)
 
     def run(first: int, stop: int) -> None:
         for i in range(first, stop):
             out[i] = work(chunks[i])
 
-    half = len(chunks) // 2 if len(chunks) >= SPLIT and (os.cpu_count() or 1) > 1 else 0
+    half = len(chunks) // 2 if len(chunks) >= SPLIT and default_threads() > 1 else 0
     if half:
         with ThreadPoolExecutor(max_workers=1) as side:
             other = side.submit(run, half, len(chunks))

@@ -1,5 +1,6 @@
 """Chunked passes on two threads (fepost._chunks): results in chunk order, two threads only
-from `SPLIT` chunks on and with more than one CPU, errors raised in the caller."""
+from `SPLIT` chunks on and with more than one thread allowed (the CPU count or FEPOST_THREADS),
+errors raised in the caller."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ def test_slices_cover_the_range_in_order():
 
 @pytest.mark.parametrize(("n", "cpus", "threads"), [(40, 2, 2), (15, 2, 1), (40, 1, 1)])
 def test_results_in_chunk_order(monkeypatch, n, cpus, threads):
-    monkeypatch.setattr(_chunks.os, "cpu_count", lambda: cpus)
+    monkeypatch.setattr(_chunks, "default_threads", lambda: cpus)
     seen = set()
 
     def work(sl):
@@ -29,7 +30,7 @@ def test_results_in_chunk_order(monkeypatch, n, cpus, threads):
 
 
 def test_an_error_on_the_second_thread_reaches_the_caller(monkeypatch):
-    monkeypatch.setattr(_chunks.os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(_chunks, "default_threads", lambda: 2)
 
     def work(sl):
         if sl.start == 30:
@@ -38,3 +39,37 @@ def test_an_error_on_the_second_thread_reaches_the_caller(monkeypatch):
 
     with pytest.raises(ValueError, match="^chunk 30$"):
         _chunks.map_chunks(work, _chunks.slices(40, 1))
+
+
+# ----------------------------------------------------------------------------- FEPOST_THREADS
+def test_threads_default_to_the_cpu_count(monkeypatch):
+    import os
+
+    from fepost import _threads
+
+    monkeypatch.delenv(_threads.THREADS_ENV, raising=False)
+    assert _threads.default_threads() == (os.cpu_count() or 1)
+    monkeypatch.setenv(_threads.THREADS_ENV, " 3 ")
+    assert _threads.default_threads() == 3
+
+
+@pytest.mark.parametrize("bad", ["0", "-2", "two", "1.5"])
+def test_threads_env_must_be_a_positive_integer(monkeypatch, bad):
+    from fepost import _threads
+    from fepost.errors import ArgumentError
+
+    monkeypatch.setenv(_threads.THREADS_ENV, bad)
+    with pytest.raises(ArgumentError, match=rf"^FEPOST_THREADS='{bad}': must be a positive integer"):
+        _threads.default_threads()
+
+
+def test_one_thread_from_the_environment_keeps_chunks_on_the_caller(monkeypatch):
+    monkeypatch.setenv("FEPOST_THREADS", "1")
+    seen = set()
+
+    def work(sl):
+        seen.add(threading.get_ident())
+        return sl.start
+
+    assert _chunks.map_chunks(work, _chunks.slices(40, 1)) == list(range(40))
+    assert seen == {threading.get_ident()}

@@ -82,7 +82,7 @@ def test_two_threads_give_the_bits_of_one(monkeypatch, location):
     values = p if location == "point" else p[tri].mean(axis=1)
     monkeypatch.setattr(facesums, "CHUNK", 97)
     assert len(tri) > _chunks.SPLIT * 97
-    monkeypatch.setattr(_chunks.os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(_chunks, "default_threads", lambda: 2)
     threads = set()
     real = facesums._chunk_sums
 

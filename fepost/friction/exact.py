@@ -44,7 +44,6 @@ uniform disc's to round-off (tests/test_friction_continuity.py).
 
 from __future__ import annotations
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import partial
@@ -53,6 +52,7 @@ import numpy as np
 
 from .._arrays import frozen
 from .._blas import one_blas_thread
+from .._threads import default_threads
 from ..errors import ArgumentError
 from . import chunksums, nodesums
 from . import turns as turns_mod
@@ -331,7 +331,8 @@ def friction_resultants(
     ``subtract``: order of the ICR singularity subtraction (module docstring):
     2 (or ``True``, default) removes g(p0) + ∇g(p0)·(p − p0), 1 only g(p0),
     0 (or ``False``) integrates the raw discontinuous field (for studies only).
-    ``threads``: worker threads over chunks of kinematic points (default: CPU count).
+    ``threads``: worker threads over chunks of kinematic points (default: the CPU count, or
+    the environment's ``FEPOST_THREADS``, `fepost._threads`).
     ``backend``: the node sums by ``"numba"`` (compiled, `fepost.friction.nodesums`,
     the optional numba dependency; ~10x faster), ``"numpy"``, or ``"auto"`` (default:
     numba when installed and the job has `KERNEL_MIN_ELEMENTS` points × nodes or
@@ -363,7 +364,7 @@ def friction_resultants(
     layout = turns_mod.polar_layout(quad, int(turns)) if backend != "numba" and n0 else None
     sigma_ref = law.reference_pressure(quad.mean_pressure) if law.pressure_coef else 1.0
     setting = _Setting(quad=quad, law=law, sigma_ref=sigma_ref, order=order)
-    workers = threads or os.cpu_count() or 1
+    workers = threads or default_threads()
     big = vx.size * quad.x.size >= KERNEL_MIN_ELEMENTS
     centres = _centres(setting, vx=vx, vy=vy, wz=wz)
     with ThreadPoolExecutor(max_workers=1) as side:
