@@ -14,6 +14,12 @@ import pyvista  # noqa: E402
 
 pyvista.OFF_SCREEN = True
 
+# Under `make test` every core runs a pytest-xdist worker: a worker's own threads (the exact
+# friction integrals, the passes over large meshes) would only compete with the other workers
+# for the same cores. One thread each (fepost._threads; the numbers are the same on any count).
+if int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1")) >= (os.cpu_count() or 1):
+    os.environ.setdefault("FEPOST_THREADS", "1")
+
 from pathlib import Path  # noqa: E402
 
 from fepost.synthetic import write_map  # noqa: E402
@@ -100,6 +106,22 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="session")
+def documented_page(made_once):
+    """Factory: ``documented_page(page)`` runs the marked blocks of a README/docs page once per
+    test session (`tests.docexamples.saved_page_run`, whichever worker asks first) and returns
+    its `PageRun` (the scratch folder the commands ran in, and what each printed): the
+    tutorial's run serves both its checked outputs (test_doc_examples.py) and the files it
+    writes (test_docs.py)."""
+    import docexamples as dx
+
+    def get(page: str):
+        key = "page-" + page.replace("/", "_").replace(".", "_")
+        return dx.load_page_run(made_once(key, lambda folder: dx.saved_page_run(page, folder)))
+
+    return get
+
+
+@pytest.fixture(scope="session")
 def coarse_static_tire(made_once):
     """The coarse sample tire's static case (scripts/tiremodel ``build --case static --coarse``)
     solved by CalculiX once per session: ``(out, keep, seconds)`` with ``out`` the exported
@@ -118,7 +140,8 @@ def coarse_static_tire(made_once):
         from scripts.tiremodel.__main__ import main
 
         t0 = time.perf_counter()
-        argv = ["build", "--case", "static", "--coarse", "--out", str(folder / "out")]
+        # one CalculiX thread: the other workers have the other cores
+        argv = ["build", "--case", "static", "--coarse", "--threads", "1", "--out", str(folder / "out")]
         rc = main([*argv, "--keep", str(folder / "keep")])
         if rc != 0:
             raise RuntimeError(f"scripts.tiremodel {' '.join(argv)} exited with {rc}")

@@ -49,6 +49,7 @@ the blocks from the runs; the runner here is those three things and nothing else
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import re
 import shlex
@@ -185,6 +186,20 @@ class PageRun:
 
     folder: Path
     outputs: dict
+
+
+def saved_page_run(page: str, folder: Path) -> PageRun:
+    """`run_page` in ``folder/work``, its outputs also saved to ``folder/outputs.json`` so
+    that another process can take the run as it is (`load_page_run`)."""
+    run = run_page(page, folder / "work")
+    (folder / "outputs.json").write_text(json.dumps(run.outputs), encoding="utf-8")
+    return run
+
+
+def load_page_run(folder: Path) -> PageRun:
+    """The `PageRun` that `saved_page_run` left in ``folder``."""
+    outputs = json.loads((folder / "outputs.json").read_text(encoding="utf-8"))
+    return PageRun(folder / "work", outputs)
 
 
 def run_page(page: str, folder: Path) -> PageRun:

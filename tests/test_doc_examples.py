@@ -19,16 +19,10 @@ CHECKED = [
 
 
 @pytest.fixture(scope="module")
-def page_run(tmp_path_factory):
-    """page -> its `PageRun`, each page run the first time one of its blocks is checked."""
-    runs: dict[str, dx.PageRun] = {}
-
-    def get(page: str) -> dx.PageRun:
-        if page not in runs:
-            runs[page] = dx.run_page(page, tmp_path_factory.mktemp(page.replace("/", "_")))
-        return runs[page]
-
-    return get
+def page_run(documented_page):
+    """page -> its `PageRun`, each page run once per test session (conftest's
+    ``documented_page``: the tutorial's run is shared with tests/test_docs.py)."""
+    return documented_page
 
 
 @pytest.mark.slow

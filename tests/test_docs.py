@@ -123,25 +123,27 @@ TUTORIAL_OUT = "out"
 
 
 @pytest.fixture(scope="module")
-def tutorial(tmp_path_factory):
-    """Run the tutorial's commands in a scratch folder holding the repository's meshes/;
-    returns the folder the tutorial writes into."""
-    work = tmp_path_factory.mktemp("tutorial")
-    (work / "meshes").symlink_to(REPO / "meshes")
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
+def tutorial(documented_page):
+    """The tutorial's commands run in a scratch folder linking the repository's top-level
+    folders (its marked blocks, which are all its steps: `test_every_tutorial_step_runs`;
+    run once per session and shared with tests/test_doc_examples.py, which compares what
+    they print); returns the folder the tutorial writes into."""
+    return documented_page("docs/tutorial.md").folder / TUTORIAL_OUT
+
+
+def test_every_tutorial_step_runs():
+    """Each console or python block of the tutorial is marked as a documentation example,
+    so the page's run (`tests.docexamples.run_page`) is the whole tutorial, in order."""
+    import docexamples as dx
+
+    text = (DOCS / "tutorial.md").read_text(encoding="utf-8").splitlines()
+    fences = [i + 1 for i, line in enumerate(text) if re.match(r"^```(console|python)\s*$", line)]
+    marked = {b.start for b in dx.blocks("docs/tutorial.md")}
+    assert fences and [f for f in fences if f not in marked] == []
+    ran = [(b.lang, line) for b in dx.blocks("docs/tutorial.md") for line in b.body]
     for kind, step in tutorial_steps():
-        if kind == "python":
-            cmd = [sys.executable, "-c", step]
-        else:
-            argv = shlex.split(step)
-            if argv == ["mkdir", "-p", TUTORIAL_OUT] or argv[0] == "head":  # head: a look at a file
-                cmd = argv
-            else:
-                assert argv[0] == "fepost", step
-                cmd = [sys.executable, "-m", "fepost", *argv[1:]]
-        proc = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True, timeout=600)
-        assert proc.returncode == 0, (step, proc.stderr[-2000:])
-    return work / TUTORIAL_OUT
+        if kind == "console":
+            assert ("console", f"$ {step}") in ran, step
 
 
 def test_tutorial_has_the_steps_it_promises():
@@ -159,8 +161,8 @@ def test_tutorial_has_the_steps_it_promises():
 def test_tutorial_writes_only_into_an_ignored_folder(tutorial):
     """Run from the repository's root, the tutorial leaves nothing untracked there: every
     file goes into out/, which .gitignore lists."""
-    work = tutorial.parent
-    assert sorted(p.name for p in work.iterdir()) == ["meshes", TUTORIAL_OUT]
+    work = tutorial.parent  # the scratch folder: links to the repository's entries, and out/
+    assert sorted(p.name for p in work.iterdir() if not p.is_symlink()) == [TUTORIAL_OUT]
     assert any(p.is_file() for p in tutorial.rglob("*"))
     ignored = (REPO / ".gitignore").read_text(encoding="utf-8").splitlines()
     assert f"/{TUTORIAL_OUT}/" in ignored
