@@ -8,7 +8,7 @@
 - ``rig [--mesh coarse|tiny|full] [--only RUN ...] [--out DIR] [--work DIR]``:
   the slide/spin programme on the small tire (meshes/rig/: the road moves
   rigidly with a sliding velocity and a spin, Coulomb friction 0.3);
-- ``rig-aircraft [--mesh rig|fine] [--only RUN ...] [--out DIR] --work DIR
+- ``rig-aircraft [--mesh rig|fine] [--inc F] [--path S] [--only RUN ...] [--out DIR] --work DIR
   [--workers N | --scheduler ADDRESS]``: the slide/spin programme on the
   aircraft tire (meshes/rig-aircraft/), resumable, its runs as Dask tasks;
 - ``roll --work DIR [--only RUN ...] [--out DIR] [--scheduler ADDRESS]``: the
@@ -81,6 +81,9 @@ def _parser() -> argparse.ArgumentParser:
     ra.add_argument("--mesh", choices=["rig", "fine"], default="rig")
     ra.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
     ra.add_argument("--only", nargs="+", default=None, help="solve only these runs (names)")
+    ra.add_argument(
+        "--path", type=float, default=None, help="reference path S of every slide, m (default: 0.30)"
+    )
     ra.add_argument("--out", type=Path, default=REPO / "meshes" / "rig-aircraft")
     ra.add_argument(
         "--work", type=Path, required=True, help="CalculiX work folder; finished solves there are reused"
@@ -151,6 +154,7 @@ def main(argv: list[str] | None = None) -> int:
             run_programme(args.out, args.work, mesh_kind=args.mesh, inc=args.inc, only=args.only)
             return 0
         if args.command == "rig-aircraft":
+            from .aircraft_rig_deck import AIRCRAFT
             from .aircraft_rig_programme import run_programme as run_aircraft_programme
 
             run_aircraft_programme(
@@ -158,6 +162,7 @@ def main(argv: list[str] | None = None) -> int:
                 args.work,
                 mesh_kind=args.mesh,
                 inc=args.inc,
+                path=AIRCRAFT.slide_path if args.path is None else args.path,
                 only=args.only,
                 workers=None if args.scheduler else args.workers,
                 scheduler=args.scheduler,

@@ -23,6 +23,7 @@ files at once (the sidecar last) and prints its progress.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import json
@@ -65,11 +66,18 @@ def programme() -> list[RunSpec]:
 
 @dataclass(frozen=True)
 class Setup:
-    """What every task needs: the mesh, the work folder, the largest increment of the slide."""
+    """What every task needs: the mesh, the work folder, the largest increment of the slide and
+    the reference path S of the slide (`AIRCRAFT.slide_path` unless a longer one is asked for)."""
 
     mesh_kind: str
     work: str
     inc: float
+    path: float = AIRCRAFT.slide_path
+
+    @property
+    def tire(self) -> rd.RigTire:
+        """The aircraft rig tire with this set-up's reference path (the base does not depend on it)."""
+        return dataclasses.replace(AIRCRAFT, slide_path=self.path)
 
 
 @functools.lru_cache(maxsize=4)
@@ -94,8 +102,8 @@ def run_deck_sha256(setup: Setup, spec: RunSpec, rim_travel: float, base_sha: st
     """The sha256 the run's sidecar records (its slide deck and the base deck's sha256)."""
     with tempfile.TemporaryDirectory(prefix="arig-deck-") as tmp:
         inp = Path(tmp) / f"{spec.name}.inp"
-        kin = rd.kinematics(spec.direction, spec.angle, spec.sign, AIRCRAFT)
-        rd.write_slide_deck(inp, _mesh(setup.mesh_kind), kin, rim_travel, (0.0, 0.0), setup.inc, AIRCRAFT)
+        kin = rd.kinematics(spec.direction, spec.angle, spec.sign, setup.tire)
+        rd.write_slide_deck(inp, _mesh(setup.mesh_kind), kin, rim_travel, (0.0, 0.0), setup.inc, setup.tire)
         return hashlib.sha256(inp.read_bytes() + base_sha.encode()).hexdigest()
 
 
@@ -118,11 +126,11 @@ def run_task(setup: Setup, spec: RunSpec, info: dict, mesh) -> dict[str, bytes]:
     exe, work = find_ccx(), Path(setup.work)
     rim_travel, _, _ = inflation_rim_travel(mesh, work, exe, AIRCRAFT)
     base = solve_base(mesh, rim_travel, work / "base", exe, AIRCRAFT)
-    kin = rd.kinematics(spec.direction, spec.angle, spec.sign, AIRCRAFT)
-    res = solve_run(mesh, base, spec.name, kin, rim_travel, work / spec.name, exe, setup.inc, AIRCRAFT)
+    kin = rd.kinematics(spec.direction, spec.angle, spec.sign, setup.tire)
+    res = solve_run(mesh, base, spec.name, kin, rim_travel, work / spec.name, exe, setup.inc, setup.tire)
     extra = {"direction_deg": spec.direction, "spin_angle_deg": spec.angle, "spin_sign": spec.sign}
     with tempfile.TemporaryDirectory(prefix="arig-export-") as tmp:
-        write_run(mesh, res, Path(tmp), {**info, **extra}, tire=AIRCRAFT)
+        write_run(mesh, res, Path(tmp), {**info, **extra}, tire=setup.tire)
         return {f"{spec.name}{s}": (Path(tmp) / f"{spec.name}{s}").read_bytes() for s in RUN_FILES}
 
 
@@ -216,7 +224,7 @@ def model_info(mesh, setup: Setup, rim_travel: float, clearance: float, solver: 
             "inflation_pressure": ad.PRESSURE,
             "rated_load": ad.RATED_LOAD,
             "road": "rigid body (*RIGID BODY), held at its reference and rotation nodes; the rim moves",
-            "slide_path": AIRCRAFT.slide_path,
+            "slide_path": setup.path,
             "r_ref": AIRCRAFT.r_ref,
             "max_increment": setup.inc,
             "slide_steps": rd.substeps(setup.inc),
@@ -231,6 +239,7 @@ def run_programme(
     *,
     mesh_kind: str = "rig",
     inc: float = 0.1,
+    path: float = AIRCRAFT.slide_path,
     only: list[str] | None = None,
     workers: int | None = 2,
     scheduler: str | None = None,
@@ -244,7 +253,7 @@ def run_programme(
     from .solve import ccx_version, find_ccx
 
     exe = find_ccx()
-    setup = Setup(mesh_kind, str(work.resolve()), inc)
+    setup = Setup(mesh_kind, str(work.resolve()), inc, path)
     specs = programme()
     if only:
         unknown = sorted(set(only) - {s.name for s in specs})
