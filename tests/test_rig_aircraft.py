@@ -309,3 +309,18 @@ def test_repeated_runs_agree_with_the_programme():
         dM = abs(b.Mz / (ub * radius) - a.Mz / (ua * radius))
         assert dF < 0.01 and dM < 0.01, (again.relative_to(RIG), dF, dM)
     assert {p.parent.name for _, p in pairs} == {"fine", "inc05"}
+
+
+@needs_runs
+def test_the_whole_folder_globbed_reads_the_runs_and_skips_the_rest():
+    """``fepost rig meshes/rig-aircraft/*.vtu``: every slide/spin run read; the static maps and
+    the rolling runs (whose sidecars hold a reaction but no kinematics) skipped, each named."""
+    every = sorted(RIG.glob("*.vtu"))
+    table = rig_table(every, shear=False)
+    assert [Path(r.source).name for r in table.runs] == [p.name for p in RUNS]
+    skipped = {Path(p).name: why for p, why in table.skipped}
+    rolling = {p.name for p in every if p.name.startswith("roll_") and p.name != "roll_static.vtu"}
+    assert rolling and set(skipped) == rolling | {"static.vtu", "roll_static.vtu"}
+    for name in rolling:
+        assert "is a rolling run" in skipped[name] and "--rolling partner" in skipped[name]
+    assert "no kinematics and no reaction" in skipped["static.vtu"]

@@ -86,17 +86,20 @@ def _load(run: Path) -> dict:
 
 def not_a_run(path) -> str | None:
     """Why the export ``path`` is no slide/spin run although its sidecar reads (a sidecar with
-    neither ``kinematics`` nor ``reaction``: the static reference map of a rig folder), or
-    None when it is one or its sidecar is faulty (`read_run` then says how)."""
+    neither ``kinematics`` nor ``reaction``: the static reference map of a rig folder; or a
+    rolling run's, ``kind: "rolling run"`` without ``kinematics``), or None when it is one or
+    its sidecar is faulty (`read_run` then says how)."""
     run = Path(path)
     try:
         data = _load(run)
     except (InputFileError, DataError):
         return None
+    side = sidecar_path(run).name
+    if "kinematics" not in data and data.get("kind") == "rolling run":
+        return f"its sidecar {side} is a rolling run: not a slide/spin run (read it as a --rolling partner)"
     if "kinematics" in data or "reaction" in data:
         return None
     what = f" (case {data['case']!r})" if isinstance(data.get("case"), str) else ""
-    side = sidecar_path(run).name
     return f"its sidecar {side}{what} has no kinematics and no reaction: not a slide/spin run"
 
 
