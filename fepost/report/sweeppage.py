@@ -86,12 +86,12 @@ def _num(v, digits: int = 4) -> str:
 def _save(fig, folder: Path, stem: str) -> list[str]:
     import matplotlib.pyplot as plt
 
-    names = []
-    for ext in ("png", "svg"):
-        fig.savefig(folder / f"{stem}.{ext}")
-        names.append(f"{stem}.{ext}")
-    plt.close(fig)
-    return names
+    from .figures import save_formats
+
+    try:
+        return save_formats(fig, folder, stem, ("png", "svg"))
+    finally:
+        plt.close(fig)
 
 
 def draw_figures(rows: Sequence[Mapping], fits: Sequence[PowerLaw], folder: Path) -> list[dict]:
