@@ -71,10 +71,14 @@ demo: $(DEMO_STAMP) system-deps-demo
 # FEPOST_REQUIRE_DOCS: tests/test_docs.py fails (instead of skipping) without the docs
 # tooling, so the strict docs build always runs here. Every test, in TEST_WORKERS pytest-xdist
 # processes (one per core; pyproject.toml adds -q, --durations=15 and --dist loadfile).
+# Compiled modules and pytest's rewritten test modules are cached under the venv
+# (PYTHONPYCACHEPREFIX, even where PYTHONDONTWRITEBYTECODE is set): every worker and every
+# command the tests run would otherwise compile them again.
 TEST_WORKERS ?= auto
 test: $(TEST_STAMP) system-deps-test
 	@echo "== running the test suite on $(TEST_WORKERS) workers (includes the strict docs build)"
-	FEPOST_REQUIRE_DOCS=1 $(PY) -m pytest -n $(TEST_WORKERS); rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; rc=0; fi; exit $$rc
+	env -u PYTHONDONTWRITEBYTECODE PYTHONPYCACHEPREFIX=$(abspath $(VENV))/pycache FEPOST_REQUIRE_DOCS=1 \
+	  $(PY) -m pytest -n $(TEST_WORKERS); rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; rc=0; fi; exit $$rc
 
 # The documentation site (MkDocs, warnings are errors) -> site/
 docs: $(TEST_STAMP)

@@ -101,3 +101,25 @@ def test_load_transfer_is_named_with_intervals_covering_the_truth(pmap):
     assert not _covered(d, TRANSFER_TRUTH)
     assert d.parameters["h_x"].unit == "m"
     assert not d.lack_of_fit["detected"]
+
+
+def test_moved_resultants_are_kept_per_shift(pmap, sim, monkeypatch):
+    """A shift asked for again (the load-transfer fit's derivatives) is not integrated again;
+    the answer is the same numbers, in an array of its own."""
+    from fepost.diagnose import models
+
+    syn = synthesize(pmap, "none", {}, n=30, seed=4)
+    pred = Predictor(sim, syn.data)
+    rng = np.random.default_rng(1)
+    dx, dy = rng.uniform(-0.005, 0.005, 30), rng.uniform(-0.005, 0.005, 30)
+    first = pred.coulomb_moved(dx, dy)
+    calls = []
+    real = models.friction_resultants
+    monkeypatch.setattr(models, "friction_resultants", lambda *a, **k: calls.append(1) or real(*a, **k))
+    again = pred.coulomb_moved(dx.copy(), dy.copy())
+    assert calls == [] and again is not first
+    np.testing.assert_array_equal(again, first)
+    again[:] = 0.0  # the caller's array: the kept one is untouched
+    np.testing.assert_array_equal(pred.coulomb_moved(dx, dy), first)
+    other = pred.coulomb_moved(dx, dy + 1e-4)  # another shift is integrated
+    assert len(calls) == len(pred.groups) and not np.array_equal(other, first)

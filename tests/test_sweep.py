@@ -444,7 +444,7 @@ def test_ctrl_c_stops_cleanly(tmp_path):
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
-    assert proc.returncode == 130
+    assert proc.returncode == 130, err
     assert err.strip().splitlines() == [
         f"fepost: the rows finished so far are kept in {out}: run the same command again to resume",
         "fepost: interrupted",

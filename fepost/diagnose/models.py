@@ -29,6 +29,7 @@ mixed ones). `fepost.diagnose.fitting.fit` iterates these local models.
 
 from __future__ import annotations
 
+import hashlib
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -40,7 +41,7 @@ from ..friction.law import FrictionLaw
 from .measured import MeasuredData
 from .simulation import Simulation
 
-#: Kept exact evaluations per predictor (law term, anisotropy, geometry).
+#: Kept exact evaluations per predictor (law term, anisotropy, geometry; shifts per row).
 CACHE_SIZE = 256
 
 #: Central-difference step of the geometric derivatives (first, second and mixed),
@@ -165,6 +166,15 @@ class Predictor:
         velocity v + ω×d of the moved origin, and the torque about the patch
         origin gains d × F (docs/diagnose.md, ``load_transfer``).
         """
+        dx = np.asarray(dx, float)
+        dy = np.asarray(dy, float)
+        # the load-transfer fits ask for the same shifts again (its derivatives about the
+        # start and about the fit's result): kept with the geometry's resultants (`raw`)
+        key = ("moved", hashlib.sha1(np.ascontiguousarray([dx, dy]).tobytes()).hexdigest())
+        hit = self._cache.get(key)
+        if hit is not None:
+            self._cache.move_to_end(key)
+            return hit.copy()
         vx = self.vx - self.wz * dy
         vy = self.vy + self.wz * dx
         law = FrictionLaw(f=1.0, pressure_ref=self.sigma_ref)
@@ -174,7 +184,11 @@ class Predictor:
             out[idx] = np.column_stack([res.Fx, res.Fy, res.Mz]) * self.lam[idx, None]
         self.evaluations += 1
         out[:, 2] += dx * out[:, 1] - dy * out[:, 0]
-        return out / self.scale
+        out /= self.scale
+        self._cache[key] = out
+        if len(self._cache) > CACHE_SIZE:
+            self._cache.popitem(last=False)
+        return out.copy()
 
     def raw(self, term: tuple[int, int], alpha: float, geometry: tuple[float, float, float]) -> np.ndarray:
         """B_term (f = 1) with anisotropy ``alpha`` on the map moved by ``geometry`` (s, dx, dy)."""
