@@ -28,6 +28,15 @@ from fepost.synthetic import write_map  # noqa: E402
 AIRCRAFT = Path(__file__).resolve().parents[1] / "meshes" / "aircraft"
 
 
+@pytest.fixture(autouse=True)
+def _fresh_cli_parser():
+    """Each test starts with the CLI's parser built anew (`fepost.cli` keeps one per process):
+    a test that replaces a command's function sees its replacement."""
+    from fepost import cli
+
+    cli._parser.cache_clear()
+
+
 @pytest.fixture
 def analytic_mesh(tmp_path):
     """Factory: ``analytic_mesh(name, profile, **kw)`` writes an analytic map into tmp_path."""

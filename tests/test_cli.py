@@ -525,3 +525,17 @@ def test_result_objects_have_a_short_repr(small_map, tmp_path):
     assert len(text.splitlines()) == 1 and len(text) < 400
     assert f"N={a.coefficients.N:.6g} N" in text and f"R={a.coefficients.R:.6g} m" in text
     assert "k_x=" in text and "array" not in text
+
+
+def test_the_parser_is_built_once_per_process(monkeypatch, capsys):
+    """Commands run one after the other in one process (a script calling `main`) share one
+    parser; `build_parser` still gives a new one (the documentation's reference reads it)."""
+    from fepost import cli
+
+    built = []
+    real = cli.build_parser
+    monkeypatch.setattr(cli, "build_parser", lambda: built.append(1) or real())
+    for _ in range(3):
+        assert main(["--version"]) == 0
+    assert len(built) == 1
+    assert real() is not real()
