@@ -447,3 +447,29 @@ def test_modules_a_child_imported_are_imported_here_before_the_next_fork():
     assert "tabnanny" in isolate._CHILD_IMPORTS and "tabnanny" not in sys.modules
     assert isolate.call(len, "ab", what="second") == 2
     assert "tabnanny" in sys.modules
+
+
+def _sleep_then_seven() -> int:
+    time.sleep(0.6)
+    return 7
+
+
+def test_a_reader_of_a_caller_ignoring_sigint_ignores_it():
+    """A sweep's Dask worker ignores SIGINT (a Ctrl-C is the client's); its reading children
+    do too, instead of dying as if the file had crashed them."""
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        pending = isolate.start(_sleep_then_seven, what="f.vtu")
+        time.sleep(0.2)
+        os.kill(pending.pid, signal.SIGINT)
+        assert pending.result() == 7
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def test_a_reader_stopped_from_outside_does_not_blame_the_file():
+    pending = isolate.start(_sleep_then_seven, what="f.vtu")
+    time.sleep(0.2)
+    os.kill(pending.pid, signal.SIGTERM)
+    with pytest.raises(InputFileError, match=r"^f\.vtu: the file reader was stopped by SIGTERM$"):
+        pending.result()

@@ -293,8 +293,12 @@ def _child_main(wfd: int, ack: int, shared: int | None, func, args, kwargs, nbyt
     inherited = set(sys.modules)
 
     faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        # the default action (die with the caller), unless the caller ignores the signal: a
+        # sweep's Dask worker ignores SIGINT, so that a Ctrl-C to the terminal's process
+        # group stops the sweep's client, not the reads under way in its workers
+        if signal.getsignal(sig) is not signal.SIG_IGN:
+            signal.signal(sig, signal.SIG_DFL)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)  # blocked by the parent around the fork
     cap = _capture_fd()
@@ -476,6 +480,8 @@ def _finish(pid: int, reader: transfer.Reader, what: str, timeout: float, nbytes
     if received is None:
         if os.WIFSIGNALED(status):
             sig = os.WTERMSIG(status)
+            if sig in _SIGNALS:  # stopped from outside (Ctrl-C, kill): not the file's doing
+                raise InputFileError(f"{what}: the file reader was stopped by {_signal_name(sig)}")
             if sig == signal.SIGKILL:
                 cause = "killed (out of memory?)"
             else:
