@@ -1,6 +1,6 @@
 """Time the test suite as a newcomer waits for it: the README's ``make test``, whole.
 
-    python benchmarks/bench_suite.py [--repeat N] [--workers auto|N]
+    python benchmarks/bench_suite.py [--repeat N] [--workers auto|N] [--log FILE]
 
 Runs ``make test TEST_WORKERS=...`` from the repository's root ``N`` times (the
 virtual environment already made: the first ``make test`` builds it), and prints for
@@ -28,8 +28,9 @@ TARGET_S = 300.0
 SUMMARY = re.compile(r"^=*\s*(\d+ (passed|failed).*) in [\d.]+s")
 
 
-def run_once(workers: str) -> tuple[float, float, str, int]:
-    """(wall s, CPU s of the whole process tree, pytest's summary, exit status) of one make test."""
+def run_once(workers: str, log: Path | None = None) -> tuple[float, float, str, int]:
+    """(wall s, CPU s of the whole process tree, pytest's summary, exit status) of one make test;
+    its output is written to ``log`` when given."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(
@@ -43,6 +44,8 @@ def run_once(workers: str) -> tuple[float, float, str, int]:
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)  # the reaped descendants' totals
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    if log is not None:
+        log.write_text(proc.stdout, encoding="utf-8")
     lines = proc.stdout.splitlines()
     summary = next((m.group(1) for line in lines if (m := SUMMARY.match(line))), "no summary")
     return wall, cpu, summary, proc.returncode
@@ -53,10 +56,12 @@ def main(argv=None) -> int:
     p.add_argument("--repeat", type=int, default=1, help="runs (default 1); the median is printed")
     p.add_argument("--workers", default="auto", help="TEST_WORKERS (default auto: one per core)")
     p.add_argument("--files", type=int, default=10, help="longest files of the last run to print")
+    p.add_argument("--log", type=Path, help="write each run's output here (run k to LOG.k)")
     args = p.parse_args(argv)
     walls = []
     for k in range(args.repeat):
-        wall, cpu, summary, rc = run_once(args.workers)
+        log = None if args.log is None else args.log.with_name(f"{args.log.name}.{k + 1}")
+        wall, cpu, summary, rc = run_once(args.workers, log)
         walls.append(wall)
         cores = cpu / wall
         print(f"run {k + 1}: wall {wall:.1f} s, CPU {cpu:.1f} s ({cores:.2f} cores), exit {rc}: {summary}")
