@@ -166,7 +166,7 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
     ncol = len(cols) + 1
     if fig is None:
         fig = Figure(figsize=(2.9 * ncol + 1.2, 11.0), layout="constrained")
-    axes = np.atleast_2d(fig.subplots(4, ncol, sharey="row", squeeze=False))
+    axes = np.atleast_2d(fig.subplots(4, ncol, sharex="col", sharey="row", squeeze=False))
     meas = diag.data.forces
     rb = 100 * (meas - diag.predictions["before"]) / diag.scales
     ra = 100 * (meas - diag.predictions["after_heldout"]) / diag.scales
