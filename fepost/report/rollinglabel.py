@@ -143,5 +143,5 @@ def own_mesh_k_x(analysis, *, friction: float, options=None) -> OwnMeshKx | None
     source = analysis.static_field.source
     if partner is None or (isinstance(source, str | Path) and Path(source).resolve() == partner.resolve()):
         return None
-    k_x = analyse(partner, rf.source, friction=friction, options=options).coefficients.k_x
+    k_x = analyse(partner, rf, friction=friction, options=options).coefficients.k_x  # rf: read already
     return None if k_x is None else OwnMeshKx(partner, float(k_x))

@@ -239,8 +239,8 @@ def sweep_provider(
         )
         if own is not None:
             name = _cell(rows[own], "case") if own < len(rows) else pairings[own].static.given
-            intro += f" The report above is the case {name} of this sweep"
-            intro += "." if same else _other_rolling_map(data, pairings[own])
+            ending = _other_rolling_map(data, pairings[own])  # "." when the report's pair is the sweep's
+            intro += f" The report above is the case {name} of this sweep{ending}"
         table = (tuple(h for _, h in TABLE), *(tuple(_cell(r, k) for k, _ in TABLE) for r in rows))
         return Section(
             key=key,
