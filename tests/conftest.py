@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 
 import matplotlib
 
@@ -35,6 +36,37 @@ def _fresh_cli_parser():
     from fepost import cli
 
     cli._parser.cache_clear()
+
+
+_STOP_SIGNALS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+
+@pytest.fixture(autouse=True)
+def _stop_signals_left_as_found():
+    """A test leaves Ctrl-C, SIGTERM and SIGHUP as it found them: no more ignored or blocked.
+
+    A process started later by the same worker inherits both (a `fepost sweep` run as a
+    subprocess would then ignore the Ctrl-C its test sends, finish, and exit with 0). What the
+    worker started with is kept: a suite started as a background job of a shell (``make test &``)
+    starts with SIGINT ignored.
+    """
+    blockable = hasattr(signal, "pthread_sigmask")
+    ignored = {s for s in _STOP_SIGNALS if signal.getsignal(s) is signal.SIG_IGN}
+    blocked = set(signal.pthread_sigmask(signal.SIG_BLOCK, [])) if blockable else set()
+    before = {s: signal.getsignal(s) for s in _STOP_SIGNALS}
+    yield
+    leaks = [
+        f"{signal.Signals(s).name} ignored"
+        for s in _STOP_SIGNALS
+        if s not in ignored and signal.getsignal(s) is signal.SIG_IGN
+    ]
+    if blockable:
+        now = set(signal.pthread_sigmask(signal.SIG_SETMASK, blocked))
+        leaks += [f"{signal.Signals(s).name} blocked" for s in _STOP_SIGNALS if s in now - blocked]
+    for s in _STOP_SIGNALS:
+        if s not in ignored and signal.getsignal(s) is signal.SIG_IGN and before[s] is not None:
+            signal.signal(s, before[s])
+    assert not leaks, f"the test left {', '.join(leaks)} in its process"
 
 
 @pytest.fixture
