@@ -166,15 +166,24 @@ def ray_integrals(domain: Ellipse, px: np.ndarray, py: np.ndarray) -> np.ndarray
 
 def _moments(r2: np.ndarray, r3: np.ndarray, r4: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
     """The 9 columns of `ray_integrals` from weighted ρ-powers (points, nodes) and the
-    nodes' cos, sin: (nodes,), the same for every point, or (points, nodes)."""
-    groups = (
-        (r2, 2.0, (c, s)),
-        (r3, 3.0, (c * c, c * s, s * s)),
-        (r4, 4.0, (c**3, c * c * s, c * s * s, s**3)),
-    )
-    return np.column_stack(
-        [(r @ t if t.ndim == 1 else np.einsum("ij,ij->i", r, t)) / k for r, k, trig in groups for t in trig]
-    )
+    nodes' cos, sin: (nodes,), the same for every point, or (points, nodes).
+
+    Each power meets its trigonometric factors in one pass: a matrix product against the
+    (nodes, k) factors when they are shared (3 products instead of 9 matrix-vector ones;
+    the rays about a centre near the edge have up to 65 536 nodes)."""
+    cc, cs, ss = c * c, c * s, s * s
+    groups = ((r2, 2.0, (c, s)), (r3, 3.0, (cc, cs, ss)), (r4, 4.0, (cc * c, cc * s, c * ss, ss * s)))
+    out = np.empty((r2.shape[0], 9))
+    k = 0
+    for r, power, trig in groups:
+        cols = slice(k, k + len(trig))
+        if c.ndim == 1:
+            np.matmul(r, np.column_stack(trig), out=out[:, cols])
+        else:
+            out[:, cols] = np.column_stack([np.einsum("ij,ij->i", r, t) for t in trig])
+        out[:, cols] /= power
+        k += len(trig)
+    return out
 
 
 def _inside_rays(domain: Ellipse, px: np.ndarray, py: np.ndarray, n: int) -> np.ndarray:

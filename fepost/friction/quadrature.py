@@ -88,15 +88,17 @@ class Ellipse:
         dy = (np.asarray(py, float) - self.cy) / self.ay
         ex, ey = c / self.ax, s / self.ay
         qa = ex * ex + ey * ey
-        qb = dx * ex + dy * ey  # half the linear coefficient
+        qb = np.asarray(dx * ex + dy * ey)  # half the linear coefficient
         qc = np.minimum(dx * dx + dy * dy - 1.0, 0.0)
-        # Positive root in the cancellation-free form -c / (b + √(b² − ac)).
-        disc = np.sqrt(qb * qb - qa * qc)
-        num = -qc
-        den = qb + disc
-        big = qb <= 0
-        # When b <= 0, (−b + √(b² − ac))/a is stable; otherwise use −c/(b + √·).
-        return np.where(big, (disc - qb) / qa, num / np.where(den > 0, den, 1.0))
+        # Positive root in the cancellation-free form: (−b + √(b² − ac))/a where b <= 0,
+        # −c / (b + √(b² − ac)) where b > 0 (in place: the rays are up to 65 536 long).
+        disc = np.asarray(qb * qb - qa * qc)
+        np.sqrt(disc, out=disc)
+        rho = np.asarray((disc - qb) / qa)
+        disc += qb
+        ahead = qb > 0
+        rho[ahead] = np.broadcast_to(-qc, rho.shape)[ahead] / disc[ahead]
+        return rho
 
     def max_distance_from(self, x0: float = 0.0, y0: float = 0.0) -> float:
         """Largest distance (m) from (x0, y0) to a point of the ellipse."""

@@ -57,7 +57,7 @@ def save_formats(fig, folder: Path, stem: str, exts: tuple[str, ...]) -> list[st
         fig.savefig(folder / f"{stem}.{ext}", metadata=_NO_DATES.get(ext))
         names.append(f"{stem}.{ext}")
         if k == 0 and fig.get_layout_engine() is not None:
-            fig.set_layout_engine("none")
+            fig.set_layout_engine(None)
     return names
 
 
