@@ -164,9 +164,12 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
     cols = _columns(diag)
     order_label, order_x = run_order(diag)
     ncol = len(cols) + 1
+    fixed = fig is None
     if fig is None:
-        fig = Figure(figsize=(2.9 * ncol + 1.2, 11.0), layout="constrained")
+        fig = Figure(figsize=(2.9 * ncol + 1.2, 11.0))
     axes = np.atleast_2d(fig.subplots(4, ncol, sharex="col", sharey="row", squeeze=False))
+    if fixed:
+        _fixed_margins(fig, 4, ncol)
     meas = diag.data.forces
     rb = 100 * (meas - diag.predictions["before"]) / diag.scales
     ra = 100 * (meas - diag.predictions["after_heldout"]) / diag.scales
@@ -246,12 +249,42 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
             if lab not in labels:
                 handles.append(h)
                 labels.append(lab)
-    fig.legend(handles, labels, loc="outside lower center", ncol=min(len(labels), 4), fontsize=8)
+    where = {"loc": "lower center", "bbox_to_anchor": (0.5, 0.005)} if fixed else {"loc": "outside lower center"}
+    fig.legend(handles, labels, ncol=min(len(labels), 4), fontsize=8, **where)
     fig.suptitle(
         "residuals (measured − predicted) vs kinematics and run order: "
-        "flat band = noise, trend or step = structure"
+        "flat band = noise, trend or step = structure",
+        **({"y": 1.0 - 0.06 / fig.get_figheight(), "va": "top"} if fixed else {}),
     )
     return fig
+
+
+#: Margins of the residuals figure (inches): left (y tick labels and two-line y labels),
+#: right, bottom (x tick labels, x labels and the legend), top (the suptitle and the first
+#: row's title), and the gaps between columns and between rows (a row title).
+RESIDUAL_MARGINS = {"left": 0.85, "right": 0.1, "bottom": 0.8, "top": 0.5, "wgap": 0.14, "hgap": 0.32}
+
+
+def _fixed_margins(fig: Figure, nrow: int, ncol: int) -> None:
+    """Lay the residual panels out with `RESIDUAL_MARGINS`, fixed in inches.
+
+    The panels share their axes by row and column, so only the outer panels carry
+    tick labels, and the margins hold them for any data; matplotlib's constrained
+    layout would measure every one of the 24 panels' ticks twice per save (half the
+    time a diagnose spends on its figures). tests/test_diagnose_figures.py checks that
+    no label, legend or panel overlaps another."""
+    m = RESIDUAL_MARGINS
+    w, h = fig.get_size_inches()
+    panel_w = (w - m["left"] - m["right"] - (ncol - 1) * m["wgap"]) / ncol
+    panel_h = (h - m["bottom"] - m["top"] - (nrow - 1) * m["hgap"]) / nrow
+    fig.subplots_adjust(
+        left=m["left"] / w,
+        right=1.0 - m["right"] / w,
+        bottom=m["bottom"] / h,
+        top=1.0 - m["top"] / h,
+        wspace=m["wgap"] / panel_w,
+        hspace=m["hgap"] / panel_h,
+    )
 
 
 def plot_candidates(diag: Diagnosis, ax=None):
