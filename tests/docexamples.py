@@ -171,21 +171,30 @@ def argv_of(line: str) -> list[str]:
     return argv
 
 
-def run(argv: list[str], cwd: Path) -> str:
-    """stdout of ``argv`` run in ``cwd``; a failure raises with the command's stderr."""
+def run(argv: list[str], cwd: Path, errors: dict | None = None) -> str:
+    """stdout of ``argv`` run in ``cwd``; a failure raises with the command's stderr. The
+    stderr of a command that succeeds goes to ``errors[shlex.join(argv)]`` when given."""
     env = {**os.environ, "PYTHONPATH": str(REPO), "COLUMNS": "200"}
     proc = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True, timeout=TIMEOUT)
     if proc.returncode != 0:
         raise RuntimeError(f"{shlex.join(argv)} exited with {proc.returncode}: {proc.stderr[-2000:]}")
+    if errors is not None:
+        errors[shlex.join(argv)] = proc.stderr
     return proc.stdout
 
 
 @dataclass(frozen=True)
 class PageRun:
-    """The outputs of a page's marked blocks: block name -> [stdout per command]."""
+    """The outputs of a page's marked blocks: block name -> [stdout per command]; and what
+    each command wrote to stderr, by its command line as the page shows it (`stderr_of`)."""
 
     folder: Path
     outputs: dict
+    errors: dict = field(default_factory=dict)
+
+    def stderr_of(self, line: str) -> str:
+        """The stderr of the page's command ``line`` (e.g. ``"fepost report --out out/report"``)."""
+        return self.errors[shlex.join(argv_of(line))]
 
 
 def saved_page_run(page: str, folder: Path) -> PageRun:
@@ -193,25 +202,28 @@ def saved_page_run(page: str, folder: Path) -> PageRun:
     that another process can take the run as it is (`load_page_run`)."""
     run = run_page(page, folder / "work")
     (folder / "outputs.json").write_text(json.dumps(run.outputs), encoding="utf-8")
+    (folder / "errors.json").write_text(json.dumps(run.errors), encoding="utf-8")
     return run
 
 
 def load_page_run(folder: Path) -> PageRun:
     """The `PageRun` that `saved_page_run` left in ``folder``."""
     outputs = json.loads((folder / "outputs.json").read_text(encoding="utf-8"))
-    return PageRun(folder / "work", outputs)
+    errors = json.loads((folder / "errors.json").read_text(encoding="utf-8"))
+    return PageRun(folder / "work", outputs, errors)
 
 
 def run_page(page: str, folder: Path) -> PageRun:
     """Run the marked blocks of ``page`` in order in ``folder``."""
     work = scratch_folder(folder)
-    outputs = {}
+    outputs: dict = {}
+    errors: dict = {}
     for block in blocks(page):
         if block.lang == "python":
             outputs[block.name] = [run([sys.executable, "-c", "\n".join(block.body)], work)]
         else:
-            outputs[block.name] = [run(argv_of(c.line), work) for c in block.commands()]
-    return PageRun(work, outputs)
+            outputs[block.name] = [run(argv_of(c.line), work, errors) for c in block.commands()]
+    return PageRun(work, outputs, errors)
 
 
 # ---------------------------------------------------------------- showing and comparing
