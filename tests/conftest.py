@@ -163,6 +163,32 @@ def documented_page(made_once):
 
 
 @pytest.fixture(scope="session")
+def analytic_report(made_once):
+    """A report of two analytic tire maps (``tire`` profile, 12 rings; the rolling one shifted,
+    k_x 0.13) that lie outside the folder the report ran in, with the default seed; made once
+    per session: ``(static, rolling, report folder)``."""
+    import contextlib
+    import io
+
+    from fepost.cli import main
+
+    def build(folder: Path) -> None:
+        maps, work = folder / "maps", folder / "work"
+        maps.mkdir()
+        work.mkdir()
+        s = write_map(maps / "static.vtu", "tire", radius=0.15, peak=6e5, n_rings=12)
+        r = write_map(maps / "rolling.vtu", "tire", radius=0.15, peak=6e5, k_x=0.13, n_rings=12)
+        quiet = contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO())
+        with contextlib.chdir(work), quiet[0], quiet[1]:
+            code = main(["report", str(s), str(r), "--out", "rep"])
+        if code != 0:
+            raise RuntimeError(f"fepost report of the analytic maps exited with {code}")
+
+    folder = made_once("analytic-report", build)
+    return folder / "maps" / "static.vtu", folder / "maps" / "rolling.vtu", folder / "work" / "rep"
+
+
+@pytest.fixture(scope="session")
 def coarse_static_tire(made_once):
     """The coarse sample tire's static case (scripts/tiremodel ``build --case static --coarse``)
     solved by CalculiX once per session: ``(out, keep, seconds)`` with ``out`` the exported

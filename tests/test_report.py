@@ -360,17 +360,15 @@ def test_report_figures_show_the_table1_fit(report):
 
 
 @pytest.mark.slow
-def test_report_and_table1_agree_on_analytic_maps(tmp_path):
+def test_report_and_table1_agree_on_analytic_maps(analytic_report, tmp_path):
     """Task: `fepost report` and `fepost table1 --json`, both with their default seed,
     give identical Table 1 rows on the same analytic meshes."""
     import io
     from contextlib import redirect_stderr, redirect_stdout
 
-    s = write_map(tmp_path / "static.vtu", "tire", radius=0.15, peak=6e5, n_rings=12)
-    r = write_map(tmp_path / "rolling.vtu", "tire", radius=0.15, peak=6e5, k_x=0.13, n_rings=12)
-    out, cli_json = tmp_path / "rep", tmp_path / "t1.json"
+    s, r, out = analytic_report
+    cli_json = tmp_path / "t1.json"
     with redirect_stderr(io.StringIO()), redirect_stdout(io.StringIO()):
-        assert main(["report", str(s), str(r), "--out", str(out)]) == 0
         assert main(["table1", "--static", str(s), "--rolling", str(r), "--json", str(cli_json)]) == 0
     from_report = json.loads((out / "table1.json").read_text())
     from_table1 = json.loads(cli_json.read_text())

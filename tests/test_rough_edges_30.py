@@ -316,23 +316,16 @@ def test_provenance_names_inputs_relative_or_by_name_with_a_hash(tmp_path, monke
 
 
 @pytest.mark.slow
-def test_report_provenance_and_grid_phrase(tmp_path, monkeypatch):
+def test_report_provenance_and_grid_phrase(analytic_report):
     """A report on maps outside the working folder: the provenance table names them by file name
     and hash, never by their absolute path; the model rows' grid is said once."""
-    maps = tmp_path / "maps"
-    maps.mkdir()
-    static = write_map(maps / "static.vtu", "tire", radius=0.15, peak=6e5, n_rings=16)
-    rolling = write_map(maps / "rolling.vtu", "tire", radius=0.15, peak=6e5, k_x=0.13, n_rings=16)
-    work = tmp_path / "work"
-    work.mkdir()
-    monkeypatch.chdir(work)
-    assert main(["report", str(static), str(rolling), "--out", "rep", "--seed", "3"]) == 0
-    html = (work / "rep" / "report.html").read_text(encoding="utf-8")
+    static, rolling, out = analytic_report
+    html = (out / "report.html").read_text(encoding="utf-8")
     table = html.split('<h2 id="inputs">', 1)[1].split("</table>", 1)[0]
     for path in (static, rolling):
         sha = hashlib.sha256(path.read_bytes()).hexdigest()[:HASH_DIGITS]
         assert f"<code>{path.name}</code> (SHA-256 {sha}…)" in table
-    assert str(maps) not in table
+    assert str(static.parent) not in table
     assert html.count("the densest evaluated") == 1
     assert "model errors: the largest errors over the error map&#39;s grid, the densest evaluated" in html
 
