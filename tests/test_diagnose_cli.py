@@ -12,6 +12,7 @@ from fepost.analysis import analyse
 from fepost.cli import main
 from fepost.diagnose.measured import write_csv
 from fepost.diagnose.synthetic import synthesize
+from fepost.synthetic import write_map
 
 CAUSES = {
     "none", "friction_level", "pressure_dependent_friction", "speed_dependent_friction",
@@ -20,14 +21,23 @@ CAUSES = {
 }  # fmt: skip
 
 
-@pytest.fixture
-def setup(tmp_path, analytic_mesh):
-    static = analytic_mesh("static.vtu", "hertz", radius=0.1, peak=3e5)
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    """A Hertz map and 120 rows measured on it with a pressure shift, written once for the
+    module (no test changes them)."""
+    folder = tmp_path_factory.mktemp("inputs")
+    static = write_map(folder / "static.vtu", "hertz", radius=0.1, peak=3e5)
     a = analyse(static, friction=0.3)
     syn = synthesize(a.static_map, "pressure_shift", {"dx": 0.004, "dy": 0.0}, n=120, seed=3)
-    csv = tmp_path / "meas.csv"
+    csv = folder / "meas.csv"
     write_csv(syn.data, csv, comment="synthetic: pressure shift dx = 4 mm")
-    return static, csv, tmp_path
+    return static, csv
+
+
+@pytest.fixture
+def setup(inputs, tmp_path):
+    """``(static map, measured CSV, a folder of the test's own for what it writes)``."""
+    return (*inputs, tmp_path)
 
 
 def test_diagnose_writes_the_interface_json_summary_and_figures(setup, capsys):
@@ -154,6 +164,7 @@ def test_blank_lines_and_comments_are_allowed(setup):
     static, csv, tmp = setup
     lines = csv.read_text().splitlines()
     text = "\n".join(lines[:3] + ["", "# mid-file comment", ""] + lines[3:]) + "\n"
+    csv = tmp / "meas.csv"  # the module's CSV stays as it is
     csv.write_text(text)
     assert (
         main(
