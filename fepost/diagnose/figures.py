@@ -249,7 +249,9 @@ def plot_residuals(diag: Diagnosis, fig: Figure | None = None) -> Figure:
             if lab not in labels:
                 handles.append(h)
                 labels.append(lab)
-    where = {"loc": "lower center", "bbox_to_anchor": (0.5, 0.005)} if fixed else {"loc": "outside lower center"}
+    where: dict = {"loc": "outside lower center"}
+    if fixed:
+        where = {"loc": "lower center", "bbox_to_anchor": (0.5, 0.005)}
     fig.legend(handles, labels, ncol=min(len(labels), 4), fontsize=8, **where)
     fig.suptitle(
         "residuals (measured − predicted) vs kinematics and run order: "

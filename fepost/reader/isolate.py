@@ -47,6 +47,7 @@ function runs in the calling process (the validation still applies).
 
 from __future__ import annotations
 
+import itertools
 import os
 import pickle
 import signal
@@ -290,7 +291,7 @@ def _child_main(wfd: int, ack: int, shared: int | None, func, args, kwargs, nbyt
     afterfork.settle()  # first: locks of the caller's other threads are held for ever here
     import faulthandler
 
-    inherited = set(sys.modules)
+    inherited = len(sys.modules)  # the modules it imports are added after these (`_new_modules`)
 
     faulthandler.disable()  # a crash here is reported by the parent, not dumped on the terminal
     for sig in (signal.SIGINT, signal.SIGTERM):
@@ -319,12 +320,23 @@ def _child_main(wfd: int, ack: int, shared: int | None, func, args, kwargs, nbyt
             payload = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
     caught = [(w.category, str(w.message)) for w in rec if issubclass(w.category, FepostWarning)]
     text = _chatter(cap)
-    imported = sorted(name for name in set(sys.modules) - inherited if not name.startswith("__"))
+    imported = _new_modules(inherited)
     try:
         transfer.send(wfd, (payload, caught, text, imported), ack, shared)
     except Exception as exc:  # the result itself could not be pickled: say so
         other = ("other", (type(exc).__name__, _first_line(exc), traceback.format_exc()))
         transfer.send(wfd, (other, caught, text, imported), ack, shared)
+
+
+def _new_modules(inherited: int) -> list[str]:
+    """The names of the modules imported since ``sys.modules`` held ``inherited`` entries.
+
+    ``sys.modules`` is a dict, in the order of insertion: the new ones are its last
+    entries, read from the end so that the child does not touch (and copy) the pages of
+    every inherited name. A module dropped meanwhile makes the list shorter, never wrong:
+    it only tells the caller what to import before its next fork (`preload`)."""
+    new = itertools.islice(reversed(sys.modules), max(0, len(sys.modules) - inherited))
+    return sorted(name for name in new if not name.startswith("__"))
 
 
 def _unchained(exc: BaseException) -> BaseException:
