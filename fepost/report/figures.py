@@ -60,6 +60,8 @@ def save_formats(fig, folder: Path, stem: str, exts: tuple[str, ...]) -> list[st
         names.append(f"{stem}.{ext}")
         if k == 0 and fig.get_layout_engine() is not None:
             fig.set_layout_engine(None)
+            if fig.get_layout_engine() is not None:  # rc asks for a default engine: a placeholder
+                fig.set_layout_engine("none")
     return names
 
 
