@@ -62,6 +62,11 @@ from typing import Any
 from ..errors import FepostError, FepostWarning, InputFileError
 from . import afterfork, transfer
 
+try:  # imported here, not in each child (an import there costs every read)
+    import resource
+except ImportError:  # not on this platform: no memory limit, the deadline still applies
+    resource = None  # type: ignore[assignment]
+
 #: Environment variable: ``off`` reads in the calling process (no child).
 ISOLATION_ENV = "FEPOST_READ_ISOLATION"
 #: Environment variable: the read timeout in seconds (overrides `timeout_for`).
@@ -77,20 +82,27 @@ _PIPE_SIZE = 1 << 20
 
 #: Modules the reading children imported that the caller had not (imported before the next fork).
 _CHILD_IMPORTS: set[str] = set()
+#: Modules that failed to import here: left to the children, not tried again.
+_NOT_HERE: set[str] = set()
 
 
 def preload() -> None:
     """Import in this process what earlier reading children had to import (module docstring).
 
-    A module that fails to import here is forgotten: the child imports it, as before.
+    A module that fails to import here is left to the children, as before. Only the names
+    the children reported are looked at (a set of all of ``sys.modules`` cost 2 ms a read).
     """
+    if not _CHILD_IMPORTS:
+        return
     import importlib
 
-    for name in sorted(_CHILD_IMPORTS - set(sys.modules)):
-        try:
-            importlib.import_module(name)
-        except Exception:  # noqa: BLE001 (any failure: leave the import to the child)
-            _CHILD_IMPORTS.discard(name)
+    for name in sorted(_CHILD_IMPORTS):
+        if name not in sys.modules:
+            try:
+                importlib.import_module(name)
+            except Exception:  # noqa: BLE001 (any failure: leave the import to the child)
+                _NOT_HERE.add(name)
+    _CHILD_IMPORTS.clear()
 
 
 class ChildTraceback(Exception):
@@ -256,9 +268,9 @@ def _budget(nbytes: int) -> int:
 
 
 def _limit_memory(nbytes: int) -> None:
+    if resource is None:
+        return
     try:
-        import resource
-
         with open("/proc/self/statm", "rb") as fh:
             vsize = int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
         budget = _budget(nbytes)
@@ -502,7 +514,7 @@ def _finish(pid: int, reader: transfer.Reader, what: str, timeout: float, nbytes
             cause = f"failed (exit status {os.WEXITSTATUS(status)})"
         raise InputFileError(f"{what}: the file reader {cause}: corrupt or malformed file")
     (kind, value), caught, text, imported = received
-    _CHILD_IMPORTS.update(imported)
+    _CHILD_IMPORTS.update(n for n in imported if n not in sys.modules and n not in _NOT_HERE)
     for category, message in caught:
         warnings.warn(message, category, stacklevel=3)
     if kind == "ok":
