@@ -45,6 +45,7 @@ def settle() -> None:
     the per-module lock table names; only they are looked at. Every object the child
     touches costs it a copy of its memory page (copy-on-write): a walk over all of
     ``sys.modules`` cost each read about 8 ms in a large process."""
+    # the loaded bootstrap module itself: an import statement here could block already
     bootstrap = sys.modules.get("_frozen_importlib") or sys.modules.get("importlib._bootstrap")
     if bootstrap is None:  # another Python: nothing to reset
         return
@@ -58,6 +59,7 @@ def settle() -> None:
         module = sys.modules.get(name)
         spec = getattr(module, "__spec__", None)
         if spec is not None and getattr(spec, "_initializing", False):
+            # another thread's import, cut off by the fork: import afresh if needed
             del sys.modules[name]
 
 
