@@ -283,17 +283,6 @@ def pytest_collection_modifyitems(config, items):
     items.sort(key=lambda it: (-seconds.get(_file_of(it.nodeid), 0.0), first[_file_of(it.nodeid)]))
 
 
-def pytest_collection_finish(session):
-    """The objects collection made (every test module, the items) live to the end of the
-    session: moved out of the cyclic collector's way (``gc.freeze``), so that its full passes
-    during the tests do not walk them again and again (1.95 -> 1.17 s of collection in three
-    diagnose and fuzz files), nor touch them in the forked reading children."""
-    import gc
-
-    gc.collect()
-    gc.freeze()
-
-
 def pytest_runtest_logreport(report):
     name = _file_of(report.nodeid)
     _seconds[name] = _seconds.get(name, 0.0) + report.duration
