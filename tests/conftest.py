@@ -51,21 +51,18 @@ def _stop_signals_left_as_found():
     starts with SIGINT ignored.
     """
     blockable = hasattr(signal, "pthread_sigmask")
-    ignored = {s for s in _STOP_SIGNALS if signal.getsignal(s) is signal.SIG_IGN}
-    blocked = set(signal.pthread_sigmask(signal.SIG_BLOCK, [])) if blockable else set()
     before = {s: signal.getsignal(s) for s in _STOP_SIGNALS}
+    blocked = set(signal.pthread_sigmask(signal.SIG_BLOCK, [])) if blockable else set()
     yield
-    leaks = [
-        f"{signal.Signals(s).name} ignored"
-        for s in _STOP_SIGNALS
-        if s not in ignored and signal.getsignal(s) is signal.SIG_IGN
-    ]
+    leaks = []
+    for s, handler in before.items():
+        if handler is not signal.SIG_IGN and signal.getsignal(s) is signal.SIG_IGN:
+            leaks.append(f"{signal.Signals(s).name} ignored")
+            if handler is not None:
+                signal.signal(s, handler)
     if blockable:
         now = set(signal.pthread_sigmask(signal.SIG_SETMASK, blocked))
         leaks += [f"{signal.Signals(s).name} blocked" for s in _STOP_SIGNALS if s in now - blocked]
-    for s in _STOP_SIGNALS:
-        if s not in ignored and signal.getsignal(s) is signal.SIG_IGN and before[s] is not None:
-            signal.signal(s, before[s])
     assert not leaks, f"the test left {', '.join(leaks)} in its process"
 
 
@@ -178,8 +175,11 @@ def analytic_report(made_once):
         work.mkdir()
         s = write_map(maps / "static.vtu", "tire", radius=0.15, peak=6e5, n_rings=12)
         r = write_map(maps / "rolling.vtu", "tire", radius=0.15, peak=6e5, k_x=0.13, n_rings=12)
-        quiet = contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO())
-        with contextlib.chdir(work), quiet[0], quiet[1]:
+        with (
+            contextlib.chdir(work),
+            contextlib.redirect_stdout(io.StringIO()),
+            contextlib.redirect_stderr(io.StringIO()),
+        ):
             code = main(["report", str(s), str(r), "--out", "rep"])
         if code != 0:
             raise RuntimeError(f"fepost report of the analytic maps exited with {code}")
