@@ -9,6 +9,7 @@ under ``if TYPE_CHECKING:``.
 from __future__ import annotations
 
 import ast
+import functools
 import re
 from collections import defaultdict
 from pathlib import Path
@@ -29,7 +30,13 @@ def _modules() -> dict[str, Path]:
 
 
 MODULES = _modules()
-TREES = {name: ast.parse(path.read_text(encoding="utf-8"), str(path)) for name, path in MODULES.items()}
+
+
+@functools.cache
+def _trees() -> dict[str, ast.Module]:
+    """Every module's syntax tree, parsed when a test first asks (not at collection: under
+    pytest-xdist every worker collects this file, one runs it)."""
+    return {name: ast.parse(path.read_text(encoding="utf-8"), str(path)) for name, path in MODULES.items()}
 
 
 def _is_face(name: str) -> bool:
@@ -44,11 +51,12 @@ def _target(current: str, node: ast.ImportFrom) -> str:
     return ".".join(base + ([node.module] if node.module else []))
 
 
+@functools.cache
 def _imports() -> list[tuple[str, str, str]]:
     """(importing module, imported module, name) for every import of fepost code; name is
     the imported name for ``from X import name`` where X is a module, else ""."""
     out = []
-    for name, tree in TREES.items():
+    for name, tree in _trees().items():
         for node in ast.walk(tree):
             if isinstance(node, ast.ImportFrom):
                 target = _target(name, node)
@@ -63,9 +71,6 @@ def _imports() -> list[tuple[str, str, str]]:
             elif isinstance(node, ast.Import):
                 out += [(name, a.name, "") for a in node.names if a.name in MODULES]
     return [(a, b, n) for a, b, n in out if a != b]
-
-
-IMPORTS = _imports()
 
 
 def _layers() -> dict[str, int]:
@@ -116,7 +121,7 @@ def _upward(imports) -> list[str]:
 
 
 def test_no_upward_imports():
-    upward = _upward(IMPORTS)
+    upward = _upward(_imports())
     assert not upward, "\n".join(upward)
 
 
@@ -169,7 +174,7 @@ def _cycles(imports) -> list[list[str]]:
 
 
 def test_no_import_cycles():
-    cycles = _cycles(IMPORTS)
+    cycles = _cycles(_imports())
     assert not cycles, "\n".join(" <-> ".join(c) for c in cycles)
 
 
@@ -178,7 +183,7 @@ def test_cycle_finder_finds_a_cycle():
     importing its own module that imports the face back is not."""
     assert any(
         {"fepost.errors", "fepost.polar"} <= set(c)
-        for c in _cycles([*IMPORTS, ("fepost.errors", "fepost.polar", "")])
+        for c in _cycles([*_imports(), ("fepost.errors", "fepost.polar", "")])
     )
     face = [("fepost.figures", "fepost.figures.curves", ""), ("fepost.figures.curves", "fepost.figures", "")]
     assert not any("fepost.figures.curves" in c for c in _cycles(face))
@@ -187,7 +192,7 @@ def test_cycle_finder_finds_a_cycle():
 def test_no_private_cross_module_imports():
     private = [
         f"{src} takes {dst}.{name}"
-        for src, dst, name in IMPORTS
+        for src, dst, name in _imports()
         if name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
     ]
     assert not private, "\n".join(private)
@@ -195,7 +200,7 @@ def test_no_private_cross_module_imports():
 
 def test_functions_are_short():
     long = []
-    for name, tree in TREES.items():
+    for name, tree in _trees().items():
         for node in ast.walk(tree):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 n = node.end_lineno - node.lineno + 1

@@ -122,7 +122,8 @@ def build(
                 file=sys.stderr,
             )
             try:
-                res = solve_case(mesh, dk.CASES[name], tmp / name, threads=threads)
+                steps = dk.COARSE_INC if coarse else dk.FINE_INC
+                res = solve_case(mesh, dk.CASES[name], tmp / name, threads=threads, increments=steps)
             finally:
                 if keep is not None and (tmp / name).exists():
                     shutil.copytree(tmp / name, keep / name, dirs_exist_ok=True)

@@ -44,6 +44,16 @@ CASES = {
 }
 
 
+#: CalculiX's ``*STATIC`` line of the load steps after inflation (vertical travel, roll):
+#: first increment, step length, smallest and largest increment. The full mesh's: at least
+#: ten increments.
+FINE_INC = "0.05, 1.0, 1e-6, 0.1"
+#: The coarse mesh's (tests, quick looks): increments of a quarter of the step. On the coarse
+#: static case the road's reaction is that of `FINE_INC` within 0.02 % (13 034 N against
+#: 13 031 N) in 4 increments instead of 12: 17 s of CalculiX instead of 32.
+COARSE_INC = "0.25, 1.0, 1e-6, 0.5"
+
+
 def cut_nodes(mesh: TireMesh) -> list[int]:
     """0-based indices of the sector cut-face nodes that carry an equation (bead nodes excluded)."""
     bead = set(int(n) for n in mesh.bead_nodes)
@@ -123,8 +133,10 @@ def write_deck(
     case: LoadCase,
     rim_travel: float,
     inflation_only: bool = False,
+    increments: str = FINE_INC,
 ) -> dict:
-    """Write the deck; ``rim_travel`` is the total downward rim displacement (m)."""
+    """Write the deck; ``rim_travel`` is the total downward rim displacement (m);
+    ``increments``: the ``*STATIC`` line of the load steps after inflation."""
     road = cx.build_road()
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
     out = model_lines(mesh, f"fepost tire sector, case {case.name}", road)
@@ -157,7 +169,7 @@ def write_deck(
         # step 2: vertical rim travel (pressure kept)
         w("*STEP, NLGEOM, INC=400")
         w("*STATIC")
-        w("0.05, 1.0, 1e-6, 0.1")
+        w(increments)
         w("*BOUNDARY")
         w(f"BEAD, 3, 3, {-rim_travel:.9e}")
         outputs()
@@ -165,7 +177,7 @@ def write_deck(
         if case.roll_dx:
             w("*STEP, NLGEOM, INC=400")
             w("*STATIC")
-            w("0.05, 1.0, 1e-6, 0.1")
+            w(increments)
             w("*BOUNDARY")
             w(f"BEAD, 1, 1, {case.roll_dx:.9e}")
             w(f"BEAD, 3, 3, {-rim_travel:.9e}")

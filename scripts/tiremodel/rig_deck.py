@@ -180,10 +180,12 @@ def write_base_deck(
     origin: tuple[float, float],
     tire: RigTire = SMALL,
     inflation_only: bool = False,
+    vertical_inc: str | None = None,
 ) -> RigNodes:
     """Steps 1-2 (inflation, vertical rim travel) with the rigid road; writes a restart file.
 
     ``inflation_only``: step 1 alone (the pre-run that finds the inflated clearance).
+    ``vertical_inc``: the ``*STATIC`` line of the vertical travel (default the tire's).
     """
     road = tire.road()
     nt, nr = mesh.nodes.shape[0], road.nodes.shape[0]
@@ -221,7 +223,7 @@ def write_base_deck(
             fh.write("\n".join(out) + "\n")
         return nodes
     w("*STEP, NLGEOM, INC=400")
-    _static(w, tire, tire.vertical_inc)
+    _static(w, tire, vertical_inc or tire.vertical_inc)
     w("*BOUNDARY")
     w(f"BEAD, 3, 3, {-rim_travel:.9e}")
     w(f"CUTREF, 3, 3, {-rim_travel:.9e}")

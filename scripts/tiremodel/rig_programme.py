@@ -65,16 +65,21 @@ def run_programme(
     *,
     mesh_kind: str = "tiny",
     inc: float = 0.1,
+    base_inc: str | None = None,
     only: list[str] | None = None,
     log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True),
 ) -> list[dict]:
-    """Solve (or reuse) and export the runs ``only`` (default: the whole programme)."""
+    """Solve (or reuse) and export the runs ``only`` (default: the whole programme).
+
+    ``inc``: the slides' largest increment; ``base_inc``: the ``*STATIC`` line of the base's
+    vertical travel (default the small tire's, `rig_deck.SMALL`), recorded in the sidecars
+    when given."""
     exe = find_ccx()
     params = mesh_params(mesh_kind)
     mesh = build_mesh(params)
     rim_travel, clearance, t_infl = inflation_rim_travel(mesh, work, exe)
     log(f"rig: inflation pre-run {t_infl:.0f} s, clearance {clearance * 1e3:.2f} mm")
-    base = solve_base(mesh, rim_travel, work / "base", exe)
+    base = solve_base(mesh, rim_travel, work / "base", exe, vertical_inc=base_inc)
     log(f"rig: base run (inflation + vertical load) {base.runtime_s:.0f} s")
     info = {
         "solver": ccx_version(exe),
@@ -103,6 +108,8 @@ def run_programme(
             "slide_steps": rd.substeps(inc),
         },
     }
+    if base_inc is not None:
+        info["model"]["base_vertical_increments"] = base_inc
     runs = programme()
     if only:
         runs = [r for r in runs if r[0] in only]

@@ -117,12 +117,18 @@ def _nodal(mesh: TireMesh, frd: Path, step: int | None = None):
 
 
 def solve_base(
-    mesh: TireMesh, rim_travel: float, workdir: Path, exe: str, tire: rd.RigTire = rd.SMALL
+    mesh: TireMesh,
+    rim_travel: float,
+    workdir: Path,
+    exe: str,
+    tire: rd.RigTire = rd.SMALL,
+    vertical_inc: str | None = None,
 ) -> Base:
-    """Solve (or reuse) the base run: inflation and vertical load with the rigid road."""
+    """Solve (or reuse) the base run: inflation and vertical load with the rigid road
+    (``vertical_inc``: the ``*STATIC`` line of the vertical travel; default the tire's)."""
     workdir.mkdir(parents=True, exist_ok=True)
     inp = workdir / "base.inp"
-    nodes = rd.write_base_deck(inp, mesh, rim_travel, (0.0, 0.0), tire)
+    nodes = rd.write_base_deck(inp, mesh, rim_travel, (0.0, 0.0), tire, vertical_inc=vertical_inc)
     t = _solve_once(exe, inp, "", tire.timeout)
     contact, u = _nodal(mesh, inp.with_suffix(".frd"), 1 if tire.one_step else 2)
     recs = [r for r in read_dat_blocks(inp.with_suffix(".dat")) if r[0] == "forces" and r[1] == "REFN"]

@@ -97,7 +97,15 @@ def _final_totals(dat: Path, name: str) -> np.ndarray:
     return rec[-1][2]
 
 
-def solve_case(mesh: TireMesh, case: dk.LoadCase, workdir: Path, threads: int = 2) -> CaseResult:
+def solve_case(
+    mesh: TireMesh,
+    case: dk.LoadCase,
+    workdir: Path,
+    threads: int = 2,
+    increments: str = dk.FINE_INC,
+) -> CaseResult:
+    """Inflate (a pre-run that finds the inflated clearance), then solve ``case``: the rim
+    moved ``case.deflection`` beyond first contact, ``increments`` the ``*STATIC`` line of its load steps."""
     exe = find_ccx()
     workdir.mkdir(parents=True, exist_ok=True)
     nt = mesh.nodes.shape[0]
@@ -117,7 +125,7 @@ def solve_case(mesh: TireMesh, case: dk.LoadCase, workdir: Path, threads: int = 
     rim_travel = float(z_infl + case.deflection)
     # 2) the load case
     inp = workdir / f"{case.name}.inp"
-    info = dk.write_deck(inp, mesh, case, rim_travel)
+    info = dk.write_deck(inp, mesh, case, rim_travel, increments=increments)
     t_total += run_ccx(exe, inp, threads)
     res = read_frd(inp.with_suffix(".frd"))
     last = max(res.last)
