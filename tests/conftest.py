@@ -266,14 +266,14 @@ def _file_of(nodeid: str) -> str:
 
 def pytest_configure(config):
     """Read once, in the controller: every worker must collect the tests in the same order.
-    And, before the workers start, BLAS on one thread in each (`_one_blas_thread`)."""
+    And, before the workers start, BLAS on one thread in each (`_workers_on_one_blas_thread`)."""
     if not hasattr(config, "workerinput"):
         cache = getattr(config, "cache", None)
         config.stash[_ORDER] = (cache.get(_CACHE_KEY, None) if cache is not None else None) or SECONDS
-        _one_blas_thread(config)
+        _workers_on_one_blas_thread(config)
 
 
-def _one_blas_thread(config) -> None:
+def _workers_on_one_blas_thread(config) -> None:
     """With a worker on every core, OpenBLAS on one thread in each worker and in the processes
     the tests start.
 
