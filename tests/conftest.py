@@ -15,13 +15,6 @@ import pyvista  # noqa: E402
 
 pyvista.OFF_SCREEN = True
 
-# Under `make test` every core runs a pytest-xdist worker: a worker's own threads (the exact
-# friction integrals, the passes over large meshes) would only compete with the other workers
-# for the same cores. One thread each (fepost._threads; the numbers are the same on any count).
-# BLAS too: `pytest_configure`.
-if int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1")) >= (os.cpu_count() or 1):
-    os.environ.setdefault("FEPOST_THREADS", "1")
-
 from pathlib import Path  # noqa: E402
 
 from fepost.synthetic import write_map  # noqa: E402
@@ -266,27 +259,30 @@ def _file_of(nodeid: str) -> str:
 
 def pytest_configure(config):
     """Read once, in the controller: every worker must collect the tests in the same order.
-    And, before the workers start, BLAS on one thread in each (`_workers_on_one_blas_thread`)."""
+    And, before the workers start, one thread in each (`_one_thread_per_worker`)."""
     if not hasattr(config, "workerinput"):
         cache = getattr(config, "cache", None)
         config.stash[_ORDER] = (cache.get(_CACHE_KEY, None) if cache is not None else None) or SECONDS
-        _workers_on_one_blas_thread(config)
+        _one_thread_per_worker(config)
 
 
-def _workers_on_one_blas_thread(config) -> None:
-    """With a worker on every core, OpenBLAS on one thread in each worker and in the processes
-    the tests start.
+def _one_thread_per_worker(config) -> None:
+    """With a worker on every core (`make test`), one thread in each worker and in the
+    processes the tests start, set in the environment the workers inherit.
 
-    OpenBLAS's idle threads spin after each call until a timeout: 100 products of 200 x 200
-    matrices, 20 ms apart, cost 2.1 s of CPU in 2.1 s (a core busy between the calls). Beside
-    a worker on every core that spinning takes the other worker's CPU and that of the forked
-    child a worker waits for while it reads a file: test_reader_frd_fuzz.py alone under -n 2
-    took 18.3 s of user CPU, 8.8 s with one BLAS thread. The count must be set before the
-    library loads (a plugin imports numpy before any conftest code runs in a worker):
-    threadpoolctl's limit at run time left the spinning as it was (18.1 s). So it is set
-    here, in the environment the workers inherit (and the processes the tests start)."""
+    A worker's own threads would only compete with the other workers for the same cores:
+    fepost's (the exact friction integrals, the passes over large meshes; `FEPOST_THREADS`,
+    fepost._threads; the numbers are the same on any count) and OpenBLAS's. OpenBLAS's idle
+    threads spin after each call until a timeout: 100 products of 200 x 200 matrices, 20 ms
+    apart, cost 2.1 s of CPU in 2.1 s (a core busy between the calls). Beside a worker on
+    every core that spinning takes the other worker's CPU and that of the forked child a
+    worker waits for while it reads a file: test_reader_frd_fuzz.py alone under -n 2 took
+    18.3 s of user CPU, 8.8 s with one BLAS thread. Its count must be set before the library
+    loads (a plugin imports numpy before any conftest code runs in a worker): threadpoolctl's
+    limit at run time left the spinning as it was (18.1 s)."""
     workers = getattr(config.option, "numprocesses", None)
     if isinstance(workers, int) and workers >= (os.cpu_count() or 1):
+        os.environ.setdefault("FEPOST_THREADS", "1")
         os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
