@@ -26,6 +26,7 @@ file and the key.
 
 from __future__ import annotations
 
+import difflib
 import json
 import math
 from dataclasses import dataclass, field, fields
@@ -129,7 +130,9 @@ def gear_from_dict(data: Any, where: str = "gear") -> Gear:
     unknown = sorted(set(data) - set(PARAMETERS) - set(OPTIONAL))
     if unknown:
         known = ", ".join([*PARAMETERS, *OPTIONAL])
-        raise GearFileError(f"{where}: unknown key {unknown[0]!r} (known: {known})")
+        close = difflib.get_close_matches(unknown[0], [*PARAMETERS, *OPTIONAL], n=1, cutoff=0.6)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise GearFileError(f"{where}: unknown key {unknown[0]!r}{hint} (known: {known})")
     missing = [k for k in PARAMETERS if k not in ("wheels", "half_track", "slip_ratio") and k not in data]
     if missing:
         raise GearFileError(f"{where}: missing key {missing[0]!r}")
