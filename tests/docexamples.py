@@ -280,12 +280,21 @@ def _half_unit(s: str) -> float:
 
 
 def numbers_agree(a: str, b: str, rtol: float) -> bool:
+    """Do the page's number and the printed one agree within ``rtol``?
+
+    The coarser of the two may be the other rounded: half a unit of its last
+    digit is allowed on top of ``rtol``, and no more. Two numbers printed to the
+    same digits that differ in the last one (0.8 and 0.9) therefore disagree
+    whatever the rtol, though a value of exactly 0.85 could print as either: a
+    page must not hide a change of one unit in its last digit.
+    """
     if a == b:
         return True
     if rtol <= 0:
         return False
     x, y = float(a), float(b)
-    return abs(x - y) <= rtol * max(abs(x), abs(y)) + _half_unit(a) + _half_unit(b)
+    allowed = rtol * max(abs(x), abs(y)) + max(_half_unit(a), _half_unit(b))
+    return abs(x - y) <= allowed * (1.0 + 1e-12)
 
 
 def line_agrees(expected: str, full: str, rtol: float) -> bool:

@@ -127,7 +127,13 @@ def test_without_a_tolerance_the_text_must_be_exact():
 
 def test_integers_get_no_rounding_allowance():
     assert dx.numbers_agree("0.0445", "0.045", 0.0) is False
-    assert dx.numbers_agree("0.044", "0.045", 1e-3)  # a value on a rounding edge prints either way
+    assert dx.numbers_agree("0.044", "0.0445", 1e-3)  # the page rounds the printed value
+    assert dx.numbers_agree("0.0446", "0.045", 1e-3)
+    # one unit in the last digit is a change, not a rounding, whatever the rtol
+    assert not dx.numbers_agree("0.8", "0.9", 1e-9)
+    assert not dx.numbers_agree("0.044", "0.045", 1e-3)
+    assert not dx.numbers_agree("1014.4", "1014.5", 1e-9)
+    assert dx.numbers_agree("1014.4", "1014.5", 1e-4)  # within rtol itself
     assert not dx.numbers_agree("82", "83", 1e-3)  # row numbers are not rounded values
     assert dx.numbers_agree("1e-18", "1.0000001e-18", 1e-3)
 
