@@ -325,3 +325,23 @@ def test_a_binary_file_cut_inside_its_last_step_is_called_truncated(cases, tmp_p
     assert err[-1].startswith(f"fepost: error: {short}: truncated .frd file: it ends at byte {cut}")
     assert "*CONTACT FILE" not in err[-1]
     assert _n_fe(short, step=2) == pytest.approx(totals[2][1], rel=ASCII_TOL)
+
+
+@pytest.mark.parametrize("into", [0, 5, 30, 60])
+def test_a_binary_file_cut_in_the_step_line_before_its_first_contact_block_is_called_truncated(
+    cases, tmp_path, capsys, into
+):
+    """A one-increment binary file cut at, or in the middle of, the ``1PSTEP`` line that opens
+    its CONTACT block holds no CONTACT block at all: the file is called truncated (it has no
+    closing 9999 line), not blamed on the deck's output requests."""
+    data = cases["binary"][0].read_bytes()
+    cut = data.rindex(b"    1PSTEP", 0, data.rindex(b" -4  CONTACT")) + into
+    assert data[cut : cut + 1] != b"\n"  # inside the line
+    short = tmp_path / "cut.frd"
+    short.write_bytes(data[:cut])
+    assert main(["coefficients", str(short)]) == 2
+    err = [ln for ln in capsys.readouterr().err.strip().splitlines() if ln.strip()]
+    assert err == [
+        f"fepost: error: {short}: truncated .frd file: it ends at byte {cut} without CalculiX's closing "
+        "9999 line (cut off while written?), in step 0 (t = 1), before its contact output"
+    ]

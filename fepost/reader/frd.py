@@ -172,6 +172,8 @@ def _assemble(frd: FrdFile, path: Path, step: int | None) -> RawMesh:
     incs = _increments(frd)
     chosen = choose_step(path, step, len(incs))
     if chosen is None:
+        if not frd.complete:
+            raise _truncated(frd, path, "before any results")
         raise FieldError(f"{path}: the file holds no results; {NO_CONTACT}")
     notes: list[str] = []
     if not _blocks_at(frd, incs[chosen][0]).get("CONTACT"):
@@ -324,6 +326,12 @@ def _contact_step(
     no step was asked for; else (or in a file cut off while that step was written) refused."""
     with_contact = {b.kode for b in frd.blocks if b.name == "CONTACT"}
     if not with_contact:
+        if not frd.complete:  # cut off in its first step, or in a step header line (1PSTEP, 100C)
+            last = len(incs) - 1
+            where = f"in step {last} (t = {incs[last][1]:g}), before its contact output"
+            if last:
+                where += f"; its complete step(s) 0-{last - 1} hold no contact output either: {NO_CONTACT}"
+            raise _truncated(frd, path, where)
         raise FieldError(f"{path}: {NO_CONTACT}")
     listed = [k for k, (kd, _) in enumerate(incs) if kd in with_contact]
     shown = ", ".join(f"{k} (t = {incs[k][1]:g})" for k in listed[-10:])
@@ -340,6 +348,14 @@ def _contact_step(
             f"step(s) {more}{shown}: choose one with --step"
         )
     return listed[-1]
+
+
+def _truncated(frd: FrdFile, path: Path, where: str) -> InputFileError:
+    """The error of a file cut off while CalculiX wrote it (no closing 9999 line)."""
+    return InputFileError(
+        f"{path}: truncated .frd file: it ends at byte {len(frd.data)} without CalculiX's closing 9999 "
+        f"line (cut off while written?), {where}"
+    )
 
 
 def _element_blocks(chosen: dict[int, np.ndarray], conn: dict[int, np.ndarray]) -> list[Block]:
