@@ -11,6 +11,7 @@ stay light: the work is imported inside `run`.
 from __future__ import annotations
 
 import argparse
+import sys
 
 from . import _validate as v
 
@@ -87,9 +88,43 @@ def add_parser(sub) -> None:
     )
     p.add_argument("--no-simulation", action="store_true", help="linear stability only (no time histories)")
     p.add_argument("--no-intervals", action="store_true", help="skip the coefficients' intervals (Table 1)")
+    p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
     add_friction_option(p)
     add_input_options(p)
     p.set_defaults(func=run)
+
+
+class _Progress:
+    """One line per stage on stderr, as ``fepost report`` prints them: the study's stages, then
+    the writing of the folder (its figures) as the last one."""
+
+    def __init__(self) -> None:
+        self.total = 0
+
+    def study(self, k: int, n: int, step: str, seconds: float) -> None:
+        self.total = n + 1
+        self._line(k, step, seconds)
+
+    def writing(self, k: int, n: int, step: str, seconds: float) -> None:
+        self._line(self.total, step, seconds)
+
+    def _line(self, k: int, step: str, seconds: float) -> None:
+        print(f"[{k}/{self.total}] {step} ... done in {seconds:.1f} s", file=sys.stderr, flush=True)
+
+
+def summary(m) -> str:
+    """One model's line on stdout: the verdict over the sweep, the critical speed (the first
+    onset of instability) with its interval, and where an unstable range ends."""
+    s = m.stability
+    if s.critical_speed is None:
+        return f"{m.name}: {s.summary()}"
+    text = f"{m.name}: critical speed {s.critical_speed:.2f} m/s"
+    ci = m.critical_speed_ci95
+    if ci is not None:
+        text += f" (95 % {ci[0]:.2f} to {ci[1]:.2f})"
+    if len(s.boundaries) > 1 or s.unstable[0]:
+        text += f"; {s.summary()}"
+    return text
 
 
 def run(args: argparse.Namespace) -> int:
@@ -111,6 +146,7 @@ def run(args: argparse.Namespace) -> int:
     inputs = [args.static, args.rolling, args.gear]
     check_replaceable(args.out, inputs)
     result = analyse(args.static, args.rolling, friction=args.friction, options=analysis_options(args))
+    progress = _Progress()
     study = shimmy_study(
         result,
         gear,
@@ -120,14 +156,16 @@ def run(args: argparse.Namespace) -> int:
         simulate_motion=not args.no_simulation,
         duration=args.duration,
         trails=args.trails,
+        progress=None if args.no_progress else progress.study,
     )
-    write_shimmy(study, args.out, force=args.force, protect=inputs)
+    write_shimmy(
+        study,
+        args.out,
+        force=args.force,
+        protect=inputs,
+        progress=None if args.no_progress else progress.writing,
+    )
     for m in study.models:
-        vc = m.stability.critical_speed
-        ci = m.critical_speed_ci95
-        text = "stable over the sweep" if vc is None else f"critical speed {vc:.2f} m/s"
-        if vc is not None and ci is not None:
-            text += f" (95 % {ci[0]:.2f} to {ci[1]:.2f})"
-        print(f"{m.name}: {text}")
+        print(summary(m))
     print(f"-> {args.out}/shimmy.json")
     return 0

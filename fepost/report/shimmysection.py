@@ -20,8 +20,16 @@ if TYPE_CHECKING:
 TITLE = "Landing-gear shimmy with the coupled friction model"
 
 
-def _speed(v) -> str:
-    return "stable over the sweep" if v is None else f"{v:.1f}"
+def _speed(stability) -> str:
+    """The critical speed (the first onset), or the verdict over the sweep in words."""
+    v = stability.critical_speed
+    return stability.summary() if v is None else f"{v:.1f}"
+
+
+def _ranges(ranges) -> str:
+    if not ranges:
+        return "none"
+    return ", ".join(f"{a:.1f} to {'top' if b is None else f'{b:.1f}'}" for a, b in ranges)
 
 
 def shimmy_section(data: ReportData, folder: Path) -> Section | None:
@@ -46,23 +54,30 @@ def shimmy_section(data: ReportData, folder: Path) -> Section | None:
     import matplotlib
 
     with matplotlib.rc_context(STYLE):  # type: ignore[arg-type]  # matplotlib types keys as Literal
-        fig, ax = plt.subplots()
-        stability_figure(result, ax)
+        fig = plt.figure()
+        stability_figure(result, fig)
         fig.tight_layout()
         figure = save_matplotlib(
             fig, folder, "shimmy_stability", "shimmy_stability", "growth rate of the gear's motion over speed"
         )
-    head = ("friction model", "critical speed (m/s)", "95 % interval (m/s)", "frequency (Hz)")
+    head = (
+        "friction model",
+        "critical speed (m/s)",
+        "95 % interval (m/s)",
+        "frequency (Hz)",
+        "unstable (m/s)",
+    )
     rows = []
     for m in result.models:
         ci = m.critical_speed_ci95
-        freq = m.stability.critical_frequencies
+        freq = m.stability.critical_frequency
         rows.append(
             (
                 m.name,
-                _speed(m.stability.critical_speed),
+                _speed(m.stability),
                 "" if ci is None else f"{ci[0]:.1f} to {ci[1]:.1f}",
-                "" if not freq else f"{freq[0]:.1f}",
+                "" if freq is None else f"{freq:.1f}",
+                _ranges(m.stability.unstable_ranges),
             )
         )
     name = gear.name or Path(str(gear_path)).name

@@ -80,13 +80,35 @@ def equilibrium(gear: Gear, contact, V: float = 1.0) -> np.ndarray:
         return rhs(np.array([q[0], 0.0, q[1], 0.0]), V, gear, contact)[[1, 3]]
 
     sol = root(residual, np.zeros(2), method="hybr", options={"xtol": 1e-13})
-    if not sol.success or np.max(np.abs(sol.x)) > 0.2:
+    converged = sol.success or _balanced_to_round_off(
+        np.array([sol.x[0], 0.0, sol.x[1], 0.0]), V, gear, contact
+    )
+    if not converged or np.max(np.abs(sol.x)) > 0.2:
         raise ArgumentError(
             f"no steady rolling state found for this gear and contact ({sol.message}; "
             f"psi = {sol.x[0]:.3g} rad, y = {sol.x[1]:.3g} m): the torsional or lateral stiffness "
             "is too small to hold the contact's asymmetry"
         )
     return np.array([sol.x[0], 0.0, sol.x[1], 0.0])
+
+
+#: Relative residual of the steady state's moment and force balance read as zero (round-off).
+BALANCE_RTOL = 1e-10
+
+
+def _balanced_to_round_off(x: np.ndarray, V: float, gear: Gear, contact) -> bool:
+    """Whether the yaw moment and the lateral force balance at ``x`` to `BALANCE_RTOL` of their
+    terms' sizes: a steady state the root finder stopped at without "converging" because the
+    residual is round-off (a symmetric map's steady state is zero to about 1e-18)."""
+    fx, fy, mz = (np.abs(np.asarray(f, float)) for f in contact(*kinematics(x, V, gear)))
+    lever = gear.trail + np.abs(np.asarray(gear.offsets)) + float(getattr(contact, "R", 0.0))
+    moment_scale = float(np.sum((fx + fy) * lever + mz)) + gear.torsional_stiffness * abs(x[0])
+    force_scale = float(np.sum(fx + fy)) + gear.lateral_stiffness * abs(x[2])
+    res = rhs(x, V, gear, contact)
+    return bool(
+        abs(res[1]) * gear.yaw_inertia <= BALANCE_RTOL * moment_scale
+        and abs(res[3]) * gear.lateral_mass <= BALANCE_RTOL * force_scale
+    )
 
 
 def scalar_rhs(gear: Gear, V: float, one):

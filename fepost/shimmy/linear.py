@@ -10,8 +10,12 @@ not depend on V, so G at speed V is G at V = 1 divided by V: one contact Jacobia
 serves a whole speed sweep (`Linearisation`).
 
 The growth rate at V is the largest real part of the eigenvalues (1/s), the
-frequency that eigenvalue's |Im|/2π (Hz). Critical speeds are where the growth
-rate changes sign along the sweep, each refined by Brent's method.
+frequency that eigenvalue's |Im|/2π (Hz). A speed is unstable when its growth rate
+is above round-off (`GROWTH_RTOL` of the Jacobian's norm). Boundaries are where that
+changes along the sweep, each refined by Brent's method and given its direction:
+``onset`` (unstable above it) or ``end`` (stable again above it). The critical speed
+is the first onset; a sweep unstable from its lowest speed has unstable ranges but
+may have no onset at all.
 """
 
 from __future__ import annotations
@@ -98,16 +102,42 @@ class Linearisation:
         return float(ev[i].real), float(abs(ev[i].imag) / (2 * np.pi))
 
 
+#: Growth rates within this fraction of the Jacobian's norm of zero are round-off: neither
+#: growing nor decaying. The eigenvalues' backward error is about 2e-16 of the norm; this
+#: leaves room for an eigenvalue condition number up to about 5e5.
+GROWTH_RTOL = 1e-10
+#: Directions of a boundary: ``onset`` (unstable above it) and ``end`` (stable again above it).
+ONSET, END = "onset", "end"
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """A speed where the growth rate changes sign, its direction (`ONSET` or `END`), the frequency
+    of the mode that crosses, and that mode's shape (ψ, ψ̇, y, ẏ), scaled to ψ = 1 rad."""
+
+    speed: float
+    direction: str
+    frequency_hz: float
+    mode: np.ndarray
+
+    def to_dict(self) -> dict:
+        return {"speed": self.speed, "direction": self.direction, "frequency_hz": self.frequency_hz}
+
+
 @dataclass(frozen=True)
 class StabilityMap:
-    """Growth rate and frequency over a speed sweep, and the critical speeds."""
+    """Growth rate and frequency over a speed sweep, the boundaries and the unstable ranges.
+
+    ``tolerance``: growth rates within ± this (1/s) are zero to round-off (`GROWTH_RTOL`
+    times the largest norm of the Jacobian over the sweep) and count as not growing.
+    """
 
     speeds: np.ndarray
     growth_rate: np.ndarray
     frequency_hz: np.ndarray
     eigenvalues: np.ndarray  # (speeds, 4) complex
-    critical_speeds: tuple[float, ...]
-    critical_frequencies: tuple[float, ...]
+    boundaries: tuple[Boundary, ...]
+    tolerance: float
 
     def rows(self) -> list[dict]:
         return [
@@ -116,57 +146,148 @@ class StabilityMap:
         ]
 
     @property
+    def unstable(self) -> np.ndarray:
+        """Whether each speed of the sweep is unstable (growth rate above `tolerance`)."""
+        return self.growth_rate > self.tolerance
+
+    @property
+    def critical_speeds(self) -> tuple[float, ...]:
+        """The onsets of instability (m/s), increasing."""
+        return tuple(b.speed for b in self.boundaries if b.direction == ONSET)
+
+    @property
     def critical_speed(self) -> float | None:
-        """The lowest critical speed (m/s), None when the sweep has none."""
-        return self.critical_speeds[0] if self.critical_speeds else None
+        """The first onset of instability (m/s), None when the sweep has none."""
+        onsets = self.critical_speeds
+        return onsets[0] if onsets else None
+
+    @property
+    def critical_frequency(self) -> float | None:
+        """The frequency (Hz) of the mode that crosses at `critical_speed`."""
+        return next((b.frequency_hz for b in self.boundaries if b.direction == ONSET), None)
+
+    @property
+    def unstable_ranges(self) -> tuple[tuple[float, float | None], ...]:
+        """[from, to] (m/s) of each unstable range: ``from`` the sweep's lowest speed when unstable
+        there, ``to`` None when still unstable at its highest."""
+        out: list[tuple[float, float | None]] = []
+        start = float(self.speeds[0]) if self.unstable[0] else None
+        for b in self.boundaries:
+            if b.direction == ONSET:
+                start = b.speed
+            else:
+                out.append((float(self.speeds[0]) if start is None else start, b.speed))
+                start = None
+        if start is not None:
+            out.append((start, None))
+        return tuple(out)
+
+    @property
+    def verdict(self) -> str:
+        """``stable`` (over the whole sweep), ``unstable`` (over the whole sweep) or ``mixed``."""
+        if not self.boundaries:
+            return "unstable" if self.unstable[0] else "stable"
+        return "mixed"
+
+    def summary(self) -> str:
+        """One line: the verdict over the sweep in words."""
+        lo, hi = float(self.speeds[0]), float(self.speeds[-1])
+        if self.verdict == "stable":
+            return f"stable over the whole range ({lo:g} to {hi:g} m/s)"
+        if self.verdict == "unstable":
+            return f"unstable over the whole range ({lo:g} to {hi:g} m/s)"
+        parts = [f"{a:.2f} to {'the top' if b is None else f'{b:.2f}'}" for a, b in self.unstable_ranges]
+        return "unstable from " + ", from ".join(parts) + " m/s"
+
+
+def _refine(lin: Linearisation, lo: float, hi: float, g_lo: float, g_hi: float, tol: float) -> float:
+    """The speed in [lo, hi] where the growth rate crosses zero (Brent); when one end is zero to
+    round-off, where it crosses ``tol`` (the classification's threshold)."""
+    from scipy.optimize import brentq
+
+    shift = 0.0 if g_lo * g_hi < 0 else tol
+    return float(brentq(lambda s: lin.growth(s)[0] - shift, lo, hi, xtol=1e-10, rtol=1e-12))
+
+
+def _mode(lin: Linearisation, V: float) -> tuple[float, np.ndarray]:
+    """(frequency in Hz, shape scaled to ψ = 1) of the least damped mode at speed V."""
+    ev, vec = np.linalg.eig(lin.jacobian(V))
+    i = int(np.argmax(ev.real))
+    shape = vec[:, i]
+    if abs(shape[0]) > 0:
+        shape = shape / shape[0]
+    return float(abs(ev[i].imag) / (2 * np.pi)), shape
 
 
 def stability_map(lin: Linearisation, speeds) -> StabilityMap:
-    """Eigenvalues over ``speeds`` (m/s, increasing, > 0) and the sign changes of the growth rate."""
-    from scipy.optimize import brentq
-
+    """Eigenvalues over ``speeds`` (m/s, increasing, > 0) and the boundaries between stable and
+    unstable speeds, each refined by Brent's method, with its direction and mode."""
     speeds = np.asarray(speeds, float)
     if speeds.ndim != 1 or speeds.size < 2 or np.any(speeds <= 0) or np.any(np.diff(speeds) <= 0):
         raise ArgumentError("speeds must be at least two increasing positive values (m/s)")
-    eig = np.array([np.sort_complex(lin.eigenvalues(V)) for V in speeds])
+    jacs = [lin.jacobian(V) for V in speeds]
+    eig = np.array([np.sort_complex(np.linalg.eigvals(j)) for j in jacs])
+    tol = GROWTH_RTOL * max(float(np.linalg.norm(j)) for j in jacs)
     imax = np.argmax(eig.real, axis=1)
     top = eig[np.arange(len(speeds)), imax]
     growth = top.real
     freq = np.abs(top.imag) / (2 * np.pi)
-    crit, fcrit = [], []
-    for i in np.nonzero(np.sign(growth[:-1]) * np.sign(growth[1:]) < 0)[0]:
-        v = brentq(lambda s: lin.growth(s)[0], speeds[i], speeds[i + 1], xtol=1e-10, rtol=1e-12)
-        crit.append(float(v))
-        fcrit.append(lin.growth(v)[1])
-    return StabilityMap(speeds, growth, freq, eig, tuple(crit), tuple(fcrit))
+    unstable = growth > tol
+    bounds = []
+    for i in np.nonzero(unstable[:-1] != unstable[1:])[0]:
+        v = _refine(lin, speeds[i], speeds[i + 1], growth[i], growth[i + 1], tol)
+        f, shape = _mode(lin, v)
+        bounds.append(Boundary(v, ONSET if unstable[i + 1] else END, f, shape))
+    return StabilityMap(speeds, growth, freq, eig, tuple(bounds), tol)
 
 
 def critical_speed(lin: Linearisation, lo: float, hi: float, n: int = 60) -> float | None:
-    """The lowest critical speed in [lo, hi] (coarse sweep of ``n`` speeds, then Brent), or None."""
+    """The first onset of instability in [lo, hi] (coarse sweep of ``n`` speeds, then Brent), or None."""
     return stability_map(lin, np.linspace(lo, hi, n)).critical_speed
 
 
 @dataclass(frozen=True)
-class TrailMap:
-    """The stability boundary over speed × trail: the lowest critical speed at each trail."""
+class ParameterMap:
+    """Stability over speed × one gear parameter: the growth rate on the grid, and at each value
+    the first onset of instability and the unstable ranges."""
 
-    trails: np.ndarray
+    parameter: str
+    values: np.ndarray
+    speeds: np.ndarray
+    growth_rate: np.ndarray  # (values, speeds), 1/s
     critical_speeds: tuple[float | None, ...]
-    speeds: tuple[float, float]
+    unstable_ranges: tuple[tuple[tuple[float, float | None], ...], ...]
+
+    @property
+    def trails(self) -> np.ndarray:
+        """The values (the name of a speed × trail map's values)."""
+        return self.values
 
     def rows(self) -> list[dict]:
         return [
-            {"trail": float(t), "critical_speed": v}
-            for t, v in zip(self.trails, self.critical_speeds, strict=True)
+            {self.parameter: float(t), "critical_speed": v, "unstable_ranges": [list(r) for r in rng]}
+            for t, v, rng in zip(self.values, self.critical_speeds, self.unstable_ranges, strict=True)
         ]
 
 
-def trail_map(lin: Linearisation, contact: Contact, trails, speeds) -> TrailMap:
-    """Lowest critical speed over ``speeds`` for each of ``trails`` (m), the gear otherwise
-    ``lin``'s (the contact's Jacobian reused, `Linearisation.for_gear`)."""
+#: The speed × trail map is a `ParameterMap` of the trail.
+TrailMap = ParameterMap
+
+
+def parameter_map(lin: Linearisation, contact: Contact, parameter: str, values, speeds) -> ParameterMap:
+    """Stability over ``speeds`` for each of ``values`` of the gear's ``parameter`` (a `Gear`
+    field), the gear otherwise ``lin``'s (the contact's Jacobian reused, `Linearisation.for_gear`)."""
     speeds = np.asarray(speeds, float)
-    crit = []
-    for t in np.asarray(trails, float):
-        other = lin.for_gear(lin.gear.replace(trail=float(t)), contact)
-        crit.append(stability_map(other, speeds).critical_speed)
-    return TrailMap(np.asarray(trails, float), tuple(crit), (float(speeds[0]), float(speeds[-1])))
+    values = np.asarray(values, float)
+    growth, crit, ranges = [], [], []
+    for t in values:
+        smap = stability_map(lin.for_gear(lin.gear.replace(**{parameter: float(t)}), contact), speeds)
+        growth.append(smap.growth_rate)
+        crit.append(smap.critical_speed)
+        ranges.append(smap.unstable_ranges)
+    return ParameterMap(parameter, values, speeds, np.array(growth), tuple(crit), tuple(ranges))
+
+
+def trail_map(lin: Linearisation, contact: Contact, trails, speeds) -> ParameterMap:
+    """First onset of instability over ``speeds`` for each of ``trails`` (m) (`parameter_map`)."""
+    return parameter_map(lin, contact, "trail", trails, speeds)

@@ -8,8 +8,8 @@ from types import MappingProxyType
 from typing import Any
 
 from .gear import Gear
-from .linear import StabilityMap, TrailMap
-from .simulate import TimeHistory
+from .linear import ParameterMap, StabilityMap
+from .simulate import BranchPoint, TimeHistory
 
 #: The model's name and reference (the ``model`` key).
 MODEL = {
@@ -38,21 +38,29 @@ class ModelStability:
     critical_speed_ci95: tuple[float, float] | None
     ci_method: str
     contact: Mapping[str, Any] = field(default_factory=dict)
-    trail_map: TrailMap | None = None
+    trail_map: ParameterMap | None = None
+    maps: Mapping[str, ParameterMap] = field(default_factory=dict)
+    branch: tuple[BranchPoint, ...] = ()
 
     def to_dict(self) -> dict:
-        crit = list(self.stability.critical_speeds)
-        freq = list(self.stability.critical_frequencies)
+        s = self.stability
         return {
-            "critical_speed": None if not crit else (crit[0] if len(crit) == 1 else crit),
+            "critical_speed": s.critical_speed,
             "critical_speed_ci95": None
             if self.critical_speed_ci95 is None
             else list(self.critical_speed_ci95),
             "critical_speed_ci95_method": self.ci_method,
-            "frequency_hz": None if not freq else (freq[0] if len(freq) == 1 else freq),
+            "frequency_hz": s.critical_frequency,
+            "verdict": s.verdict,
+            "summary": s.summary(),
+            "boundaries": [b.to_dict() for b in s.boundaries],
+            "unstable_ranges": [list(r) for r in s.unstable_ranges],
+            "growth_rate_tolerance": s.tolerance,
             "contact": dict(self.contact),
-            "stability": self.stability.rows(),
+            "stability": s.rows(),
             "trail_map": None if self.trail_map is None else self.trail_map.rows(),
+            "parameter_maps": {k: m.rows() for k, m in self.maps.items() if k != "trail"},
+            "limit_cycle_branch": [p.to_dict() for p in self.branch],
         }
 
 

@@ -9,11 +9,18 @@ the closed forms themselves, or for the map-based models their
 of directions, so the integration does not repeat the map's integrals).
 
 Verdict, from the yaw deviation |ψ − ψ_eq| over the windows [0.6, 0.8] T (A_mid)
-and [0.8, 1] T (A_end) of the duration T, with A_0 the perturbation:
+and [0.8, 1] T (A_end) of the duration T, with A_0 the perturbation. The motion is
+classed by where it settles, never against the size of the kick (a limit cycle
+smaller than the kick is a limit cycle):
 
-* ``decays``: A_end < A_0 and A_end <= A_mid (the perturbation dies away);
-* ``grows``: otherwise, A_end > (1 + `SETTLED`) A_mid (still growing at the end);
-* ``limit_cycle``: otherwise (settled on an oscillation of amplitude A_end, rad).
+* ``decays``: A_end < `DECAYED` A_0 (died away), or A_end < (1 − `SETTLED`) A_mid
+  (still falling at the end);
+* ``grows``: A_end > (1 + `SETTLED`) A_mid (still growing at the end);
+* ``limit_cycle``: otherwise: the amplitude changed by at most `SETTLED` between the
+  two windows; it has settled on an oscillation of amplitude A_end (rad).
+
+Close to a boundary the linear growth rate σ is small and A_end/A_mid ≈ exp(0.2 σ T):
+with |σ| below about 0.25/T the motion is read as settled whatever its sign.
 """
 
 from __future__ import annotations
@@ -29,9 +36,14 @@ from .gear import Gear
 
 #: Relative change of the amplitude between the last two windows read as "settled".
 SETTLED = 0.05
+#: Amplitude, as a fraction of the perturbation, below which the motion has died away (far
+#: above the integrator's absolute tolerance of 1e-10 rad).
+DECAYED = 1e-3
 #: Default perturbation of the yaw angle (rad) and duration (s); output sampling (Hz).
 PERTURBATION, DURATION, SAMPLING = 1e-3, 10.0, 1000.0
 VERDICTS = ("decays", "grows", "limit_cycle")
+#: Duration (s) of each run of the limit-cycle sweep (`amplitude_sweep`).
+BRANCH_DURATION = 3.0
 
 
 @dataclass(frozen=True)
@@ -60,7 +72,7 @@ def verdict_of(t: np.ndarray, dev: np.ndarray, a0: float) -> tuple[str, float | 
     T = t[-1]
     a_mid = float(np.max(dev[(t >= 0.6 * T) & (t < 0.8 * T)]))
     a_end = float(np.max(dev[t >= 0.8 * T]))
-    if a_end < a0 and a_end <= a_mid:
+    if a_end < DECAYED * a0 or a_end < (1 - SETTLED) * a_mid:
         return "decays", None, a_end
     if a_end > (1 + SETTLED) * a_mid:
         return "grows", None, a_end
@@ -111,3 +123,57 @@ def simulate(
     return TimeHistory(
         speed, name, sol.t, sol.y, np.array(equilibrium), perturbation, verdict, amplitude, final
     )
+
+
+@dataclass(frozen=True)
+class BranchPoint:
+    """One run of `amplitude_sweep`: the speed, the verdict and the amplitude at the end (rad)."""
+
+    speed: float
+    verdict: str
+    amplitude: float
+
+    def to_dict(self) -> dict:
+        return {"speed": self.speed, "verdict": self.verdict, "amplitude": self.amplitude}
+
+
+def amplitude_sweep(
+    gear: Gear,
+    contact,
+    speeds,
+    *,
+    equilibrium: np.ndarray,
+    perturbation: float = PERTURBATION,
+    duration: float = BRANCH_DURATION,
+) -> tuple[BranchPoint, ...]:
+    """The limit-cycle branch by a sweep of simulations down ``speeds`` (m/s).
+
+    The highest speed starts from the steady state plus the yaw ``perturbation``; each
+    lower speed starts where the run above it ended (natural continuation: it starts
+    near that speed's cycle when there is one, so ``duration`` seconds suffice to
+    settle). Below the speed where the branch starts, the motion decays (amplitude
+    → 0 at a supercritical Hopf point); a branch that goes on below the linear
+    critical speed is subcritical (a large enough disturbance shimmies below it).
+    Points in increasing speed.
+    """
+    from scipy.integrate import solve_ivp
+
+    eq = np.array(equilibrium, float)
+    x0 = eq.copy()
+    x0[0] += perturbation
+    out = []
+    for v in sorted((float(s) for s in speeds), reverse=True):
+        t_eval = np.linspace(0.0, duration, int(round(duration * 400.0)) + 1)
+        f = scalar_rhs(gear, v, contact.scalar)
+        sol = solve_ivp(f, (0.0, duration), x0, method="DOP853", t_eval=t_eval, rtol=1e-7, atol=1e-10)
+        if sol.status != 0:
+            raise ArgumentError(f"the time integration at {v:g} m/s failed: {sol.message}")
+        dev = np.abs(sol.y[0] - eq[0])
+        verdict, _, final = verdict_of(sol.t, dev, max(float(dev[0]), perturbation))
+        out.append(BranchPoint(v, verdict, final))
+        if final > DECAYED * perturbation:
+            x0 = sol.y[:, -1]
+        else:  # died away: the next speed starts from the kick again
+            x0 = eq.copy()
+            x0[0] += perturbation
+    return tuple(reversed(out))

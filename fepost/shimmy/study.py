@@ -31,20 +31,26 @@ import numpy as np
 from ..errors import ArgumentError
 from .contact import MODEL_NAMES, Contact, closed_forms_contact, exact_contact, model_contact
 from .gear import Gear
-from .linear import Linearisation, stability_map, trail_map
+from .linear import Linearisation, parameter_map, stability_map
 from .result import ModelStability, ShimmyResult, Simulation
-from .simulate import DURATION, simulate
+from .simulate import DURATION, amplitude_sweep, simulate
 from .table import DirectionTable
 
 #: Default speed sweep (m/s): 200 speeds.
 DEFAULT_SPEEDS = (1.0, 150.0, 200)
 #: Friction levels across f's interval at which the map-based models' V_c is recomputed.
 F_POINTS = 9
-#: The speed × trail map: trails from 0 to `TRAIL_SPAN` times the gear's (0.3 m for no trail),
-#: and speeds over the sweep's range.
+#: The stability maps: trails from 0 to `TRAIL_SPAN` times the gear's (0.3 m for no trail),
+#: and `TRAIL_SPEEDS` speeds over the sweep's range.
 TRAIL_SPAN, TRAIL_SPEEDS = 3.0, 60
 #: Speeds of the time simulations, as fractions of each critical speed.
 SIMULATION_FRACTIONS = (0.8, 1.2)
+#: The other stability maps: torsional damping from 0 to this fraction of the torsional mode's
+#: critical damping 2√(k_ψ I_ψ) (at least 3 times the gear's), torsional stiffness over this
+#: range of multiples of the gear's.
+DAMPING_SPAN, STIFFNESS_SPAN = 0.05, (0.25, 2.0)
+#: Speeds of the limit-cycle sweep (`fepost.shimmy.simulate.amplitude_sweep`).
+BRANCH_SPEEDS = 8
 
 
 def contacts(analysis, names: Sequence[str] = MODEL_NAMES) -> dict[str, Contact]:
@@ -71,7 +77,7 @@ def contacts(analysis, names: Sequence[str] = MODEL_NAMES) -> dict[str, Contact]
     return out
 
 
-def _lowest_critical(gear: Gear, contact: Contact, speeds: np.ndarray) -> float | None:
+def _first_onset(gear: Gear, contact: Contact, speeds: np.ndarray) -> float | None:
     return stability_map(Linearisation.of(gear, contact), speeds).critical_speed
 
 
@@ -91,7 +97,7 @@ def critical_interval(gear: Gear, contact: Contact, vc: float, speeds: np.ndarra
             for sign in (1.0, -1.0):
                 t = theta.copy()
                 t[i] += sign * h
-                v = _lowest_critical(
+                v = _first_onset(
                     gear, closed_forms_contact(**dict(zip(names, t, strict=True)), R=info["R"]), window
                 )
                 if v is None:
@@ -112,6 +118,81 @@ def critical_interval(gear: Gear, contact: Contact, vc: float, speeds: np.ndarra
     return (min(found), max(found)), f"forces scaled across Table 1's interval of f ({F_POINTS} levels)"
 
 
+class _Stages:
+    """Counts the study's stages and reports each one as it ends: ``progress(k, n, step, s)``."""
+
+    def __init__(self, total: int, progress, timings: dict[str, float]) -> None:
+        self.k, self.total, self.progress, self.timings = 0, total, progress, timings
+
+    def run(self, step: str, key: str, fun):
+        t0 = time.perf_counter()
+        out = fun()
+        seconds = time.perf_counter() - t0
+        self.timings[key] = seconds
+        self.k += 1
+        if self.progress is not None:
+            self.progress(self.k, self.total, step, seconds)
+        return out
+
+
+def _maps(gear: Gear, lin: Linearisation, contact: Contact, speeds: np.ndarray, n: int) -> dict:
+    """The stability maps over speed × trail, × torsional damping and × torsional stiffness
+    (`DAMPING_SPAN`, `STIFFNESS_SPAN`), ``n`` values each, on `TRAIL_SPEEDS` speeds over the sweep's range."""
+    tspeeds = np.linspace(speeds[0], speeds[-1], TRAIL_SPEEDS)
+    out = {}
+    for key, values in map_values(gear, n).items():
+        out[key] = parameter_map(lin, contact, key, values, tspeeds)
+    return out
+
+
+def map_values(gear: Gear, n: int) -> dict[str, np.ndarray]:
+    """The values of each mapped parameter (`DAMPING_SPAN`, `STIFFNESS_SPAN`)."""
+    critical_damping = 2.0 * np.sqrt(max(gear.torsional_stiffness, 1.0) * gear.yaw_inertia)
+    top_trail = TRAIL_SPAN * gear.trail if gear.trail > 0 else 0.3
+    top_damping = max(DAMPING_SPAN * critical_damping, 3.0 * gear.torsional_damping)
+    k = gear.torsional_stiffness if gear.torsional_stiffness > 0 else 1e6
+    lo, hi = STIFFNESS_SPAN
+    return {
+        "trail": np.linspace(0.0, top_trail, n),
+        "torsional_damping": np.linspace(0.0, top_damping, n),
+        "torsional_stiffness": np.linspace(lo * k, hi * k, n),
+    }
+
+
+def _simulations(gear, contact, lin, smap, name, duration, stages) -> tuple[list, tuple]:
+    """The two time histories (`SIMULATION_FRACTIONS` of the critical speed, or the sweep's ends)
+    and the limit-cycle sweep (`BRANCH_SPEEDS` from 0.8 V_c, or the lowest unstable speed, up)."""
+    sim_contact = stages.run(
+        f"{name}: table over the sphere of directions",
+        f"{name}_table",
+        lambda: contact if contact.scalar is not None else DirectionTable.build(contact).as_contact(),
+    )
+    vc, top = smap.critical_speed, float(smap.speeds[-1])
+    if vc is not None:
+        run_speeds = [f * vc for f in SIMULATION_FRACTIONS]
+    else:
+        run_speeds = [float(smap.speeds[0]), top]
+    sims = []
+    for v in run_speeds:
+        h = stages.run(
+            f"{name}: {duration:g} s of motion at {v:.1f} m/s",
+            f"{name}_simulation_{v:.4g}",
+            lambda v=v: simulate(gear, sim_contact, v, equilibrium=lin.state, name=name, duration=duration),
+        )
+        sims.append(Simulation(h, f"time_{name}_{v:.2f}.csv", lin.growth(v)[0]))
+    ranges = smap.unstable_ranges
+    branch: tuple = ()
+    if ranges:
+        start = 0.8 * vc if vc is not None else float(ranges[0][0])
+        bspeeds = np.linspace(max(start, float(smap.speeds[0])), top, BRANCH_SPEEDS)
+        branch = stages.run(
+            f"{name}: limit-cycle amplitude, {BRANCH_SPEEDS} runs",
+            f"{name}_limit_cycle_sweep",
+            lambda: amplitude_sweep(gear, sim_contact, bspeeds, equilibrium=lin.state),
+        )
+    return sims, branch
+
+
 def shimmy_study(
     analysis,
     gear: Gear,
@@ -123,14 +204,18 @@ def shimmy_study(
     duration: float = DURATION,
     anchor: bool = True,
     trails: int = 16,
+    progress=None,
 ) -> ShimmyResult:
     """Stability of ``gear`` on the tire of ``analysis`` with each friction model (module docstring).
 
     ``speeds``: the sweep (m/s, increasing; default `DEFAULT_SPEEDS`, 200 speeds
     from 1 to 150 m/s). ``intervals``: carry Table 1's intervals to the critical
     speeds. ``simulate_motion``: time histories at 0.8 and 1.2 times each critical
-    speed (at the top speed when there is none), ``duration`` seconds each.
-    ``trails``: the boundary over speed × trail at that many trails (`TRAIL_SPAN`; 0: none).
+    speed (at the sweep's ends when there is none), ``duration`` seconds each, and the
+    limit-cycle amplitude over speed (`amplitude_sweep`). ``trails``: the stability maps
+    over speed × trail, × torsional damping and × torsional stiffness at that many
+    values each (`map_values`; 0: none). ``progress``: called as
+    ``progress(k, n, step, seconds)`` after each of the n stages.
     """
     from .anchor import anchor_record
 
@@ -138,48 +223,58 @@ def shimmy_study(
         raise ArgumentError(f"gear must be a Gear, got {type(gear).__name__}")
     speeds = np.linspace(*DEFAULT_SPEEDS) if speeds is None else np.asarray(speeds, float)
     timings: dict[str, float] = {}
-    t0 = time.perf_counter()
-    found = contacts(analysis, models)
-    timings["contacts"] = time.perf_counter() - t0
+    n_models = len(models)
+    per_model = 1 + int(intervals) + int(bool(trails)) + (4 if simulate_motion else 0)
+    stages = _Stages(1 + int(intervals) + n_models * per_model, progress, timings)
+    found = stages.run("friction models", "contacts", lambda: contacts(analysis, models))
     t1 = None
     if intervals:
         from ..table1 import table1
 
-        t1 = table1(analysis, bias=False, profile=False, generalised=False)
+        t1 = stages.run(
+            "Table 1 identification (intervals)",
+            "table1",
+            lambda: table1(analysis, bias=False, profile=False, generalised=False),
+        )
     results, sims = [], []
     for name, contact in found.items():
-        t0 = time.perf_counter()
-        lin = Linearisation.of(gear, contact)
-        smap = stability_map(lin, speeds)
-        timings[f"{name}_stability_map"] = time.perf_counter() - t0
+        lin, smap = stages.run(
+            f"{name}: stability over {len(speeds)} speeds",
+            f"{name}_stability_map",
+            lambda c=contact: _linear(gear, c, speeds),
+        )
         ci, method = None, "not computed"
-        if t1 is not None and smap.critical_speed is not None:
-            ci, method = critical_interval(gear, contact, smap.critical_speed, speeds, t1, lin)
+        if t1 is not None:
+            if smap.critical_speed is not None:
+                ci, method = stages.run(
+                    f"{name}: 95 % interval of the critical speed",
+                    f"{name}_interval",
+                    lambda c=contact, s=smap, lin=lin: critical_interval(
+                        gear, c, s.critical_speed, speeds, t1, lin
+                    ),
+                )
+            else:
+                method = "no onset of instability in the sweep"
+                stages.run(f"{name}: no interval ({method})", f"{name}_interval", lambda: None)
         elif smap.critical_speed is None:
-            method = "no critical speed in the sweep"
+            method = "no onset of instability in the sweep"
         info = {k: float(v) for k, v in contact.info.items() if isinstance(v, int | float)}
-        tmap = None
+        maps = {}
         if trails:
-            t0 = time.perf_counter()
-            top = TRAIL_SPAN * gear.trail if gear.trail > 0 else 0.3
-            tspeeds = np.linspace(speeds[0], speeds[-1], TRAIL_SPEEDS)
-            tmap = trail_map(lin, contact, np.linspace(0.0, top, trails), tspeeds)
-            timings[f"{name}_trail_map"] = time.perf_counter() - t0
-        stab = ModelStability(name, smap, ci, method, {"F0": contact.F0, "M0": contact.M0, **info}, tmap)
-        results.append(stab)
-        if simulate_motion:
-            t0 = time.perf_counter()
-            sim_contact = (
-                contact if contact.scalar is not None else DirectionTable.build(contact).as_contact()
+            maps = stages.run(
+                f"{name}: stability maps over speed x trail, damping, stiffness ({trails} values each)",
+                f"{name}_maps",
+                lambda c=contact, lin=lin: _maps(gear, lin, c, speeds, trails),
             )
-            timings[f"{name}_table"] = time.perf_counter() - t0
-            vc = smap.critical_speed
-            run_speeds = [f * vc for f in SIMULATION_FRACTIONS] if vc is not None else [float(speeds[-1])]
-            for v in run_speeds:
-                t0 = time.perf_counter()
-                h = simulate(gear, sim_contact, v, equilibrium=lin.state, name=name, duration=duration)
-                timings[f"{name}_simulation_{v:.4g}"] = time.perf_counter() - t0
-                sims.append(Simulation(h, f"time_{name}_{v:.2f}.csv", lin.growth(v)[0]))
+        branch: tuple = ()
+        if simulate_motion:
+            runs, branch = _simulations(gear, contact, lin, smap, name, duration, stages)
+            sims.extend(runs)
+        stab = ModelStability(
+            name, smap, ci, method, {"F0": contact.F0, "M0": contact.M0, **info}, maps.get("trail"),
+            maps, branch,
+        )  # fmt: skip
+        results.append(stab)
     c = analysis.coefficients
     source = {
         "static": str(analysis.static_field.source),
@@ -198,3 +293,8 @@ def shimmy_study(
         source=source,
         timings=timings,
     )
+
+
+def _linear(gear: Gear, contact: Contact, speeds: np.ndarray):
+    lin = Linearisation.of(gear, contact)
+    return lin, stability_map(lin, speeds)
