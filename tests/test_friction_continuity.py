@@ -30,7 +30,10 @@ from fepost.friction.law import FrictionLaw
 from fepost.friction.quadrature import Ellipse, PressureQuadrature, edge_grid
 from fepost.polar import PolarMap
 
-JUMP = 1e-4
+#: Largest change allowed over a step of 1e-6 of the centre's ellipse level across the rim
+#: (fraction of fN or fNR): measured 4.2e-7 (uniform) and 3.0e-7 (Hertz); the defect this
+#: guards (the Hertz subtraction's gradient term at the rim) jumped by 1.2e-4, 24x above it.
+JUMP = 5e-6
 EXACT = 1e-10
 EDGE = 5e-5
 
