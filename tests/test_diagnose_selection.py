@@ -156,8 +156,8 @@ def test_ranking_puts_admissible_first():
             assert a.bic <= b.bic
 
 
-def test_chi2_level_is_bonferroni_over_nine_extensions():
-    assert ALPHA == pytest.approx(0.05 / 9)
+def test_chi2_level_is_bonferroni_over_ten_extensions():
+    assert ALPHA == pytest.approx(0.05 / 10)
     assert stats.chi2.isf(ALPHA, 1) > 2.0  # far stricter than AIC's 2 per parameter
 
 

@@ -16,4 +16,5 @@ CAUSES = (
     "sensor_offset",
     "sensor_crosstalk",
     "load_transfer",
+    "pressure_shape",
 )

@@ -19,6 +19,7 @@ cause                          parameters            no-effect value
 ``elliptic_patch``             f, s                  s = 1
 ``pressure_shift``             f, dx, dy (m)         dx = dy = 0
 ``sensor_offset``              f, oFx, oFy (N), oMz  offsets = 0
+``pressure_shape``             f, c_rim              c_rim = 0
 ============================== ===================== ===============================
 
 Two extensions at once (`joint_candidate`) share f and keep both
@@ -41,6 +42,7 @@ import numpy as np
 
 from .causenames import CAUSES
 from .models import Candidate, Parameter, Predictor, extension_model, with_fixed
+from .shape import rim_bounds
 from .transfer import load_transfer_model
 
 __all__ = [
@@ -69,6 +71,8 @@ MEANING = {
     "sensor_offset": "constant offsets in the measured channels",
     "sensor_crosstalk": "the load cell's calibration matrix has off-diagonal terms",
     "load_transfer": "the centre of pressure moves with the friction force",
+    "pressure_shape": "the same load and centre of pressure, carried more towards the rim (c_rim > 0) "
+    "or the centre (c_rim < 0)",
 }
 
 #: Causes the load-transfer model combines with (applied after the force, on the sensor).
@@ -83,6 +87,7 @@ def extension_parameters(pred: Predictor) -> dict[str, tuple[Parameter, ...]]:
     cp_low = -1.0 / (ratio - 1.0) if ratio > 1.0 else -10.0
     top = pred.max_slip_speed()
     cv_low = -1.0 / top if top > 0 else -10.0
+    rim_lo, rim_hi = shape_bounds(pred)
     return {
         "pressure_dependent_friction": (
             Parameter("c_p", "1", 0.0, cp_low, 1.0, 0.1, 0.0, "μ = f (1 + c_p (σ/σ_ref − 1))"),
@@ -117,7 +122,23 @@ def extension_parameters(pred: Predictor) -> dict[str, tuple[Parameter, ...]]:
             Parameter(name, "m", 0.0, -R, R, 0.05 * R, 0.0, f"centre of pressure moves by {name}·{F}/N")
             for name, F in (("h_x", "Fx"), ("h_y", "Fy"))
         ),
+        "pressure_shape": (
+            Parameter("c_rim", "1", 0.0, rim_lo, rim_hi, 0.1, 0.0, "σ → σ (1 + c_rim r), r the rim weight"),
+        ),
     }
+
+
+#: c_rim is kept within ± this, whatever the map allows (a uniform disc allows ±1).
+RIM_LIMIT = 5.0
+
+
+def shape_bounds(pred: Predictor) -> tuple[float, float]:
+    """Bounds of c_rim: the pressure stays non-negative on every map (`fepost.diagnose.shape`)."""
+    lo, hi = -RIM_LIMIT, RIM_LIMIT
+    for quad in pred.sim.quads.values():
+        a, b = rim_bounds(quad)
+        lo, hi = max(lo, a), min(hi, b)
+    return lo, hi
 
 
 def friction_parameter(pred: Predictor) -> Parameter:
@@ -134,6 +155,7 @@ _DESCRIPTION = {
     "sensor_offset": "constant offsets in the measured Fx, Fy, Mz",
     "sensor_crosstalk": "the load cell's calibration matrix has off-diagonal terms (measured = C·true)",
     "load_transfer": "the centre of pressure moves with the friction force (dx = h_x Fx/N, dy = h_y Fy/N)",
+    "pressure_shape": "the same load and centre of pressure, distributed more towards the rim or the centre",
 }
 
 

@@ -10,8 +10,9 @@ Effect sizes (`example_parameters`) are set relative to the simulation, so
 that every cause is plain on any map: a 15 % lower friction level; c_p = 0.25;
 c_v = −0.1 s/m; a patch stretched by 12 %; f_y/f_x = 1.15; the centre of
 pressure moved by (4 %, −3 %) of R; offsets of (8 %, −6 %) of f·N and 5 % of
-f·N·R. The programme has loads 0.8, 1.0 and 1.2 × N (pressure dependence then
-shows through the load), 300 points, noise 1.5 % of each channel's range and
+f·N·R; c_rim = 0.4 (more of the load towards the rim). The programme has
+loads 0.8, 1.0 and 1.2 × N (pressure dependence then shows through the
+load), 300 points, noise 1.5 % of each channel's range and
 `EXAMPLE_OUTLIERS` gross errors (a sign flip, a 2.5× spike).
 
 The example shipped as ``examples/measured_example.csv`` was made from
@@ -64,6 +65,7 @@ def example_parameters(cause: str, friction: float, load: float, radius: float) 
             "c_zy": 0.0,
         },  # fmt: skip
         "load_transfer": {"h_x": 0.3 * radius, "h_y": 0.2 * radius},
+        "pressure_shape": {"c_rim": 0.4},
     }
     if cause not in table:
         raise ArgumentError(f"--cause must be one of {', '.join(CAUSES)}, got {cause!r}")

@@ -17,8 +17,10 @@ B(α) = B(1) + (α − 1)(B(2) − B(1)). Offsets o add to the channels. Only th
 terms a model needs are evaluated (one for ``friction_level``, two for a
 single pressure-, speed- or direction-dependent law, up to eight for a pair).
 
-Geometry (the stretch s of ``elliptic_patch`` and the shift dx, dy of
-``pressure_shift``; stretch first, then shift) moves the pressure map, so every
+Geometry (the stretch s of ``elliptic_patch``, the shift dx, dy of
+``pressure_shift`` and the rim share c_rim of ``pressure_shape``,
+`fepost.diagnose.shape`; reshaped first, then stretched, then shifted) changes
+the pressure map, so every
 B depends on it and needs new exact integrals per geometry. Those are cached
 (`CACHE_SIZE` per `Predictor`, shared by all models). A geometric
 model also offers ``expand(values)``: the same formula with each B replaced by
@@ -39,6 +41,7 @@ import numpy as np
 from ..friction.exact import friction_resultants
 from ..friction.law import FrictionLaw
 from .measured import MeasuredData
+from .shape import reshaped, rim_weight
 from .simulation import Simulation
 
 #: Kept exact evaluations per predictor (law term, anisotropy, geometry; shifts per row).
@@ -54,7 +57,7 @@ CACHE_SIZE = 256
 GEOMETRY_STEP = 0.2
 
 #: Geometric parameters and their no-effect values, in the order of the geometry tuple.
-GEOMETRY = (("s", 1.0), ("dx", 0.0), ("dy", 0.0))
+GEOMETRY = (("s", 1.0), ("dx", 0.0), ("dy", 0.0), ("c_rim", 0.0))
 IDENTITY = tuple(v for _, v in GEOMETRY)
 OFFSETS = ("offset_Fx", "offset_Fy", "offset_Mz")
 #: Crosstalk terms of the load cell, c_ab: measured channel a gains c_ab × true channel b
@@ -147,6 +150,7 @@ class Predictor:
         self.sigma_ref = sim.pressure_ref
         self.evaluations = 0
         self._cache: OrderedDict[tuple, np.ndarray] = OrderedDict()
+        self._rims: dict[int, tuple] = {}
 
     def resultants(self, law: FrictionLaw, power: int = 1, transform=None) -> np.ndarray:
         out = np.empty((self.n, 3))
@@ -190,8 +194,8 @@ class Predictor:
             self._cache.popitem(last=False)
         return out.copy()
 
-    def raw(self, term: tuple[int, int], alpha: float, geometry: tuple[float, float, float]) -> np.ndarray:
-        """B_term (f = 1) with anisotropy ``alpha`` on the map moved by ``geometry`` (s, dx, dy)."""
+    def raw(self, term: tuple[int, int], alpha: float, geometry: tuple[float, ...]) -> np.ndarray:
+        """B_term (f = 1) with anisotropy ``alpha`` on the map changed by ``geometry`` (s, dx, dy, c_rim)."""
         key = (term, float(alpha), *(float(g) for g in geometry))
         hit = self._cache.get(key)
         if hit is not None:
@@ -202,22 +206,31 @@ class Predictor:
             f=1.0, pressure_coef=float(cp), speed_coef=float(cv), anisotropy=float(alpha),
             pressure_ref=self.sigma_ref,
         )  # fmt: skip
-        s, dx, dy = (float(g) for g in geometry)
+        s, dx, dy, c_rim = (float(g) for g in geometry)
 
         def transform(q):
+            if c_rim:
+                q = reshaped(q, c_rim, self.rim_weight(q))
             if s != 1.0:
                 q = q.stretched(s)
             if dx or dy:
                 q = q.shifted(dx, dy)
             return q
 
-        moved = (s, dx, dy) != IDENTITY
+        moved = (s, dx, dy, c_rim) != IDENTITY
         value = self.resultants(law, power=2 if cp else 1, transform=transform if moved else None)
         value.setflags(write=False)
         self._cache[key] = value
         if len(self._cache) > CACHE_SIZE:
             self._cache.popitem(last=False)
         return value
+
+    def rim_weight(self, quad):
+        """The rim weight of ``quad`` (one of the simulation's maps), computed once per map."""
+        hit = self._rims.get(id(quad))
+        if hit is None or hit[0] is not quad:
+            hit = self._rims[id(quad)] = (quad, rim_weight(quad))
+        return hit[1]
 
     def max_slip_speed(self) -> float:
         """An upper bound of |w| over every patch point and test point (m/s)."""
@@ -255,11 +268,11 @@ class _Layout:
         geometric = tuple(index[GEOMETRY[k][0]] for k in slots)
         return cls(index, tuple(terms), alphas, geometric, tuple(slots))
 
-    def geometry(self, p) -> tuple[float, float, float]:
+    def geometry(self, p) -> tuple[float, ...]:
         g = list(IDENTITY)
         for j, k in zip(self.geometric, self.geometry_slots, strict=True):
             g[k] = float(p[j])
-        return (g[0], g[1], g[2])
+        return tuple(g)
 
     def keys(self):
         return [(t, a) for t in self.terms for a in self.alphas]

@@ -17,9 +17,11 @@ The effects are applied here independently of the diagnosis's own models:
 through `FrictionLaw` for the friction laws,
 `stretched`/``shifted`` for
 the geometry, offsets added in N and N·m, crosstalk as the matrix C applied to
-the forces in SI, load transfer as a fixed point per distinct test point on the
-map moved by its own shift (``shifted``, one row at a time, where the diagnosis
-moves the kinematics instead); loads by scaling the map's pressure;
+the forces in SI, the pressure shape by reweighting the fine map's pressure
+(`fepost.diagnose.shape.reshaped`, its rim weight from the fine map), load
+transfer as a fixed point per distinct test point on the map moved by its own
+shift (``shifted``, one row at a time, where the diagnosis moves the kinematics
+instead); loads by scaling the map's pressure;
 the reversed rolling map (roll = −1) by mirroring the kinematics and the
 resultants (vx, ω_z, Fx, Mz change sign) rather than the map.
 """
@@ -40,6 +42,7 @@ from ..friction_coefficient import DEFAULT_FRICTION
 from ..polar import PolarGrid, PolarMap
 from .causes import CAUSES
 from .measured import MeasuredData
+from .shape import reshaped
 from .simulation import regrid
 
 #: Spin speeds u = |ω|R of the programme (m/s): several absolute speeds per ratio.
@@ -63,6 +66,7 @@ EFFECT_PARAMETERS: dict[str, dict[str, float | None]] = {
     "sensor_offset": {"offset_Fx": 0.0, "offset_Fy": 0.0, "offset_Mz": 0.0},
     "sensor_crosstalk": {k: 0.0 for k in ("c_xy", "c_xz", "c_yx", "c_yz", "c_zx", "c_zy")},
     "load_transfer": {"h_x": 0.0, "h_y": 0.0},
+    "pressure_shape": {"c_rim": 0.0},
 }
 #: Crosstalk terms: (measured channel, true channel) in (Fx, Fy, Mz).
 CROSSTALK_TERMS = {
@@ -391,6 +395,7 @@ def _law(params: dict, f: float, pressure_ref: float) -> FrictionLaw:
 def _clean_resultants(quads, kin: Kinematics, law, params: dict, *, scaled_loads: bool, N_sim: float):
     """Noise-free Fx, Fy, Mz (N, N, N·m) of every row, with the geometric effects and load transfer."""
     s = float(params.get("s", 1.0))
+    c_rim = float(params.get("c_rim", 0.0))
     dx, dy = float(params.get("dx", 0.0)), float(params.get("dy", 0.0))
     heights = (float(params.get("h_x", 0.0)), float(params.get("h_y", 0.0)))
     clean = np.empty((kin.vx.size, 3))
@@ -402,6 +407,7 @@ def _clean_resultants(quads, kin: Kinematics, law, params: dict, *, scaled_loads
             idx = np.flatnonzero((kin.roll == r) & (kin.load_factor == lam))
             # Rows without a load column carry each map as given (λ = 1).
             quad = base if not scaled_loads else _scaled(base, lam * N_sim / base.load)
+            quad = reshaped(quad, c_rim)
             if s != 1.0:
                 quad = quad.stretched(s)
             kv = (sx * kin.vx[idx], kin.vy[idx], sx * kin.wz[idx])
