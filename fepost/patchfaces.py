@@ -34,6 +34,10 @@ from .regions import FRAGMENT_SHARE, loaded_regions
 REFINE_TOL = 1e-4
 #: Most triangles the cut of curved faces may make (the finest level stays within it).
 REFINE_MAX_TRIANGLES = 4_000_000
+#: Sidecar key by which a map declares that it holds this many separate contact patches on
+#: purpose (a body on point supports, `fepost.bodymap`): exactly that many regions are kept
+#: together; any other count is refused as for every other map.
+DECLARED_PATCHES_KEY = "separate_patches"
 
 
 class Geometry(NamedTuple):
@@ -142,7 +146,7 @@ def drop_fragments(fld: ContactField, *, cut: Cut, values: np.ndarray, thr: floa
     regions each carry more than `FRAGMENT_SHARE` of the load)."""
     src, geo = fld.source, cut.geo
     ncomp, labels = loaded_regions(geo.xy[:, 0], geo.xy[:, 1], geo.triangles, geo.sums)
-    if ncomp <= 1:
+    if ncomp <= 1 or ncomp == declared_patches(fld):
         return cut
     loads = face_loads(geo.xy, geo.triangles, geo.values, fld.location)
     share = np.bincount(labels, weights=loads, minlength=ncomp) / geo.sums.N
@@ -172,6 +176,13 @@ def drop_fragments(fld: ContactField, *, cut: Cut, values: np.ndarray, thr: floa
     if cut.parent is not None and cut.xy_native is not None:
         exact = exact_load(groups, cut.xy_native, values, fld.location)
     return cut._replace(geo=geo, groups=groups, exact=exact, dropped=dropped)
+
+
+def declared_patches(fld: ContactField) -> int:
+    """The number of separate patches ``fld``'s sidecar declares (`DECLARED_PATCHES_KEY`, an
+    integer >= 2), else 1."""
+    n = (fld.sidecar or {}).get(DECLARED_PATCHES_KEY)
+    return n if isinstance(n, int) and not isinstance(n, bool) and n >= 2 else 1
 
 
 def patch_load(cut: Cut, *, location: str) -> tuple[float, np.ndarray, float, tuple[str, ...]]:

@@ -43,6 +43,7 @@ COMMANDS = [
     "sweep",
     "rig",
     "shimmy",
+    "map",
 ]
 
 #: Exit statuses of ``fepost`` (the ``--help`` epilog and docs/cli-exit-codes.md).
