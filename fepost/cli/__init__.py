@@ -43,6 +43,7 @@ COMMANDS = [
     "sweep",
     "rig",
     "shimmy",
+    "pushes",
     "map",
 ]
 
