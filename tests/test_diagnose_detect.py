@@ -12,7 +12,7 @@ The tests below use **other maps and other values** (never tuned on):
   loads 0.7/1.0/1.3 × N, 400 points, noise 1.5 % of range;
 * set B: a paraboloid, R = 0.09 m, peak 4e5 Pa, with a rolling map (k_x = 0.1)
   and rows at roll = −1/0/+1, one load, 300 points, noise 2 % of range;
-* set C: the CalculiX sample map ``meshes/static.vtu`` (skipped until it exists).
+* set C: the CalculiX sample map ``meshes/static.vtu`` (committed: its absence fails).
 Seeds are fixed per case (set base + index), chosen before the first run and
 never changed. Each case must name the cause with no rival, gain in held-out
 RMSE, leave noise-like residuals, and every parameter's truth must lie inside
@@ -153,10 +153,6 @@ def test_closed_forms_are_compared():
     assert np.all(np.isfinite(d.predictions["closed_form"]))
 
 
-@pytest.mark.skipif(
-    not (MESHES / "static.vtu").is_file(),
-    reason="CalculiX sample map meshes/static.vtu not yet built",
-)
 @pytest.mark.parametrize(
     ("effect", "params"),
     [
