@@ -4,8 +4,9 @@
 
 * **the sensor's zero**: the offset of each push (the mean of the quiet samples before the
   impact, sensor axes), its drift over the log (the last push's minus the first's, and
-  the range) set beside the median force, and how far the first sample alone (the
-  authors' zero) lies from it;
+  the range) set beside the median force, how far the first sample alone (the
+  authors' zero) lies from it, and which pushes started loaded and took the log's
+  median zero (these are left out of the drift);
 * **pushes that hardly moved** or gave no wrench: left out, each with its reason;
 * **the finger's impact**: when it comes (s and fraction of the push; how many pushes
   are hit after 30 % of their samples, where a fixed 30 % cut would keep unloaded
@@ -49,6 +50,7 @@ class LogChecks:
     zero_last: tuple[float, float]
     zero_range: tuple[float, float]
     zero_vs_first_sample: float
+    zero_replaced: tuple[int, ...]
     median_force: float
     impact_time: tuple[float, float]
     impact_fraction: tuple[float, float]
@@ -82,7 +84,9 @@ class LogChecks:
             f"  zero: first push ({zf[0]:+.3f}, {zf[1]:+.3f}) N, last ({zl[0]:+.3f}, {zl[1]:+.3f}) N: "
             f"drift {drift:.3f} N ({share:.1f} % of the median force {self.median_force:.2f} N); "
             f"range over the log {zr[0]:.3f}, {zr[1]:.3f} N (fx, fy); "
-            f"the first sample alone is off by up to {self.zero_vs_first_sample:.3f} N",
+            f"the first sample alone is off by up to {self.zero_vs_first_sample:.3f} N; "
+            f"loaded at the start, given the log's median zero: {len(self.zero_replaced)}"
+            f"{_named(self.zero_replaced)}",
             f"  impact: {when[0]:.2f}-{when[1]:.2f} s into the push "
             f"({100 * frac[0]:.0f}-{100 * frac[1]:.0f} % of its samples; {late}); "
             f"spike (peak of the settling window / plateau) median {peak[0]:.2f}, "
@@ -129,7 +133,8 @@ def check_log(log: str, results: list[Push | LeftOut], *, weight: float, radius:
     idx = np.array([p.index for p in kept])
     force = np.hypot(w[:, 0], w[:, 1])
     slide = np.hypot(d[:, 0], d[:, 1])
-    zeros = np.array([p.zero for p in kept])
+    own = [p for p in kept if not p.zero_from_log] or kept
+    zeros = np.array([p.zero for p in own])
     level = force / weight
     mad = 1.4826 * float(np.median(np.abs(level - np.median(level))))
     far = np.abs(level - np.median(level)) > OUTLIER_Z * mad if mad > 0 else np.zeros(len(kept), bool)
@@ -147,7 +152,8 @@ def check_log(log: str, results: list[Push | LeftOut], *, weight: float, radius:
         zero_first=(float(zeros[0, 0]), float(zeros[0, 1])),
         zero_last=(float(zeros[-1, 0]), float(zeros[-1, 1])),
         zero_range=(float(np.ptp(zeros[:, 0])), float(np.ptp(zeros[:, 1]))),
-        zero_vs_first_sample=float(max(np.hypot(*(p.first - p.zero)) for p in kept)),
+        zero_vs_first_sample=float(max(np.hypot(*(p.first - p.zero)) for p in own)),
+        zero_replaced=tuple(p.index for p in kept if p.zero_from_log),
         median_force=float(np.median(force)),
         impact_time=(min(p.impact_time for p in kept), max(p.impact_time for p in kept)),
         impact_fraction=(float(frac.min()), float(frac.max())),
@@ -177,6 +183,7 @@ def _empty(log: str, logged: int, left, radius: float) -> LogChecks:
         zero_last=nan2,
         zero_range=nan2,
         zero_vs_first_sample=math.nan,
+        zero_replaced=(),
         median_force=math.nan,
         impact_time=nan2,
         impact_fraction=nan2,

@@ -15,6 +15,8 @@ import io
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..body import Body
 from .checks import LogChecks, check_log
 from .log import read_log
@@ -89,13 +91,28 @@ def read_pushes(logs: Sequence, body: Body, settings: Settings | None = None) ->
         A log is missing or unreadable.
     """
     log_format(body)
+    settings = settings or Settings()
     radius = patch_radius(body)
     pushes: list[Push] = []
     left: list[LeftOut] = []
     checks = []
     for log in logs:
-        results = [form_push(raw, body, settings) for raw in read_log(log)]
+        results = _log_pushes(log, body, settings)
         pushes += [r for r in results if isinstance(r, Push)]
         left += [r for r in results if isinstance(r, LeftOut)]
         checks.append(check_log(str(log), results, weight=body.weight, radius=radius))
     return PushTable(body=body, pushes=tuple(pushes), left_out=tuple(left), checks=tuple(checks))
+
+
+def _log_pushes(log, body: Body, settings: Settings) -> list[Push | LeftOut]:
+    """One log's pushes; those whose own zero is loaded are formed again with the log's median zero."""
+    raws = list(read_log(log))
+    results = [form_push(raw, body, settings) for raw in raws]
+    zeros = np.array([r.zero for r in results if isinstance(r, Push)])
+    if len(zeros) == 0:
+        return results
+    median = np.median(zeros, axis=0)
+    for k, r in enumerate(results):
+        if isinstance(r, Push) and np.hypot(*(r.zero - median)) > settings.zero_tolerance:
+            results[k] = form_push(raws[k], body, settings, zero=median)
+    return results
