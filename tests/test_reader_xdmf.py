@@ -174,3 +174,200 @@ def test_a_time_series_step_linked_outside_the_folder_is_refused(mesh, tmp_path)
         f"{path}: refused .xdmf file (heavy-data file 'solution.h5': dataset '/Function/p/1' reaches "
         "'../far.h5' through an HDF5 external link, which lies outside the file's folder)"
     )
+
+
+# ------------------------------------------------- heavy data reaching files outside the folder
+
+SMALL = Path(__file__).resolve().parents[1] / "meshes" / "static.vtu"  # 2961 nodes
+
+
+@pytest.fixture(scope="module")
+def small_n_fe():
+    from fepost.patch import build_patch
+
+    return build_patch(read_contact(SMALL)).N_fe
+
+
+def _n_fe(path: Path, **kw) -> float:
+    from fepost.patch import build_patch
+
+    return build_patch(read_contact(path, **kw)).N_fe
+
+
+def _map_with_far(tmp_path: Path) -> tuple[Path, Path, Path, str]:
+    """A meshio XDMF map in ``tmp_path/run``, and ``far.h5`` beside the folder and ``near.h5``
+    in it, each holding the pressure tripled as ``/p``; returns (xdmf, its .h5, far.h5, the
+    pressure's dataset)."""
+    folder = tmp_path / "run"
+    folder.mkdir()
+    path = folder / "map.xdmf"
+    meshio.write(path, meshio.read(SMALL))
+    text = path.read_text()
+    item = text.index("<DataItem", text.index('Name="CPRESS"'))
+    dataset = text[text.index(">", item) + 1 : text.index("</DataItem>", item)].split(":")[1]
+    h5 = path.with_suffix(".h5")
+    with h5py.File(h5) as f:
+        tripled = 3 * f[dataset][()]
+    for where in (tmp_path / "far.h5", folder / "near.h5"):
+        with h5py.File(where, "w") as g:
+            g["p"] = tripled
+    return path, h5, tmp_path / "far.h5", dataset
+
+
+def _rename(path: Path, dataset: str, new: str) -> None:
+    path.write_text(path.read_text().replace(f"map.h5:{dataset}<", f"map.h5:{new}<"))
+
+
+def _absolute_on_the_dataset(path, h5, far, ds):
+    with h5py.File(h5, "a") as f:
+        del f[ds]
+        f[ds] = h5py.ExternalLink(str(far), "/p")
+    return f"dataset {ds!r} reaches {str(far)!r} through an HDF5 external link"
+
+
+def _absolute_on_a_group(path, h5, far, ds):
+    with h5py.File(h5, "a") as f:
+        f["g"] = h5py.ExternalLink(str(far), "/")
+    _rename(path, ds, "/g/p")
+    return f"dataset '/g/p' reaches {str(far)!r} through an HDF5 external link"
+
+
+def _a_space_after_the_colon(path, h5, far, ds):
+    """meshio splits 'map.h5: /p' into the keys ' ' and 'p' (no space stripped); the plain '/p'
+    is a clean copy, so a check that strips the space would pass the file."""
+    with h5py.File(h5, "a") as f:
+        f["p"] = f[ds][()]
+        f[" /p"] = h5py.ExternalLink(str(far), "/p")
+    path.write_text(path.read_text().replace(f"map.h5:{ds}<", "map.h5: /p<"))
+    return f"dataset ' /p' reaches {str(far)!r} through an HDF5 external link"
+
+
+def _a_relative_soft_link(path, h5, far, ds):
+    """A soft link 'sub/p' in group /g: HDF5 resolves it from /g (into the external link /g/sub),
+    not from the root, where /sub/p is a clean copy."""
+    with h5py.File(h5, "a") as f:
+        f["sub/p"] = f[ds][()]
+        f["g/sub"] = h5py.ExternalLink(str(far), "/")
+        f["g/d"] = h5py.SoftLink("sub/p")
+    _rename(path, ds, "/g/d")
+    return f"dataset '/g/d' reaches {str(far)!r} through an HDF5 external link"
+
+
+def _a_link_off_the_named_paths(path, h5, far, ds):
+    with h5py.File(h5, "a") as f:
+        f["spare"] = h5py.ExternalLink("../far.h5", "/p")
+    return "link '/spare' reaches '../far.h5' through an HDF5 external link"
+
+
+def _through_a_file_in_the_folder(path, h5, far, ds):
+    with h5py.File(path.with_name("near.h5"), "a") as f:
+        del f["p"]
+        f["p"] = h5py.ExternalLink(str(far), "/p")
+    with h5py.File(h5, "a") as f:
+        del f[ds]
+        f[ds] = h5py.ExternalLink("near.h5", "/p")
+    return f"dataset {ds!r} reaches {str(far)!r} through an HDF5 external link"
+
+
+def _a_virtual_dataset(path, h5, far, ds):
+    with h5py.File(h5, "a") as f:
+        n = f[ds].shape
+        del f[ds]
+        layout = h5py.VirtualLayout(shape=n, dtype="f8")
+        layout[:] = h5py.VirtualSource(str(far), "p", shape=n)
+        f.create_virtual_dataset(ds, layout)
+    return f"dataset {ds!r} reaches {str(far)!r} through a virtual dataset"
+
+
+def _external_raw_storage(path, h5, far, ds):
+    raw = far.with_suffix(".bin")
+    with h5py.File(far) as g:
+        g["p"][()].astype("<f8").tofile(raw)
+    with h5py.File(h5, "a") as f:
+        n = f[ds].shape
+        del f[ds]
+        f.create_dataset(ds, shape=n, dtype="<f8", external=[(str(raw), 0, 8 * n[0])])
+    return f"dataset {ds!r} reaches {str(raw)!r} through external raw storage (from the working directory)"
+
+
+def _a_link_to_a_file_not_in_the_folder(path, h5, far, ds):
+    """'far.h5' is not in the folder: HDF5 would go on to the working directory (the test's is
+    the folder above, where far.h5 is)."""
+    with h5py.File(h5, "a") as f:
+        del f[ds]
+        f[ds] = h5py.ExternalLink("far.h5", "/p")
+    return (
+        f"dataset {ds!r} reaches 'far.h5' through an HDF5 external link, which is not in the file's "
+        "folder (HDF5 would look for it in the working directory)"
+    )
+
+
+@pytest.mark.parametrize(
+    "damage",
+    [
+        _absolute_on_the_dataset,
+        _absolute_on_a_group,
+        _a_space_after_the_colon,
+        _a_relative_soft_link,
+        _a_link_off_the_named_paths,
+        _through_a_file_in_the_folder,
+        _a_virtual_dataset,
+        _external_raw_storage,
+        _a_link_to_a_file_not_in_the_folder,
+    ],
+)
+def test_heavy_data_reaching_a_file_outside_the_folder_is_refused(tmp_path, capsys, monkeypatch, damage):
+    """Every way an .h5 can make HDF5 open a file outside the XDMF file's folder (each of these
+    was read, or would be, to 3 × N with the file tripled outside): one line naming the link
+    or dataset and the file it names; exit 2 through the CLI."""
+    from fepost.cli import main
+    from fepost.errors import InputFileError
+
+    monkeypatch.chdir(tmp_path)  # where far.h5 is: HDF5's last resort for names it cannot find
+    path, h5, far, ds = _map_with_far(tmp_path)
+    what = damage(path, h5, far, ds)
+    with pytest.raises(InputFileError) as err:
+        read_contact(path)
+    assert str(err.value) == f"{path}: refused .xdmf file (heavy-data file 'map.h5': {what}" + (
+        ")" if "HDF5 would look" in what else ", which lies outside the file's folder)"
+    )
+    assert main(["coefficients", str(path), "--nr", "12", "--nphi", "24"]) == 2
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.strip()]
+    assert lines == [f"fepost: error: {err.value}"]
+
+
+def test_links_inside_the_folder_are_read_as_hdf5_reads_them(tmp_path, small_n_fe, monkeypatch):
+    """The same constructions pointing inside the folder are read, to the linked (tripled)
+    values: an external link on a group, a soft link and a virtual dataset; with
+    HDF5_EXT_PREFIX naming a folder whose near.h5 holds the pressure times 5 (HDF5 would
+    look there first), still the folder's near.h5."""
+    path, h5, far, ds = _map_with_far(tmp_path)
+    decoy = tmp_path / "decoy"
+    decoy.mkdir()
+    with h5py.File(far) as f, h5py.File(decoy / "near.h5", "w") as g:
+        g["p"] = f["p"][()] * 5 / 3
+    with h5py.File(h5, "a") as f:
+        n = f[ds].shape
+        f["g"] = h5py.ExternalLink("near.h5", "/")
+        f["h/d"] = h5py.SoftLink("/g/p")
+        layout = h5py.VirtualLayout(shape=n, dtype="f8")
+        layout[:] = h5py.VirtualSource("near.h5", "p", shape=n)
+        f.create_virtual_dataset("v", layout)
+    for new in ("/g/p", "/h/d", "/v"):
+        text = path.read_text()
+        path.write_text(text.replace(f"map.h5:{ds}<", f"map.h5:{new}<"))
+        assert _n_fe(path) == pytest.approx(3 * small_n_fe, rel=TOL), new
+        path.write_text(text)
+    monkeypatch.setenv("HDF5_EXT_PREFIX", str(decoy))
+    _rename(path, ds, "/g/p")
+    assert _n_fe(path) == pytest.approx(3 * small_n_fe, rel=TOL)
+
+
+def test_a_symbolic_link_to_an_xdmf_file_reads_the_heavy_data_beside_its_target(tmp_path, small_n_fe):
+    """meshio looks for the .h5 beside the XDMF file's real path, and so do the checks: a link
+    to the map from another folder, with no .h5 beside the link, is read to the map's N."""
+    path, h5, far, ds = _map_with_far(tmp_path)
+    other = tmp_path / "elsewhere"
+    other.mkdir()
+    (other / "map.xdmf").symlink_to(path)
+    assert _n_fe(other / "map.xdmf") == pytest.approx(small_n_fe, rel=TOL)

@@ -17,6 +17,9 @@ VTK's order).
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -132,8 +135,28 @@ def read_steps(path: Path) -> tuple[float, ...]:
     return _times(path, collections)
 
 
+#: Environment variables that make HDF5 look for linked, virtual-source and raw-storage files
+#: in other folders first (the checks follow HDF5's search without them): unset while reading.
+HDF5_PREFIXES = ("HDF5_EXT_PREFIX", "HDF5_VDS_PREFIX", "HDF5_EXTFILE_PREFIX")
+
+
+@contextmanager
+def _own_folder() -> Iterator[None]:
+    """HDF5 without the search prefixes of `HDF5_PREFIXES` (restored afterwards)."""
+    saved = {name: os.environ.pop(name) for name in HDF5_PREFIXES if name in os.environ}
+    try:
+        yield
+    finally:
+        os.environ.update(saved)
+
+
 def read_xdmf(path: Path, step: int | None) -> RawMesh:
     """Read an XDMF file into a `fepost.reader.raw.RawMesh` (``step``: of a time series)."""
+    with _own_folder():
+        return _read_xdmf(path, step)
+
+
+def _read_xdmf(path: Path, step: int | None) -> RawMesh:
     layout = check_xdmf(path)
     times: tuple[float, ...] = ()
     chosen = None
