@@ -142,6 +142,45 @@ def test_damaged_base64_is_refused_naming_the_array(grid, tmp_path, mode, comp, 
         assert "zero everywhere" not in message
 
 
+def _damaged_at(src: Path, out: Path, damage: bytes, where: str, position: int, name: str = "CPRESS") -> Path:
+    """``damage`` written at ``position`` (0-3) of a 4-character base64 group of the array's text:
+    its first group, the one in its middle, or its last (where the padding is)."""
+    data = src.read_bytes()
+    start, end = _text_of(data, name)
+    text = data[start:end]
+    chars = [i for i, c in enumerate(text) if c not in b" \t\r\n"]
+    groups = len(chars) // 4
+    group = {"first": 0, "middle": groups // 2, "last": groups - 1}[where]
+    at = start + chars[4 * group + position]
+    return out.write_bytes(data[:at] + damage + data[at + len(damage) :]) and out
+
+
+@pytest.mark.parametrize(("mode", "comp", "uint64"), [LAYOUTS[0], LAYOUTS[3], LAYOUTS[5]])
+@pytest.mark.parametrize("where", ["first", "middle", "last"])
+@pytest.mark.parametrize("damage", ["invalid", "padding"])
+def test_damage_at_every_position_of_a_group_is_refused(grid, tmp_path, mode, comp, uint64, where, damage):
+    """The damage of `test_damaged_base64_is_refused_naming_the_array` at each of the four
+    positions of a group, at the text's start, middle and end: "=" inside a group is never a
+    stream boundary that decodes to fewer bytes without a word."""
+    clean = xml_file(grid, tmp_path / "clean.vtu", mode, True, comp, uint64=uint64)
+    reference = contact.read_here(clean).values
+    for position in range(4):
+        path = _damaged_at(clean, tmp_path / f"map{position}.vtu", DAMAGE[damage], where, position)
+        if path.read_bytes() == clean.read_bytes():
+            continue  # the character was already there (padding over padding): nothing damaged
+        for way, got in zip(("direct", "VTK"), _both(path), strict=True):
+            if not isinstance(got, tuple):
+                # read without a word: only if the numbers are the clean ones
+                assert np.array_equal(got.values, reference), (way, where, position)
+                continue
+            kind, message = got
+            assert kind is InputFileError, (way, where, position, message)
+            assert message.startswith(f"{path}: ") and "\n" not in message
+            # "=" closing the first group early leaves a header of too few bytes: "truncated"
+            assert "array 'CPRESS'" in message, (way, where, position, message)
+            assert "base64" in message or "truncated" in message, (way, where, position, message)
+
+
 def _reencoded(src: Path, out: Path) -> Path:
     """``src`` (inline, uncompressed) with every array's length word encoded on its own, as some
     writers do: padding sits between two valid base64 streams."""
