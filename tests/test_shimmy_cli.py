@@ -97,14 +97,26 @@ def test_shimmy_end_to_end_writes_the_contract(tmp_path, capsys):
             "3",
             "--trails",
             "4",
+            "--branch-speeds",
+            "3",
         ]
     )
-    assert status == 0, capsys.readouterr().err
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    progress = captured.err.splitlines()
+    n = len(progress)
+    assert n > 5 and all(line.startswith(f"[{k + 1}/{n}] ") for k, line in enumerate(progress)), progress
+    assert "figures" in progress[-1] and "done in" in progress[-1]
     data = json.loads((out / "shimmy.json").read_text())
     assert {"gear", "model", "friction_models", "simulations", "anchor"} <= set(data)
     assert set(data["friction_models"]) == {"closed_forms", "generalised"}
     for name, fm in data["friction_models"].items():
         assert {"critical_speed", "critical_speed_ci95", "frequency_hz", "stability"} <= set(fm), name
+        assert {"boundaries", "unstable_ranges"} <= set(fm), name
+        onsets = [b["speed"] for b in fm["boundaries"] if b["direction"] == "onset"]
+        assert fm["critical_speed"] == onsets[0], "the critical speed is the first onset"
+        assert all(set(b) == {"speed", "direction", "frequency_hz"} for b in fm["boundaries"])
+        assert fm["unstable_ranges"][0][0] == onsets[0]
         assert len(fm["stability"]) == 60
         assert set(fm["stability"][0]) == {"speed", "growth_rate", "frequency_hz"}
         assert [r["trail"] for r in fm["trail_map"]] == pytest.approx([0.0, 0.1, 0.2, 0.3])
@@ -113,6 +125,10 @@ def test_shimmy_end_to_end_writes_the_contract(tmp_path, capsys):
         assert row["verdict"] in ("decays", "grows", "limit_cycle")
         assert (out / row["csv"]).is_file()
         assert row["agrees_with_linear"]
+    for name, fm in data["friction_models"].items():
+        branch = fm["limit_cycle_branch"]
+        assert len(branch) == 3 and branch[-1]["verdict"] in ("limit_cycle", "grows"), name
+        assert branch[0]["speed"] == pytest.approx(0.8 * fm["critical_speed"]), name
     assert set(data["anchor"]) == {"reference", "published", "computed"}
     assert data["gear"]["trail"] == {"value": 0.1, "unit": "m"}
     for fig in (
@@ -121,6 +137,10 @@ def test_shimmy_end_to_end_writes_the_contract(tmp_path, capsys):
         "time_histories.png",
         "limit_cycle_amplitude.png",
         "stability_plane.png",
+        "stability_damping.png",
+        "stability_stiffness.png",
+        "damping_frequency.png",
+        "mode_shapes.png",
     ):
         assert (out / fig).stat().st_size > 1000, fig
 
@@ -157,3 +177,21 @@ def test_speed_range_must_increase(tmp_path, capsys):
     assert err == "fepost: error: argument --speed-max: must be above --speed-min (50), got 20\n"
     assert main([*argv, "--speeds", "1"]) == 2
     assert "--speeds" in capsys.readouterr().err
+
+
+def test_steady_state_zero_to_round_off_is_a_steady_state(aircraft):
+    """The documented commands failed at their defaults: the trail sweep's long trails, on the
+    generalised and exact models of a nearly symmetric map, have a steady state of about 1e-18
+    that scipy's root finder reports as "not making good progress"; it is a steady state."""
+    import numpy as np
+
+    from fepost.shimmy.contact import model_contact
+    from fepost.shimmy.equations import equilibrium, rhs
+
+    contact = model_contact(aircraft.model_summary.static)
+    gear = load_gear(EXAMPLE)
+    for trail in (0.26, 0.28, 0.3):
+        g = gear.replace(trail=trail)
+        x0 = equilibrium(g, contact)
+        assert np.max(np.abs(x0)) < 1e-12, trail
+        assert np.max(np.abs(rhs(x0, 1.0, g, contact))) < 1e-9, trail

@@ -86,6 +86,14 @@ def add_parser(sub) -> None:
         metavar="N",
         help="boundary over speed x trail at N trails from 0 to 3 x the gear's (default 16; 0: none)",
     )
+    p.add_argument(
+        "--branch-speeds",
+        type=v.integer_in(0, 1000),
+        default=8,
+        metavar="N",
+        help="limit-cycle amplitude over speed: N simulations from 0.8 x the critical speed up "
+        "(default 8; 0: none)",
+    )
     p.add_argument("--no-simulation", action="store_true", help="linear stability only (no time histories)")
     p.add_argument("--no-intervals", action="store_true", help="skip the coefficients' intervals (Table 1)")
     p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
@@ -156,6 +164,7 @@ def run(args: argparse.Namespace) -> int:
         simulate_motion=not args.no_simulation,
         duration=args.duration,
         trails=args.trails,
+        branch_speeds=args.branch_speeds,
         progress=None if args.no_progress else progress.study,
     )
     write_shimmy(

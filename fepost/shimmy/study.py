@@ -93,6 +93,8 @@ def critical_interval(gear: Gear, contact: Contact, vc: float, speeds: np.ndarra
         window = np.linspace(0.5 * vc, 1.5 * vc, 41)
         for i in range(5):
             h = 0.05 * float(np.sqrt(cov[i, i]))
+            if h == 0.0:  # a coefficient the fit holds exactly adds nothing
+                continue
             ends = []
             for sign in (1.0, -1.0):
                 t = theta.copy()
@@ -159,7 +161,7 @@ def map_values(gear: Gear, n: int) -> dict[str, np.ndarray]:
     }
 
 
-def _simulations(gear, contact, lin, smap, name, duration, stages) -> tuple[list, tuple]:
+def _simulations(gear, contact, lin, smap, name, duration, stages, n_branch) -> tuple[list, tuple]:
     """The two time histories (`SIMULATION_FRACTIONS` of the critical speed, or the sweep's ends)
     and the limit-cycle sweep (`BRANCH_SPEEDS` from 0.8 V_c, or the lowest unstable speed, up)."""
     sim_contact = stages.run(
@@ -182,14 +184,16 @@ def _simulations(gear, contact, lin, smap, name, duration, stages) -> tuple[list
         sims.append(Simulation(h, f"time_{name}_{v:.2f}.csv", lin.growth(v)[0]))
     ranges = smap.unstable_ranges
     branch: tuple = ()
-    if ranges:
+    if n_branch and ranges:
         start = 0.8 * vc if vc is not None else float(ranges[0][0])
-        bspeeds = np.linspace(max(start, float(smap.speeds[0])), top, BRANCH_SPEEDS)
+        bspeeds = np.linspace(max(start, float(smap.speeds[0])), top, n_branch)
         branch = stages.run(
-            f"{name}: limit-cycle amplitude, {BRANCH_SPEEDS} runs",
+            f"{name}: limit-cycle amplitude, {n_branch} runs",
             f"{name}_limit_cycle_sweep",
             lambda: amplitude_sweep(gear, sim_contact, bspeeds, equilibrium=lin.state),
         )
+    elif n_branch:
+        stages.run(f"{name}: no unstable speed, no limit-cycle sweep", f"{name}_limit_cycle_sweep", tuple)
     return sims, branch
 
 
@@ -204,6 +208,7 @@ def shimmy_study(
     duration: float = DURATION,
     anchor: bool = True,
     trails: int = 16,
+    branch_speeds: int = BRANCH_SPEEDS,
     progress=None,
 ) -> ShimmyResult:
     """Stability of ``gear`` on the tire of ``analysis`` with each friction model (module docstring).
@@ -212,7 +217,8 @@ def shimmy_study(
     from 1 to 150 m/s). ``intervals``: carry Table 1's intervals to the critical
     speeds. ``simulate_motion``: time histories at 0.8 and 1.2 times each critical
     speed (at the sweep's ends when there is none), ``duration`` seconds each, and the
-    limit-cycle amplitude over speed (`amplitude_sweep`). ``trails``: the stability maps
+    limit-cycle amplitude over speed at ``branch_speeds`` speeds (`amplitude_sweep`; 0:
+    none). ``trails``: the stability maps
     over speed × trail, × torsional damping and × torsional stiffness at that many
     values each (`map_values`; 0: none). ``progress``: called as
     ``progress(k, n, step, seconds)`` after each of the n stages.
@@ -224,7 +230,9 @@ def shimmy_study(
     speeds = np.linspace(*DEFAULT_SPEEDS) if speeds is None else np.asarray(speeds, float)
     timings: dict[str, float] = {}
     n_models = len(models)
-    per_model = 1 + int(intervals) + int(bool(trails)) + (4 if simulate_motion else 0)
+    per_model = (
+        1 + int(intervals) + int(bool(trails)) + (3 + int(branch_speeds > 0) if simulate_motion else 0)
+    )
     stages = _Stages(1 + int(intervals) + n_models * per_model, progress, timings)
     found = stages.run("friction models", "contacts", lambda: contacts(analysis, models))
     t1 = None
@@ -268,7 +276,7 @@ def shimmy_study(
             )
         branch: tuple = ()
         if simulate_motion:
-            runs, branch = _simulations(gear, contact, lin, smap, name, duration, stages)
+            runs, branch = _simulations(gear, contact, lin, smap, name, duration, stages, branch_speeds)
             sims.extend(runs)
         stab = ModelStability(
             name, smap, ci, method, {"F0": contact.F0, "M0": contact.M0, **info}, maps.get("trail"),
