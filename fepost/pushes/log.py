@@ -144,7 +144,8 @@ def _unit_quaternion(lines: _Lines, q: list[float], what: str) -> list[float]:
     norm = math.sqrt(sum(c * c for c in q))
     if abs(norm - 1.0) > QUATERNION_TOLERANCE:
         raise DataError(
-            f"{lines.where()}: the {what} quaternion has norm {norm:.4g}, not 1 (an impossible rotation)"
+            f"{lines.where()}: the quaternion of the {what} has norm {norm:.4g}, "
+            "not 1 (an impossible rotation)"
         )
     return [c / norm for c in q]
 
@@ -165,7 +166,7 @@ def _samples(lines: _Lines, n: int, width: int, what: str, *, quaternion: bool) 
             raise DataError(f"{lines.where()}: time {row[0]!r} goes back (previous sample {previous!r})")
         previous = row[0]
         if quaternion:
-            row[4:] = _unit_quaternion(lines, row[4:], "finger's")
+            row[4:] = _unit_quaternion(lines, row[4:], "finger's pose")
         out[i] = row
     return sealed(out), first
 
