@@ -116,7 +116,8 @@ def _map_frame(body: Body, xy) -> np.ndarray:
     return np.asarray(xy, float) - np.asarray(body.reference_point, float)
 
 
-def _common_info(body: Body, contact: str) -> dict[str, Any]:
+def common_info(body: Body, contact: str) -> dict[str, Any]:
+    """What every map's sidecar says about the body, its frame and its reaction (statics)."""
     com = _map_frame(body, body.centre_of_mass)
     return {
         "kind": "body map",
@@ -176,7 +177,7 @@ def support_map(body: Body, *, profile: str = "hertz") -> BodyMap:
         rows.append({"centre": [float(centre[0]), float(centre[1])], "radius": a, "load": float(load)})
     xy, tri, p = np.vstack(pts), np.vstack(tris), np.concatenate(vals)
     load, first = linear_load(xy, tri, p)
-    info = _common_info(body, "point supports")
+    info = common_info(body, "point supports")
     info.update(supports=rows, profile=profile, separate_patches=len(rows))
     return BodyMap("supports", xy, tri, p, load, (float(first[0] / load), float(first[1] / load)), info)
 
@@ -203,7 +204,7 @@ def base_map(body: Body) -> BodyMap:
     p = np.full(len(xy), body.weight / unit)
     load = body.weight
     cop = (float(first[0] / unit), float(first[1] / unit))
-    info = _common_info(body, "flat base, uniform pressure")
+    info = common_info(body, "flat base, uniform pressure")
     info.update(pressure=body.weight / unit, area=unit)
     com = info["centre_of_mass"]
     off = float(np.hypot(cop[0] - com[0], cop[1] - com[1]))

@@ -89,6 +89,12 @@ def run(args: argparse.Namespace) -> int:
         f"polar grid: the default carries {grid['default_load_carried']:.2%} of the load; "
         f"--nr {grid['nr']} --nphi {grid['nphi']} carries {grid['load_carried']:.2%}"
     )
+    if "uniform_pressure" in bmap.info:
+        print(
+            f"board model: solver's reaction {bmap.info['reaction_z']:.6g} N, peak pressure "
+            f"{bmap.peak() / bmap.info['uniform_pressure']:.3g} x the uniform m g / area "
+            f"(CPRESS scaled by {bmap.info['cpress_scale']:.5f} to carry the reaction)"
+        )
     for note in bmap.info.get("notes", []):
         print(f"note: {note}")
     return 0
