@@ -1,6 +1,6 @@
 """A rigid body on its supports: the body JSON contract and the supports' statics loads.
 
-`load_body` reads and validates a body file (INTERFACE.md, "body JSON"): the mass
+`load_body` reads and validates a body file (the "body JSON" of the command-line contract): the mass
 (kg), gravity (m/s²), the centre of mass and the reference point ([x, y], m, body
 frame), and either three point supports (``supports``, each a disc of radius
 ``support_radius``) or a flat base (``base``, a simple polygon). The optional

@@ -18,7 +18,7 @@
 * **the physics' signs**: the friction force against the sliding direction (the cosine
   of the angle between F and −(dx, dy)) and the torque against the spin;
 * the friction level |F|/N and the spin ratio u = |dθ| R / |(dx, dy)|, R the patch
-  radius about the reference point (THEORY.md section 1).
+  radius about the reference point (the smallest circle about it that holds the support).
 """
 
 from __future__ import annotations
@@ -80,25 +80,25 @@ class LogChecks:
         when, frac, peak = self.impact_time, self.impact_fraction, self.impact_peak
         late = f"{len(self.late_impacts)} after {100 * FIXED_CUT:.0f} %{_named(self.late_impacts)}"
         cos = self.cos_force_sliding
+        nd, un, far = self.not_dissipating, self.unsteady, self.far_level
         out += [
-            f"  zero: first push ({zf[0]:+.3f}, {zf[1]:+.3f}) N, last ({zl[0]:+.3f}, {zl[1]:+.3f}) N: "
-            f"drift {drift:.3f} N ({share:.1f} % of the median force {self.median_force:.2f} N); "
-            f"range over the log {zr[0]:.3f}, {zr[1]:.3f} N (fx, fy); "
-            f"the first sample alone is off by up to {self.zero_vs_first_sample:.3f} N; "
-            f"loaded at the start, given the log's median zero: {len(self.zero_replaced)}"
-            f"{_named(self.zero_replaced)}",
-            f"  impact: {when[0]:.2f}-{when[1]:.2f} s into the push "
-            f"({100 * frac[0]:.0f}-{100 * frac[1]:.0f} % of its samples; {late}); "
-            f"spike (peak of the settling window / plateau) median {peak[0]:.2f}, "
-            f"max {peak[1]:.2f}; samples kept per push {self.samples_kept[0]}-{self.samples_kept[1]}",
-            f"  outliers (kept): not dissipating {len(self.not_dissipating)}{_named(self.not_dissipating)}; "
-            f"unsteady force (scatter > {100 * UNSTEADY:.0f} %) {len(self.unsteady)}{_named(self.unsteady)}; "
-            f"|F|/N beyond {OUTLIER_Z:g} robust sd {len(self.far_level)}{_named(self.far_level)}",
+            f"  zero: ({zf[0]:+.3f}, {zf[1]:+.3f}) N at the first push, "
+            f"({zl[0]:+.3f}, {zl[1]:+.3f}) N at the last: drift {drift:.3f} N",
+            f"        ({share:.1f} % of the median force {self.median_force:.2f} N); "
+            f"range {zr[0]:.3f}, {zr[1]:.3f} N (fx, fy)",
+            f"        the first sample alone is off by up to {self.zero_vs_first_sample:.3f} N; "
+            f"started loaded: {len(self.zero_replaced)}{_named(self.zero_replaced)}",
+            f"  impact: {when[0]:.2f}-{when[1]:.2f} s into the push, "
+            f"{100 * frac[0]:.0f}-{100 * frac[1]:.0f} % of its samples; {late}",
+            f"          spike (peak while settling / plateau) median {peak[0]:.2f}, max {peak[1]:.2f}; "
+            f"samples kept {self.samples_kept[0]}-{self.samples_kept[1]}",
+            f"  outliers (kept): not dissipating {len(nd)}{_named(nd)}; "
+            f"unsteady (scatter > {100 * UNSTEADY:.0f} %) {len(un)}{_named(un)}",
+            f"                   |F|/N beyond {OUTLIER_Z:g} robust sd {len(far)}{_named(far)}",
             f"  signs: cos(F, -v) median {cos[0]:.3f}, min {cos[1]:.3f}; torque against the spin in "
-            f"{self.torque_against_spin} of {self.kept}; block tilt up to {math.degrees(self.tilt):.1f} deg",
+            f"{self.torque_against_spin} of {self.kept}; tilt up to {math.degrees(self.tilt):.1f} deg",
             f"  |F|/N mean {self.level[0]:.3f} ({self.level[1]:.3f}-{self.level[2]:.3f}); u = |w| R/|v| "
-            f"{self.u[0]:.2f}-{self.u[1]:.2f} (R = {1e3 * self.radius:.1f} mm, the patch radius about the "
-            "reference point)",
+            f"{self.u[0]:.2f}-{self.u[1]:.2f} (R = {1e3 * self.radius:.1f} mm about the reference point)",
         ]
         return out
 

@@ -1,6 +1,6 @@
 """The planar-push log, read as the logger wrote it: one push at a time, every line numbered.
 
-The format (``../shared/real/planar-sliding/README.md``) is whitespace-separated text::
+The format (the rig's README, beside the logs) is whitespace-separated text::
 
     n_pushes
     then, for each push:

@@ -1,4 +1,4 @@
-"""The pushes of one or more logs as the measured-data CSV (INTERFACE.md, "pushes CSV").
+"""The pushes of one or more logs as the measured-data CSV (the contract's "pushes CSV").
 
 One row per push that gives a wrench: ``vx, vy, wz`` the block's displacement over the
 push in its frame at the start of the push (m, m, rad: a direction of the twist, the

@@ -19,8 +19,9 @@ minus the finger's wrench on it. `form_push` forms one push's wrench and twist s
    sensor's (fx, fy) to the robot tool's axes, and the tool's yaw ψ (from the finger's
    logged quaternion, interpolated to each force sample) turns those into the world:
    R(ψ) S f. Without R(ψ) the measured force lies about 90° off the push direction at
-   random; with it, it lies within 31-38° of the inward normal of the block's edge the
-   finger touches (the finger's own friction cone), on all five hardboard logs. The
+   random; with it, it lies 22-25° (median; at most 32-38°) from the inward normal of the
+   block's edge the finger touches, on all five hardboard logs: the finger's own friction
+   cone, the finger sliding along the edge. The
    force of the finger on the block is minus that (the sensor reads the block's
    reaction on the finger).
 3. **The finger's impact.** The force rises from noise to its sliding level within a
@@ -38,9 +39,9 @@ minus the finger's wrench on it. `form_push` forms one push's wrench and twist s
    logged pose is that of the motion-capture frame; the body frame's origin is at
    ``body_origin_in_mocap`` (log units) in it, axes parallel: a body point b (m) is the
    mocap point ``body_origin_in_mocap + b / length_unit``. On the hardboard logs the
-   mocap frame's origin is the block's right-angle corner, as the body files' frame:
-   at the end of every push the finger's centre lies within about 1 mm (its tip's
-   radius) of the edge x = 0, y = 0 or x + y = 150 mm of the mocap frame.
+   mocap frame's origin is the block's right-angle corner, as the body files' frame: the
+   finger's mean contact point of every push lies within 2 mm (median 0.5-0.7 mm, about
+   its tip's radius) of the edge x = 0, y = 0 or x + y = 150 mm.
 6. **The wrench of a sample.** The finger's contact point is its tip's centre, from its
    logged (x, y) interpolated to the sample's time. Its torque about the reference point
    is r × F with r from the interpolated reference point. (The contact lies 1 mm, the
@@ -220,7 +221,7 @@ def block_pose(body: Body, pose) -> tuple[np.ndarray, float, float]:
 
 
 def patch_radius(body: Body) -> float:
-    """R (m): the smallest circle about the reference point that holds the support (THEORY.md section 1)."""
+    """R (m): the radius of the smallest circle about the reference point that holds the support."""
     ref = np.asarray(body.reference_point)
     if body.supports is not None:
         d = np.hypot(*(np.asarray(body.supports) - ref).T)
