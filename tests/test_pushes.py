@@ -171,6 +171,21 @@ def test_a_push_that_hardly_moved_is_left_out(tmp_path, synthetic):
     assert "left out: push 2: hardly moved" in "\n".join(table.lines())
 
 
+def test_pushes_without_a_wrench_are_left_out_and_counted(tmp_path, synthetic):
+    _, body, _ = synthetic
+    short = SyntheticPush(**PUSHES[0], n=10, impact=3)
+    idle = SyntheticPush(**dict(PUSHES[1], force=[0.0, 0.0]))
+    log = write_log(tmp_path / "idle.txt", [short, SyntheticPush(**PUSHES[0]), idle])
+    table = read_pushes([log], body)
+    assert [p.index for p in table.pushes] == [2]
+    assert [(o.index, o.reason) for o in table.left_out] == [
+        (1, "10 force samples (fewer than 20)"),
+        (3, "no contact force (plateau 0 N, under 0.1 N)"),
+    ]
+    assert table.lines()[0] == f"{log}: 3 pushes, 1 kept, 2 left out"
+    assert table.to_csv().count("\n") == 2  # the header and push 2
+
+
 def test_reader_streams_one_push_at_a_time(synthetic):
     log, _, _ = synthetic
     it = read_log(log)
