@@ -87,7 +87,8 @@ def run(args: argparse.Namespace) -> int:
     )
     print(
         f"polar grid: the default carries {grid['default_load_carried']:.2%} of the load; "
-        f"--nr {grid['nr']} --nphi {grid['nphi']} carries {grid['load_carried']:.2%}"
+        f"--nr {grid['nr']} --nphi {grid['nphi']} carries {grid['load_carried']:.2%} (pure-spin moment "
+        f"{grid['moment_carried']:.2%})"
     )
     if "uniform_pressure" in bmap.info:
         print(
