@@ -1,16 +1,27 @@
 # fepost: `make demo` runs the main job on the sample meshes, `make test` runs the tests.
 # Both create their own virtual environment (.venv) and install what they need, saying
-# what they do: the demo only the package and the GL libraries VTK renders with; the
-# tests also the test, model and docs extras, CalculiX and Chromium. Missing Debian
-# packages are listed first with every package apt will install or upgrade for them
-# (a simulated `apt-get -s install`), and Chromium's side effect is said before it
-# happens: it registers itself as the system's default web browser.
+# what they do: fepost from this clone and its Python dependencies from PyPI; the demo
+# needs the Debian packages in GL_PACKAGES (the GL libraries VTK renders with), the tests
+# also CalculiX and Chromium (TEST_PACKAGES).
+#
+# System packages (Debian names; `make system-packages` lists them):
+#   APT=yes (default)  install the missing ones with apt, listing first every package apt
+#                      would install (a simulated `apt-get -s install`); apt never upgrades an
+#                      installed package here: when it would (Mesa libraries, say), make stops,
+#                      names them and leaves the choice to you (APT=upgrade lets apt do it);
+#   APT=no             install nothing: install them yourself (or not) and run the rest; a
+#                      missing one is named, and what needs it fails or skips with a reason.
+#   CHROMIUM=no        the tests without Chromium (the report screenshot test then skips).
+#                      With Chromium, the web-browser choice it takes over on installing
+#                      (x-www-browser, gnome-www-browser) is given back as it was.
 
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 PIP    := $(PY) -m pip --disable-pip-version-check
 OUT    ?= report
+APT      ?= yes
+CHROMIUM ?= yes
 # One stamp per set of extras: `make demo` then `make test` in one clone installs the
 # extras the tests need on top of the demo's install.
 DEMO_STAMP := $(VENV)/.installed-demo
@@ -18,9 +29,9 @@ TEST_STAMP := $(VENV)/.installed-test
 # Debian packages. GL: the libraries VTK's off-screen rendering loads (Figures 1-2).
 GL_PACKAGES   := libgl1 libegl1 libosmesa6 libxrender1
 # Tests only: CalculiX (the sample model's end-to-end test), Chromium (report screenshot).
-TEST_PACKAGES := calculix-ccx chromium $(GL_PACKAGES)
+TEST_PACKAGES := calculix-ccx $(if $(filter no,$(CHROMIUM)),,chromium) $(GL_PACKAGES)
 
-.PHONY: demo test docs venv system-deps-demo system-deps-test lint bench clean
+.PHONY: demo test docs venv system-deps-demo system-deps-test system-packages lint bench clean
 
 $(PY):
 	@echo "== creating the virtual environment $(VENV) with $(PYTHON)"
@@ -28,40 +39,67 @@ $(PY):
 	$(PIP) install --upgrade pip
 
 $(DEMO_STAMP): pyproject.toml | $(PY)
-	@echo "== installing fepost and its run-time dependencies from PyPI (a few minutes the first time)"
+	@echo "== installing fepost from this clone (editable) and its run-time dependencies from PyPI (a few minutes the first time)"
 	$(PIP) install --progress-bar on -e .
 	@touch $@
 
 $(TEST_STAMP): pyproject.toml | $(PY)
-	@echo "== installing fepost with the test, model and docs extras from PyPI"
+	@echo "== installing fepost from this clone with the test, model and docs extras (dependencies from PyPI)"
 	$(PIP) install --progress-bar on -e '.[test,model,docs]'
 	@touch $@
 
 venv: $(TEST_STAMP)
 
-# Installs the Debian packages of $(1) that are missing (as root, or through sudo).
+# Installs the Debian packages of $(1) that are missing (as root, or through sudo); see APT
+# and CHROMIUM above. Never upgrades an installed package unless APT=upgrade.
 define apt_install
-	@if ! command -v dpkg >/dev/null 2>&1; then \
+	@echo "== system packages needed ($(2)): $(1)"; \
+	if ! command -v dpkg >/dev/null 2>&1; then \
 	  echo "== not a Debian system: install $(1) (or your system's equivalents) yourself"; exit 0; \
 	fi; \
 	missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
-	if [ -z "$$missing" ]; then echo "== system packages present: $(1)"; exit 0; fi; \
+	if [ -z "$$missing" ]; then echo "== all present"; exit 0; fi; \
+	if [ "$(APT)" = no ]; then \
+	  echo "== APT=no: not installing the missing$$missing; install them yourself (what needs them fails or skips, naming them)"; exit 0; \
+	fi; \
 	if [ "$$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi; \
 	$$SUDO apt-get update -q || exit 1; \
-	echo "== missing system packages:$$missing; apt will install or upgrade (a simulated run, apt-get -s):"; \
-	apt-get -s install --no-install-recommends $$missing | sed -n \
-	  -e 's/^Inst \([^ ]*\) \[\([^]]*\)\] (\([^ ]*\).*/     \1 \2 -> \3 (upgrade)/p' \
+	sim=$$(apt-get -s install --no-install-recommends $$missing) || { echo "$$sim" | tail -5; exit 1; }; \
+	echo "== missing system packages:$$missing; apt would install (a simulated run, apt-get -s):"; \
+	echo "$$sim" | sed -n \
+	  -e 's/^Inst \([^ ]*\) \[\([^]]*\)\] (\([^ ]*\).*/     \1 \2 -> \3 (UPGRADE of an installed package)/p' \
 	  -e 's/^Inst \([^ ]*\) (\([^ ]*\).*/     \1 \2 (new)/p'; \
-	case " $$missing " in *" chromium "*) echo "== note: the chromium package registers itself as the system's default web browser (x-www-browser, gnome-www-browser; undo with update-alternatives --config x-www-browser)";; esac; \
+	if echo "$$sim" | grep -q '^Inst [^ ]* \['; then \
+	  if [ "$(APT)" != upgrade ]; then \
+	    echo "== stopped: that would upgrade installed packages (marked UPGRADE). Install$$missing yourself,"; \
+	    echo "   or let apt upgrade them: make $@ APT=upgrade; or go on without them: make $@ APT=no"; \
+	    exit 1; \
+	  fi; \
+	  echo "== APT=upgrade: apt upgrades the packages marked UPGRADE"; \
+	fi; \
+	before_x=$$(update-alternatives --query x-www-browser 2>/dev/null | sed -n 's/^Value: //p'); \
+	before_g=$$(update-alternatives --query gnome-www-browser 2>/dev/null | sed -n 's/^Value: //p'); \
 	echo "== installing them"; \
-	DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -q --no-install-recommends $$missing
+	DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -q --no-install-recommends --no-upgrade $$missing || exit 1; \
+	for pair in "x-www-browser:$$before_x" "gnome-www-browser:$$before_g"; do \
+	  name=$${pair%%:*}; before=$${pair#*:}; \
+	  now=$$(update-alternatives --query $$name 2>/dev/null | sed -n 's/^Value: //p'); \
+	  if [ "$$now" = "$$before" ] || [ -z "$$now" ]; then continue; fi; \
+	  if [ -n "$$before" ]; then $$SUDO update-alternatives --set $$name "$$before" >/dev/null; \
+	  else $$SUDO update-alternatives --remove $$name "$$now" >/dev/null; fi; \
+	  echo "== $$name given back as it was ($${before:-none}; the installed package had made it $$now)"; \
+	done
 endef
 
+system-packages:
+	@echo "demo: $(GL_PACKAGES)"
+	@echo "test: $(TEST_PACKAGES)"
+
 system-deps-demo:
-	$(call apt_install,$(GL_PACKAGES))
+	$(call apt_install,$(GL_PACKAGES),make demo)
 
 system-deps-test:
-	$(call apt_install,$(TEST_PACKAGES))
+	$(call apt_install,$(TEST_PACKAGES),make test)
 
 demo: $(DEMO_STAMP) system-deps-demo
 	@echo "== fepost report on the sample aircraft tire at its rated load (meshes/aircraft/static_100, rolled map meshes/rig-aircraft/roll_free) -> $(OUT)/"

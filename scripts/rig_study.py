@@ -1,7 +1,13 @@
 """The friction model against the FE with friction: misfit of four predictions over the rig runs.
 
-    python scripts/rig_study.py [--rig meshes/rig] [--out docs/rig]
-    python scripts/rig_study.py --rig meshes/rig-aircraft --out docs/rig/aircraft
+    python scripts/rig_study.py [--rig meshes/rig] [--out out/rig]
+    python scripts/rig_study.py --rig meshes/rig-aircraft          # -> out/rig-aircraft
+    python scripts/rig_study.py --rig meshes/rig-aircraft --update # -> docs/rig/aircraft (tracked)
+
+Writes into ``out/<rig folder name>`` (or ``--out``); only ``--update`` rewrites the
+tracked copies the documentation shows (``docs/rig/`` for ``meshes/rig``,
+``docs/rig/aircraft/`` for ``meshes/rig-aircraft``). Each step prints a progress line
+on stderr with its time.
 
 Reads the slide/spin runs of ``meshes/rig/`` (``fepost.rig``: forces of the road
 on the tire from CalculiX's reactions) and compares them with
@@ -499,27 +505,80 @@ def heights(table, static, preds, shifts, shift_law, friction: float, diagnosis:
     ]
 
 
+#: The tracked folder each rig folder's study is kept in (rewritten only with --update).
+TRACKED = {"rig": REPO / "docs" / "rig", "rig-aircraft": REPO / "docs" / "rig" / "aircraft"}
+
+
+class _Progress:
+    """``rig_study: [k/n] step ... done in t s`` lines on stderr, one per step."""
+
+    def __init__(self, total: int) -> None:
+        self.total, self.k = total, 0
+
+    def __call__(self, name: str, func, *args):
+        import time
+
+        self.k += 1
+        print(f"rig_study: [{self.k}/{self.total}] {name} ...", end="", file=sys.stderr, flush=True)
+        t0 = time.perf_counter()
+        value = func(*args)
+        print(f" done in {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
+        return value
+
+
+def output_folder(rig: Path, out: Path | None, update: bool) -> Path:
+    """Where the study writes: ``--out``, the tracked folder with ``--update``, else
+    ``out/<rig folder name>`` in the working folder."""
+    if update:
+        if out is not None:
+            raise SystemExit("rig_study: --update writes the tracked folder; give either --out or --update")
+        tracked = TRACKED.get(rig.resolve().name)
+        if tracked is None or rig.resolve() != (REPO / "meshes" / rig.resolve().name).resolve():
+            raise SystemExit(
+                f"rig_study: --update: {rig} has no tracked study (only meshes/rig, meshes/rig-aircraft)"
+            )
+        return tracked
+    return out if out is not None else Path("out") / rig.resolve().name
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rig", type=Path, default=REPO / "meshes" / "rig")
-    ap.add_argument("--out", type=Path, default=REPO / "docs" / "rig")
+    ap.add_argument("--out", type=Path, default=None, help="output folder (default out/<rig folder name>)")
+    ap.add_argument(
+        "--update",
+        action="store_true",
+        help="rewrite the tracked copy the documentation shows (docs/rig/...)",
+    )
     ap.add_argument("--friction", type=float, default=0.3)
     ap.add_argument(
         "--diagnosis", type=Path, default=None, help="a `fepost diagnose` diagnosis.json to compare h with"
     )
     args = ap.parse_args(argv)
+    out = output_folder(args.rig, args.out, args.update)
     runs = _runs(args.rig)
     if not runs:
         print(f"rig_study: no rig runs in {args.rig}", file=sys.stderr)
         return 2
-    table, static, preds, shifts = predictions(args.rig, runs, args.friction)
-    ext, shift_law = extension(table, static, shifts, args.friction)
+    step = _Progress(8)
+    table, static, preds, shifts = step(
+        f"predictions (a)-(d) over {len(runs)} runs", predictions, args.rig, runs, args.friction
+    )
+    ext, shift_law = step(
+        "load-transfer extension (e), held out by direction", extension, table, static, shifts, args.friction
+    )
     preds.update(ext)
     rows, summary = misfit_table(table, static, preds, args.friction)
-    write_outputs(args.out, rows, summary, static, len(runs))
-    with open(args.out / "table.txt", "a") as fh:
+    write_outputs(out, rows, summary, static, len(runs))
+    with open(out / "table.txt", "a") as fh:
         fh.write("\n".join(law_lines(shift_law)) + "\n")
-    conv = convergence(args.rig, static, args.friction)
+    conv = step(
+        "convergence (finer mesh, smaller increments, longer slides)",
+        convergence,
+        args.rig,
+        static,
+        args.friction,
+    )
     if conv:
         head = [
             "",
@@ -528,16 +587,29 @@ def main(argv=None) -> int:
             "| run | repeated with | programme | repeat | \\|dF\\| / fN | \\|dMz\\| / fNR | N change |",
             "|---|---|---|---|---|---|---|",
         ]
-        with open(args.out / "table.txt", "a") as fh:
+        with open(out / "table.txt", "a") as fh:
             fh.write("\n".join(head + conv) + "\n")
-    with open(args.out / "table.txt", "a") as fh:
-        fh.write("\n".join(steady_lines(steady_state(runs, args.friction))) + "\n")
-        fh.write("\n".join(heights(table, static, preds, shifts, shift_law, args.friction, args.diagnosis)))
+    steady = step("steady state over the last 20 % of each path", steady_state, runs, args.friction)
+    found = step(
+        "load-transfer heights, four ways",
+        heights,
+        table,
+        static,
+        preds,
+        shifts,
+        shift_law,
+        args.friction,
+        args.diagnosis,
+    )
+    with open(out / "table.txt", "a") as fh:
+        fh.write("\n".join(steady_lines(steady)) + "\n")
+        fh.write("\n".join(found))
         fh.write("\n")
-    figures(args.out, rows)
-    shift_figure(args.out, table, shifts, shift_law)
-    history_figure(args.rig, args.out, runs, args.friction)
-    print((args.out / "table.txt").read_text())
+    step("figures per sliding direction", figures, out, rows)
+    step("figure of the shifts", shift_figure, out, table, shifts, shift_law)
+    step("figure of the histories", history_figure, args.rig, out, runs, args.friction)
+    print((out / "table.txt").read_text())
+    print(f"rig_study: wrote {out}", file=sys.stderr)
     return 0
 
 

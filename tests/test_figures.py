@@ -277,13 +277,13 @@ def test_figure1_texts_legend_and_colour_bar_are_legible(case, request):
         ren = pl.renderer
         lay = layout(pl)
         texts = {f"{t.GetInput()}#{i}": text_box(t, ren) for i, t in enumerate(lay.texts)}
-        assert {"x (m)", "y (m)", "p/P*"} <= {k.split("#")[0] for k in texts}
+        assert {"x (m)", "y (m)", "σ/P*"} <= {k.split("#")[0] for k in texts}
         assert min(t.GetTextProperty().GetFontSize() for t in lay.texts) >= TICK_FONT >= 18
         names = list(texts)
         for i, p in enumerate(names):
             for q in names[i + 1 :]:
                 assert not boxes_overlap(texts[p], texts[q]), (p, q)
-        # the axes carry at least three labels each way (x, y in m; height in p/P*)
+        # the axes carry at least three labels each way (x, y in m; height in σ/P*)
         assert (
             sum(k.split("#")[0].replace("−", "-").replace(".", "").lstrip("-").isdigit() for k in names) >= 8
         )

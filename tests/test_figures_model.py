@@ -73,8 +73,24 @@ def test_labels_render_subscripts_not_underscores():
     assert "_" not in [g[0] for g in glyphs]
     (m, m_size, m_y), (c, c_size, c_y) = glyphs
     assert (m, c) == ("M", "C") and c_size < m_size and c_y != m_y  # C is a subscript
-    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "generalised model (FE map)" in legend
+
+
+def test_curve_legend_lies_outside_the_axes():
+    """Figures 4-6: the legend sits below the axes, so it covers no test point and no band,
+    and every entry is inside the figure (none cut at the edge)."""
+    fig = plot_curve(_curve())
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    assert ax.get_legend() is None and len(fig.legends) == 1
+    legend = fig.legends[0].get_window_extent()
+    assert not legend.overlaps(ax.get_window_extent())
+    assert legend.y1 < ax.get_window_extent().y0
+    width = fig.get_window_extent().width
+    for t in fig.legends[0].get_texts():
+        box = t.get_window_extent()
+        assert 0 <= box.x0 and box.x1 <= width, t.get_text()
 
 
 def test_generalised_curve_is_plotted_and_tabulated():

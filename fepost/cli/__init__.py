@@ -274,9 +274,50 @@ def _suggest(word: str, choices: Sequence[str]) -> str:
     return f" (did you mean {close[0]}?)" if close else ""
 
 
+def _options_of(parser: argparse.ArgumentParser | None) -> list[str]:
+    return [] if parser is None else [o for a in parser._actions for o in a.option_strings]
+
+
+def _known(name: str, options: Sequence[str]) -> bool:
+    """``name`` is one of ``options`` or an abbreviation of exactly one (argparse's rule)."""
+    return name in options or len([o for o in options if o.startswith(name)]) == 1
+
+
+def _check_long_options(parser: argparse.ArgumentParser, argv: list[str]) -> None:
+    """Refuse an unknown ``--option`` before argparse looks at the rest, naming the nearest
+    known one; an option of ``fepost`` itself after the command (``--debug``, ``--version``)
+    or a subcommand's option before it is told where it belongs."""
+    at = next((i for i, a in enumerate(argv) if a in COMMANDS), None)
+    top = _options_of(parser)
+    cmd = None if at is None else argv[at]
+    sub = _options_of(_subparser(parser, cmd)) if cmd else []
+    for i, arg in enumerate(argv):
+        if arg == "--":
+            return
+        if not arg.startswith("--"):
+            continue
+        name = arg.split("=", 1)[0]
+        before = at is None or i < at
+        if _known(name, top if before else sub):
+            continue
+        if not before and name in top:
+            raise UsageError(
+                f"{name} is an option of fepost itself, not of '{cmd}': put it before the command "
+                f"('fepost {name} {cmd} ...')"
+            )
+        if before and cmd and name in sub:
+            raise UsageError(
+                f"{name} is an option of '{cmd}': put it after the command ('fepost {cmd} {name} ...')"
+            )
+        where = f"fepost {cmd}" if cmd and not before else "fepost"
+        options = top if before else [*sub, *top]
+        raise UsageError(f"unrecognized argument {arg!r}{_suggest(name, options)} (see '{where} --help')")
+
+
 def _parse(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Namespace:
     """Parse ``argv``; an unknown option or command is a `UsageError` naming the nearest
     known one and the subcommand's help."""
+    _check_long_options(parser, argv)
     command = next((a for a in argv if not a.startswith("-")), None)
     if command is not None and command not in COMMANDS:
         raise UsageError(f"unknown command {command!r}{_suggest(command, COMMANDS)} (see 'fepost --help')")

@@ -79,7 +79,11 @@ def format_analysis(a: Analysis) -> str:
         ("r_equiv", f"{p.r_equiv:.6g} m"),
         ("ellipse semi-axes", f"{p.ellipse_axes[0]:.5g} x {p.ellipse_axes[1]:.5g} m, aspect {p.aspect:.4f}"),
         ("load outside r_equiv", f"{p.load_outside:.2%}"),
-        ("circular", f"{'yes' if p.circular else 'NO'}  ({p.to_dict()['circular_rule']})"),
+        (
+            "circular",
+            f"{'yes' if p.circular else 'NO'}  (aspect {p.aspect:.3f}, r_max/r_equiv "
+            f"{p.r_max / p.r_equiv:.3f}; circular needs {p.to_dict()['circular_rule']})",
+        ),
         ("A0..A3", ", ".join(f"{v:.6g}" for v in c.A) + " Pa"),
         ("f", f"{c.f:g}"),
         ("F0", f"{c.F0:.6g} N"),

@@ -153,7 +153,7 @@ def plot_curve(data: CurveData, ax=None):
     lab = {k: mathtext(v) for k, v in lab.items()}
     with theme.mpl_style():
         if ax is None:
-            fig, ax = plt.subplots(layout="constrained")
+            fig, ax = plt.subplots(figsize=(6.4, 6.2), layout="constrained")
         else:
             fig = ax.figure
         if data.band_lo is not None:
@@ -228,7 +228,9 @@ def plot_curve(data: CurveData, ax=None):
         ax.set_title(mathtext(data.title), fontsize=10)
         ax.set_xlim(float(data.x[0]), float(data.x[-1]))
         ax.axhline(0.0, color="black", lw=0.6)
-        ax.legend(loc="best")
+        # below the axes, outside them: a legend inside would cover test points or the band
+        handles, labels = ax.get_legend_handles_labels()
+        fig.legend(handles, labels, loc="outside lower center", ncol=1, fontsize=8.5)
     return fig
 
 

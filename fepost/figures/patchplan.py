@@ -9,6 +9,14 @@ from ..patch import Patch
 from . import theme
 from .outline import circle_points, ellipse_points
 from .render import EDGE_FRACTION, contact_edge
+from .scene import nice_top
+
+
+def pressure_colour_range(*patches: Patch) -> tuple[float, float]:
+    """(0, top) in kPa: the colour range of the pressure in Figures 1, 2 and the patch plan,
+    the peak of ``patches`` rounded up to the colour bar's round top (`nice_top`)."""
+    peak = max(float(np.max(p.values)) for p in patches) / 1e3
+    return 0.0, nice_top(peak, 7)[0]
 
 
 def circularity_verdict(patch: Patch) -> str:
@@ -26,8 +34,12 @@ def verdict_title(patch: Patch) -> str:
     )
 
 
-def plot_patch_plan(patch: Patch, ax=None):
+def plot_patch_plan(patch: Patch, ax=None, *, clim: tuple[float, float] | None = None, symbol: str = "σ₀"):
     """Plot the loaded region in plan (m, pressure in kPa); return the figure.
+
+    ``clim``: the colour range in kPa (default 0 … the round top of the colour bar of
+    Figure 1, `pressure_colour_range`), so the same pressure has the same colour in both;
+    ``symbol``: the pressure's symbol in the colour bar and legend.
 
     Draws the FE triangles coloured by the FE pressure (Gouraud for nodal data,
     flat for face data), the contact edge (the contour where the pressure is
@@ -58,15 +70,17 @@ def plot_patch_plan(patch: Patch, ax=None):
             cmap=theme.CMAP,
             gid="pressure",
             rasterized=True,
+            vmin=(clim or pressure_colour_range(patch))[0],
+            vmax=(clim or pressure_colour_range(patch))[1],
         )
-        fig.colorbar(tpc, ax=ax, label="contact pressure (kPa)", shrink=0.8)
+        fig.colorbar(tpc, ax=ax, label=f"contact pressure {symbol} (kPa)", shrink=0.8)
         edge = contact_edge(patch)
         ax.add_collection(
             LineCollection(
                 list(edge),
                 colors=theme.EDGE_COLOUR,
                 linewidths=1.2,
-                label=f"contact edge (p = {EDGE_FRACTION:.0%} of peak)",
+                label=f"contact edge ({symbol} = {EDGE_FRACTION:.0%} of peak)",
                 gid="edge",
             )
         )

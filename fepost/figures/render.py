@@ -30,7 +30,7 @@ from ..errors import ArgumentError
 from ..patch import Patch
 from . import theme
 from .outline import circle_points, ellipse_points, level_segments
-from .scene import add_text, draw_axis, nice_ceil, nice_ticks, nice_top, thin_axis, tick_labels
+from .scene import add_text, draw_axis, nice_ceil, nice_ticks, nice_top, rgb, thin_axis, tick_labels, use_font
 from .scene import boxes_overlap as boxes_overlap  # re-exported: the figure tests check overlaps
 from .scene import text_box as text_box
 from .scene import viewport_box as viewport_box
@@ -52,9 +52,13 @@ TICK_FONT = 20
 AXIS_TITLE_FONT = 22
 TITLE_FONT = 24
 #: Legend box (lower-left corner, size) in window fractions: top right, under the heading,
-#: above the colour bar, where the camera leaves no data.
+#: above the colour bar, where the camera leaves no data. Each entry is a line sample of
+#: `LEGEND_SAMPLE` (window fraction) in the outline's colour and width, then its text.
 LEGEND_ORIGIN = (0.62, 0.76)
 LEGEND_SIZE = (0.36, 0.13)
+LEGEND_SAMPLE = 0.05
+#: The contact edge's line width (px); the circle's and the ellipse's.
+EDGE_WIDTH, RMAX_WIDTH, ELLIPSE_WIDTH = 4.0, 6.0, 5.0
 
 
 def check_pressure(inflation_pressure: float) -> float:
@@ -137,6 +141,7 @@ def pressure_surface(
     height_scale: float | None = None,
     clim: tuple[float, float] | None = None,
     extent: float | None = None,
+    symbol: str = "σ",
 ):
     """Render the patch pressure as a 3-D surface; return the (off-screen) plotter.
 
@@ -160,7 +165,12 @@ def pressure_surface(
         Half-width in m of the square the axes frame, rounded up to a round value
         (default `EXTENT_FACTOR` × r_max; give Figures 1 and 2 the same value
         so they compare).
+    symbol : str
+        The pressure's symbol in the heading, the height axis and the colour bar
+        (the report: σ₀ for the static map, σᵥ for the rolling one, as docs/theory.md).
 
+    The circle, the ellipse and the contact edge are drawn on a layer above the
+    surface (`overlay_renderer`), so the pressure never hides them.
     The caller saves it with ``plotter.screenshot(path)``; `layout`
     gives the text actors, legend and surface it placed.
     """
@@ -182,19 +192,25 @@ def pressure_surface(
     if plotter is None:
         theme.use_headless_vtk()
         plotter = _new_plotter()
-    _add_surface(plotter, surface, location=patch.location, clim=(lo, hi))
+    _add_surface(plotter, surface, location=patch.location, clim=(lo, hi), symbol=symbol)
     texts = [_add_outlines(plotter, patch)]
     peak_dimless = float(np.max(nodes)) if len(nodes) else 0.0
     z_range, z_step = nice_top(peak_dimless, 4)
     _place_camera(plotter, ext=ext, z_top=z_range * hs)
-    heading = f"height p/P* (P* = {p_star / 1e3:.0f} kPa), colour p (kPa)"
+    heading = f"height {symbol}/P* (P* = {p_star / 1e3:.0f} kPa), colour {symbol} (kPa)"
     head = add_text(
         plotter, f"{title}\n{heading}" if title else heading, (0.5, 0.985, 0.0), TITLE_FONT, "center", "top"
     )
     head.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-    legend = _add_legend(plotter, patch)
+    legend = _add_legend(plotter, patch, symbol)
     texts += _add_axes(
-        plotter, ext=ext, z_range=z_range, z_step=z_step, hs=hs, placed=(texts[0], head, legend)
+        plotter,
+        ext=ext,
+        z_range=z_range,
+        z_step=z_step,
+        hs=hs,
+        placed=(texts[0], head, legend),
+        symbol=symbol,
     )
     plotter._fepost_layout = SurfaceLayout(tuple(texts), head, legend, surface)
     return plotter
@@ -206,7 +222,7 @@ def _new_plotter():
     return pv.Plotter(off_screen=True, window_size=list(theme.WINDOW_SIZE), theme=theme.pyvista_theme())
 
 
-def _add_surface(plotter, surface, *, location: str, clim: tuple[float, float]) -> None:
+def _add_surface(plotter, surface, *, location: str, clim: tuple[float, float], symbol: str = "σ") -> None:
     """The pressure surface, coloured in kPa, with its colour bar (round ticks from ``clim[0]``)."""
     lo, hi = clim
     top, cstep = nice_top(hi - lo, 7)
@@ -219,7 +235,7 @@ def _add_surface(plotter, surface, *, location: str, clim: tuple[float, float]) 
         show_edges=False,
         lighting=True,
         scalar_bar_args={
-            "title": "p (kPa)",
+            "title": f"{symbol} (kPa)",
             "vertical": True,
             "position_x": 0.86,
             "position_y": 0.20,
@@ -232,6 +248,9 @@ def _add_surface(plotter, surface, *, location: str, clim: tuple[float, float]) 
         },
         show_scalar_bar=True,
     )
+    bar = plotter.scalar_bar
+    use_font(bar.GetTitleTextProperty())
+    use_font(bar.GetLabelTextProperty())
 
 
 def _add_outlines(plotter, patch: Patch):
@@ -240,14 +259,28 @@ def _add_outlines(plotter, patch: Patch):
     import pyvista as pv
 
     r = patch.r_max
+    top = overlay_renderer(plotter)
     edge = contact_edge(patch)
+    lines = []
     if len(edge):
-        plotter.add_mesh(_segments(edge), color=theme.EDGE_COLOUR, line_width=3)
-    plotter.add_mesh(
-        _polyline(circle_points(r)), color=theme.RMAX_COLOUR, line_width=6, render_lines_as_tubes=True
+        lines.append(plotter.add_mesh(_segments(edge), color=theme.EDGE_COLOUR, line_width=EDGE_WIDTH))
+    lines.append(
+        plotter.add_mesh(
+            _polyline(circle_points(r)),
+            color=theme.RMAX_COLOUR,
+            line_width=RMAX_WIDTH,
+            render_lines_as_tubes=True,
+        )
     )
     ell = ellipse_points(patch.ellipse_axes, patch.ellipse_angle, patch.ellipse_centre)
-    plotter.add_mesh(_polyline(ell), color=theme.ELLIPSE_COLOUR, line_width=5, render_lines_as_tubes=True)
+    lines.append(
+        plotter.add_mesh(
+            _polyline(ell), color=theme.ELLIPSE_COLOUR, line_width=ELLIPSE_WIDTH, render_lines_as_tubes=True
+        )
+    )
+    for actor in lines:  # drawn over the surface, never hidden under the pressure
+        plotter.renderer.RemoveActor(actor)
+        top.AddActor(actor)
     # Rolling direction +x: an arrow in front of the patch, its label before the tail.
     y_arrow = -1.2 * r
     arrow = pv.Arrow(
@@ -281,26 +314,88 @@ def _place_camera(plotter, *, ext: float, z_top: float) -> None:
     cam.focal_point = tuple(np.add(cam.focal_point, shift))
 
 
-def _add_legend(plotter, patch: Patch):
-    """The legend of the outlines, top right under the heading."""
-    legend = plotter.add_legend(
-        [
-            [f"circle of radius R = {patch.r_max:.4g} m", theme.RMAX_COLOUR],
-            [f"fitted ellipse, aspect {patch.aspect:.3f}", theme.ELLIPSE_COLOUR],
-            [f"contact edge, p = {EDGE_FRACTION:.0%} of peak", theme.EDGE_COLOUR],
-        ],
-        bcolor="white",
-        border=False,
-        loc="upper right",
-        size=LEGEND_SIZE,
-        face="line",
-    )
-    legend.SetPosition(*LEGEND_ORIGIN)
-    legend.SetPosition2(*LEGEND_SIZE)
-    return legend
+def overlay_renderer(plotter):
+    """A renderer on the layer above the plotter's, sharing its camera: what it draws is
+    drawn over the surface (its depth buffer starts empty). Made once per plotter."""
+    top = getattr(plotter, "_fepost_overlay", None)
+    if top is not None:
+        return top
+    from vtkmodules.vtkRenderingCore import vtkRenderer
+
+    win = plotter.render_window
+    win.SetNumberOfLayers(max(2, win.GetNumberOfLayers()))
+    top = vtkRenderer()
+    top.SetLayer(1)
+    top.SetViewport(*plotter.renderer.GetViewport())
+    top.SetActiveCamera(plotter.renderer.GetActiveCamera())
+    top.InteractiveOff()
+    win.AddRenderer(top)
+    plotter._fepost_overlay = top
+    return top
 
 
-def _add_axes(plotter, *, ext: float, z_range: float, z_step: float, hs: float, placed) -> list:
+def _add_legend(plotter, patch: Patch, symbol: str = "σ"):
+    """The legend of the outlines, top right under the heading: for each, a line sample in
+    its colour and width, then its text. Returns the legend's frame, a 2-D actor whose
+    position and size (normalised viewport) hold every sample and text."""
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+    from vtkmodules.vtkRenderingCore import vtkActor2D, vtkCoordinate, vtkPolyDataMapper2D, vtkTextActor
+
+    entries = [
+        (f"circle of radius R = {patch.r_max:.4g} m", theme.RMAX_COLOUR, RMAX_WIDTH),
+        (f"fitted ellipse, aspect {patch.aspect:.3f}", theme.ELLIPSE_COLOUR, ELLIPSE_WIDTH),
+        (f"contact edge, {symbol} = {EDGE_FRACTION:.0%} of peak", theme.EDGE_COLOUR, EDGE_WIDTH),
+    ]
+    x0, y0 = LEGEND_ORIGIN
+    w, h = LEGEND_SIZE
+    row = h / len(entries)
+    right = x0 + w
+    renderer = plotter.renderer
+    win_w, _ = renderer.GetSize()
+    for i, (text, colour, width) in enumerate(entries):
+        yc = y0 + h - (i + 0.5) * row
+        sample = vtkPolyData()
+        sp, sc = vtkPoints(), vtkCellArray()
+        sp.InsertNextPoint(x0 + 0.005, yc, 0.0)
+        sp.InsertNextPoint(x0 + 0.005 + LEGEND_SAMPLE, yc, 0.0)
+        sc.InsertNextCell(2)
+        sc.InsertCellPoint(0)
+        sc.InsertCellPoint(1)
+        sample.SetPoints(sp)
+        sample.SetLines(sc)
+        coord = vtkCoordinate()
+        coord.SetCoordinateSystemToNormalizedViewport()
+        mapper = vtkPolyDataMapper2D()
+        mapper.SetInputData(sample)
+        mapper.SetTransformCoordinate(coord)
+        line = vtkActor2D()
+        line.SetMapper(mapper)
+        line.GetProperty().SetColor(*rgb(colour))
+        line.GetProperty().SetLineWidth(width)
+        plotter.add_actor(line, reset_camera=False, pickable=False)
+        label = vtkTextActor()
+        label.SetInput(text)
+        prop = label.GetTextProperty()
+        prop.SetFontSize(TICK_FONT)
+        use_font(prop)
+        prop.SetColor(*rgb("black"))
+        prop.SetJustificationToLeft()
+        prop.SetVerticalJustificationToCentered()
+        label.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+        label.GetPositionCoordinate().SetValue(x0 + 0.015 + LEGEND_SAMPLE, yc)
+        plotter.add_actor(label, reset_camera=False, pickable=False)
+        box = text_box(label, renderer)
+        right = max(right, box[1] / max(win_w, 1))
+    frame = vtkActor2D()
+    frame.SetPosition(x0, y0)
+    frame.SetPosition2(right - x0, h)
+    return frame
+
+
+def _add_axes(
+    plotter, *, ext: float, z_range: float, z_step: float, hs: float, placed, symbol: str = "σ"
+) -> list:
     """Axes: x along the front edge, y along the left edge (z = 0), height at the back-left
     corner; labels thinned clear of each other and of the ``placed`` (label, heading, legend)."""
     import pyvista as pv
@@ -339,7 +434,12 @@ def _add_axes(plotter, *, ext: float, z_range: float, z_step: float, hs: float, 
         add_text(plotter, "x (m)", (0.55 * ext, -1.5 * ext, 0.0), AXIS_TITLE_FONT, "left", "top"),
         add_text(plotter, "y (m)", (-1.45 * ext, -0.55 * ext, 0.0), AXIS_TITLE_FONT, "right", "top"),
         add_text(
-            plotter, "p/P*", (-ext, ext, z_top * 1.12 + 0.02 * ext), AXIS_TITLE_FONT, "center", "bottom"
+            plotter,
+            f"{symbol}/P*",
+            (-ext, ext, z_top * 1.12 + 0.02 * ext),
+            AXIS_TITLE_FONT,
+            "center",
+            "bottom",
         ),
     ]
 

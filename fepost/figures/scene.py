@@ -76,6 +76,24 @@ def nice_ceil(x: float) -> float:
     return float(10 ** (k + 1))
 
 
+def font_file() -> str:
+    """The TrueType font of the 3-D figures' text: matplotlib's DejaVu Sans, the font of the
+    other figures, which has the Greek letters and subscripts (σ₀, σᵥ) VTK's own Arial lacks."""
+    import os
+
+    import matplotlib
+
+    return os.path.join(matplotlib.get_data_path(), "fonts", "ttf", "DejaVuSans.ttf")
+
+
+def use_font(prop) -> None:
+    """Set a ``vtkTextProperty`` to `font_file`."""
+    from vtkmodules.vtkCommonCore import VTK_FONT_FILE
+
+    prop.SetFontFamily(VTK_FONT_FILE)
+    prop.SetFontFile(font_file())
+
+
 def add_text(
     plotter, text: str, xyz, size: int, h: str = "center", v: str = "center", color="black", name=None
 ):
@@ -86,7 +104,7 @@ def add_text(
     actor.SetInput(text)
     prop = actor.GetTextProperty()
     prop.SetFontSize(size)
-    prop.SetFontFamilyToArial()
+    use_font(prop)
     prop.SetColor(*rgb(color))
     {
         "left": prop.SetJustificationToLeft,

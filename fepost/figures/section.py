@@ -169,7 +169,7 @@ def plot_sections(data: SectionData, axes=None):
         top = float(np.max(plotted_values(data)))
         for ax in axes:
             ax.set_ylim(0.0, 1.05 * top if top > 0 else 1.0)
-        axes[0].set_ylabel(f"p/P* (P* = {data.inflation_pressure / 1e3:.0f} kPa)")
+        axes[0].set_ylabel(f"σ/P* (P* = {data.inflation_pressure / 1e3:.0f} kPa)")
         handles, labels = axes[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="outside upper center", ncol=min(len(labels), 2))
     return fig

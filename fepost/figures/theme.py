@@ -26,7 +26,7 @@ RMAX_COLOUR = "#222222"
 REQUIV_COLOUR = "#7f7f7f"
 ELLIPSE_COLOUR = "#e67e22"
 #: The contact edge (contour of the FE pressure at a small fraction of its peak).
-EDGE_COLOUR = "#8c8c8c"
+EDGE_COLOUR = "#555555"
 EXACT_COLOUR = "#1f4e99"
 CLOSED_COLOUR = "#2ca02c"
 FIT_COLOUR = "#c0392b"

@@ -60,9 +60,32 @@ def display_unit(unit: str | None) -> str:
 _UNIT_AFTER_NUMBER = re.compile(r"(\d) (N m|N·m|kPa|MPa|Pa|m²|m|N|s)(?![\w²])")
 
 
+#: ASCII spellings in free text from elsewhere (notes of Table 1, rules) and the report's
+#: Unicode for them, so a page never mixes "<x^2>" with "⟨x²⟩".
+ASCII_MATH = (
+    ("<x^2>", "⟨x²⟩"),
+    (" m^1/2", " √m"),
+    ("^2", "²"),
+    ("+-", "±"),
+)
+_WORDS = {"theta": "θ", "sigma": "σ"}
+_SQRT = re.compile(r"sqrt\(([^()]*)\)")
+
+
+def unicode_math(text: str) -> str:
+    """`ASCII_MATH` and ``sqrt(x)`` -> ``√x`` (``√(x y)`` when x has a space or operator)."""
+    for ascii_, uni in ASCII_MATH:
+        text = text.replace(ascii_, uni)
+    text = re.sub(r"\b(theta|sigma)\b", lambda m: _WORDS[m.group(1)], text)
+    return _SQRT.sub(
+        lambda m: f"√{m.group(1)}" if re.fullmatch(r"\w+", m.group(1)) else f"√({m.group(1)})", text
+    )
+
+
 def normalise(text: str) -> str:
     """Free text from elsewhere (notes, rules) in the report's style: "N m" -> "N·m",
-    "<=" -> "≤", a narrow no-break space between a number and its unit."""
+    "<=" -> "≤", `unicode_math`, a narrow no-break space between a number and its unit."""
+    text = unicode_math(text)
     text = text.replace("<=", "≤").replace(">=", "≥")
     text = _UNIT_AFTER_NUMBER.sub(lambda m: f"{m.group(1)}{NNBSP}{display_unit(m.group(2))}", text)
     return text.replace(" N m", f"{NNBSP}N·m")

@@ -10,13 +10,25 @@ the first time) only when a caller asks for the compiled path, and the callers'
 from __future__ import annotations
 
 import importlib.util
+import os
 import threading
 from collections.abc import Callable, Mapping
+from typing import Any
 
 #: True when numba can be imported (the optional ``fast`` extra is installed).
 AVAILABLE = importlib.util.find_spec("numba") is not None
 
 _LOCK = threading.Lock()
+
+
+def cache_folder() -> str:
+    """Where numba keeps its compiled kernels, outside the source tree: ``NUMBA_CACHE_DIR``
+    when set, else ``$XDG_CACHE_HOME/fepost/numba`` (``~/.cache/fepost/numba``)."""
+    given = os.environ.get("NUMBA_CACHE_DIR")
+    if given:
+        return given
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "fepost", "numba")
 
 
 def compile_functions(
@@ -37,6 +49,10 @@ def compile_functions(
             return
         import numba
         from numba.extending import overload
+
+        config: Any = numba.config
+        if not config.CACHE_DIR:  # numba's default is __pycache__ beside the source
+            config.CACHE_DIR = cache_folder()
 
         fm = fastmath or False
         for name, typed in (overloads or {}).items():

@@ -29,6 +29,20 @@ class Counts:
     connectivity: list[int] = field(default_factory=list)  # values of each piece's connectivity arrays
 
 
+#: The first bytes of netCDF files (classic, 64-bit offset, 64-bit data; netCDF-4 is HDF5).
+NETCDF_MAGIC = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
+
+
+def refuse_netcdf(path: Path, data) -> None:
+    """Refuse a netCDF file under a VTK suffix (an Exodus II export renamed), saying so."""
+    if bytes(data[:8]).startswith(NETCDF_MAGIC):
+        raise bad_file(
+            path,
+            "refused: this is a netCDF file (an Exodus II export?), not VTK; give it the suffix "
+            f".e or .exo instead of {path.suffix}",
+        )
+
+
 def bad_file(path: Path, what: str) -> InputFileError:
     """The one-line error for ``path``: refusals as they are, everything else as corrupt or truncated.
 

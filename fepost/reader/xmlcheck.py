@@ -27,6 +27,7 @@ from .checks import (
     bad_file,
     find_releasing,
     inside_folder,
+    refuse_netcdf,
     regular_file,
     release,
 )
@@ -93,6 +94,7 @@ class Xml(ArrayLengths):
 
     def check(self) -> Counts:
         path, data = self.path, self.data
+        refuse_netcdf(path, data)
         suffix = path.suffix.lower()
         cut = find_releasing(data, b"<AppendedData")
         limit = len(data) if cut < 0 else cut

@@ -50,23 +50,49 @@ def check_inflation_option(option) -> float:
     return p
 
 
-def resolve_inflation_pressure(option: float | None, analysis: Analysis) -> tuple[float, str]:
-    """P* (Pa) and where it came from: the option, the static mesh's sidecar, or the default."""
-    if option is not None:
-        return check_inflation_option(option), "option"
-    side = analysis.static_field.sidecar or {}
-    value = side.get("inflation_pressure")
-    if value is not None:
+#: Where a sidecar may keep the inflation pressure, in the order looked at: the top level
+#: (``meshes/aircraft/*.json``) and the model block (``meshes/rig-aircraft/*.json``).
+SIDECAR_PRESSURE_KEYS = (("inflation_pressure",), ("model", "inflation_pressure"))
+
+
+def _sidecar_pressure(analysis: Analysis) -> tuple[float, str] | None:
+    """(P* in Pa, the dotted sidecar key it was read from), or None when the sidecar has none.
+
+    A top-level ``inflation_pressure`` was scaled to SI by the reader; one under
+    ``model`` is scaled here with the same unit system."""
+    field_ = analysis.static_field
+    side = field_.sidecar or {}
+    for path in SIDECAR_PRESSURE_KEYS:
+        value: Any = side
+        for part in path:
+            value = value.get(part) if isinstance(value, Mapping) else None
+        if value is None:
+            continue
+        key = ".".join(path)
         try:
             p = float(value)
         except (TypeError, ValueError):
             p = math.nan
         if not (math.isfinite(p) and p > 0):
             raise ArgumentError(
-                f"{analysis.static_field.source}: sidecar inflation_pressure must be a positive "
-                f"pressure in Pa, got {value!r}"
+                f"{field_.source}: sidecar {key} must be a positive pressure in Pa, got {value!r}"
             )
-        return p, "sidecar"
+        units = getattr(field_, "units", None)
+        if len(path) > 1 and units is not None and not units.is_si:
+            p *= units.pressure
+        return p, key
+    return None
+
+
+def resolve_inflation_pressure(option: float | None, analysis: Analysis) -> tuple[float, str]:
+    """P* (Pa) and where it came from: the option, the static mesh's sidecar (the key named:
+    ``inflation_pressure`` or ``model.inflation_pressure``), or the default."""
+    if option is not None:
+        return check_inflation_option(option), "option --inflation-pressure"
+    found = _sidecar_pressure(analysis)
+    if found is not None:
+        source = Path(str(analysis.static_field.source)).with_suffix(".json").name
+        return found[0], f"sidecar {source}, key {found[1]}"
     return DEFAULT_INFLATION_PRESSURE, "default (the paper's 200 kPa)"
 
 
@@ -193,7 +219,7 @@ _FIGURES = {
         "F_parallel",
         r"Figure 4: longitudinal friction force $F_\parallel$ against $\psi = u/v$",
         "psi",
-        r"$\psi = \omega_z R\,/\,v$",
+        r"$\psi = u\,/\,v$",
         r"$F_\parallel$ (N)",
         "N",
     ),
@@ -201,7 +227,7 @@ _FIGURES = {
         "M_C",
         r"Figure 5: friction torque $M_C$ against $\upsilon = v/u$",
         "upsilon",
-        r"$\upsilon = v\,/\,(\omega_z R)$",
+        r"$\upsilon = v\,/\,u$ (upsilon)",
         r"$M_C$ (N·m)",
         "N·m",
     ),
@@ -209,7 +235,7 @@ _FIGURES = {
         "F_perp",
         r"Figure 6: lateral friction force $F_\perp$ against $\upsilon = v/u$ (rolling map)",
         "upsilon",
-        r"$\upsilon = v\,/\,(\omega_z R)$",
+        r"$\upsilon = v\,/\,u$ (upsilon)",
         r"$F_\perp = -F_y$ (N)",
         "N",
     ),
@@ -274,29 +300,54 @@ MODEL_ROWS = (
     ("static.L", "L", None, "correction: Chebyshev polynomials in t; (2K + 1)·L numbers"),
     (
         "static.accuracy.model_force",
-        "model: largest |ΔF|/F0",
+        "static map: generalised model, largest |ΔF|/F0",
         "fraction",
         "generalised model against the exact integrals",
     ),
-    ("static.accuracy.model_torque", "model: largest |ΔMz|/M0", "fraction", "the same for the torque"),
+    (
+        "static.accuracy.model_torque",
+        "static map: generalised model, largest |ΔMz|/M0",
+        "fraction",
+        "the same for the torque",
+    ),
     (
         "static.accuracy.compare_force",
-        "paper: largest |ΔF|/F0",
+        "static map: paper's closed forms, largest |ΔF|/F0",
         "fraction",
         "the closed forms (1.8) with the coefficients above",
     ),
-    ("static.accuracy.compare_torque", "paper: largest |ΔMz|/M0", "fraction", "the same for the torque"),
+    (
+        "static.accuracy.compare_torque",
+        "static map: paper's closed forms, largest |ΔMz|/M0",
+        "fraction",
+        "the same for the torque",
+    ),
     ("rolling.g.0", "ĝx (rolling map)", None, "−∬ σ cos φ dA / N: force at pure spin of the rolling map"),
     ("rolling.xc.0", "x̂c (rolling map)", None, "x_c/R: centre of pressure of the rolling map"),
     (
         "rolling.accuracy.model_force",
-        "rolling: model |ΔF|/F0",
+        "rolling map: generalised model, largest |ΔF|/F0",
         "fraction",
         "generalised model of the rolling map",
     ),
-    ("rolling.accuracy.model_torque", "rolling: model |ΔMz|/M0", "fraction", "the same for the torque"),
-    ("rolling.accuracy.compare_force", "rolling: paper |ΔF|/F0", "fraction", "the closed forms with k_x"),
-    ("rolling.accuracy.compare_torque", "rolling: paper |ΔMz|/M0", "fraction", "the same for the torque"),
+    (
+        "rolling.accuracy.model_torque",
+        "rolling map: generalised model, largest |ΔMz|/M0",
+        "fraction",
+        "the same for the torque",
+    ),
+    (
+        "rolling.accuracy.compare_force",
+        "rolling map: paper's closed forms, largest |ΔF|/F0",
+        "fraction",
+        "the closed forms with k_x",
+    ),
+    (
+        "rolling.accuracy.compare_torque",
+        "rolling map: paper's closed forms, largest |ΔMz|/M0",
+        "fraction",
+        "the same for the torque",
+    ),
 )
 #: Rows of the patch table: (key in coefficients.json "patch", label, unit kind).
 PATCH_ROWS = (
@@ -349,7 +400,9 @@ def _k_x_definition(key: str, definition: str, label: RollingLabel | None) -> st
 
 
 def model_rows(coef: Mapping[str, Any]) -> list[dict]:
-    """Rows of the generalised model (`MODEL_ROWS`) present in ``coef["model"]``."""
+    """Rows of the generalised model (`MODEL_ROWS`) present in ``coef["model"]``; ``main``:
+    the accuracy rows, shown in the main table (the rest are the model's internals, in the
+    page's appendix)."""
     model = coef.get("model")
     if not model:
         return []
@@ -357,7 +410,8 @@ def model_rows(coef: Mapping[str, Any]) -> list[dict]:
     for key, label, kind, definition in MODEL_ROWS:
         value = _dig(model, key)
         if value is not None:
-            rows.append(_row(key, label, kind, definition, value, "coefficients.model"))
+            row = _row(key, label, kind, definition, value, "coefficients.model")
+            rows.append({**row, "main": ".accuracy." in key})
     return rows
 
 
@@ -433,7 +487,7 @@ def page_context(
         for key, label_, kind, d in COEFFICIENT_ROWS
         if coef.get(key) is not None
     ]
-    coefficient_rows += [
+    moment_rows = [
         _row(f"A.{j}", f"A{j}", "pressure", f"∫₀¹ σ̄₀(ρ) ρ{'⁰¹²³'[j]} dρ", coef["A"][j], "coefficients")
         for j in range(4)
     ]
@@ -482,6 +536,8 @@ def page_context(
         "R": coef["R"],
         "R_definition": coef.get("R_definition", ""),
         "coefficient_rows": coefficient_rows,
+        "moment_rows": moment_rows,
+        "k_x_label": "" if label is None else label.text,
         "patch": pd,
         "patch_rows": patch_rows,
         "rmax_over_requiv": pd["r_max"] / pd["r_equiv"],

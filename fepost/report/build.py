@@ -12,8 +12,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from .. import __version__
 from ..analysis import analyse
 from ..errors import ReaderWarning
@@ -97,15 +95,15 @@ def inflation_pressure_of(option: float | None, a) -> tuple[float, str]:
     p_star, p_src = resolve_inflation_pressure(option, a)
     if p_src.startswith("default"):
         warnings.warn(
-            f"{a.static_field.source}: no inflation pressure given (no sidecar 'inflation_pressure', no "
-            f"--inflation-pressure): the paper's P* = {p_star / 1e3:g} kPa is assumed for sigma/P* in "
-            "Figures 1-3",
+            f"{a.static_field.source}: no inflation pressure given (no sidecar 'inflation_pressure' or "
+            f"'model.inflation_pressure', no --inflation-pressure): the paper's P* = {p_star / 1e3:g} kPa "
+            "is assumed for sigma/P* in Figures 1-3",
             ReaderWarning,
             stacklevel=3,
         )
         p_src = (
-            f"NOT GIVEN: the paper's {p_star / 1e3:g} kPa assumed (no sidecar inflation_pressure, no "
-            "--inflation-pressure); the σ/P* axes of Figures 1–3 depend on it"
+            f"NOT GIVEN: the paper's {p_star / 1e3:g} kPa assumed (no sidecar inflation_pressure or "
+            "model.inflation_pressure, no --inflation-pressure); the σ/P* axes of Figures 1–3 depend on it"
         )
     return p_star, p_src
 
@@ -242,16 +240,23 @@ def build_report(
 def _pressure_figures(steps: _Steps, a, tmp: Path, p_star: float) -> dict[str, Figure]:
     """Figures 1–3 (pressure surfaces and diameter sections) and the patch plan."""
     from ..figures import diameter_sections, plot_patch_plan, plot_sections
+    from ..figures.patchplan import pressure_colour_range
     from ..figures.render import EXTENT_FACTOR, default_height_scale, pressure_surface
 
     patches = [a.static_patch] + ([a.rolling_patch] if a.rolling_patch is not None else [])
     hs = default_height_scale(*patches, inflation_pressure=p_star)
-    clim = (0.0, max(float(np.max(pp.values)) for pp in patches) / 1e3)
+    clim = pressure_colour_range(*patches)  # one colour scale: Figures 1, 2 and the patch plan
     extent = max(pp.r_max for pp in patches) * EXTENT_FACTOR
 
-    def render(patch, stem, key, title):
+    def render(patch, stem, key, title, symbol):
         pl = pressure_surface(
-            patch, inflation_pressure=p_star, title=title, height_scale=hs, clim=clim, extent=extent
+            patch,
+            inflation_pressure=p_star,
+            title=title,
+            height_scale=hs,
+            clim=clim,
+            extent=extent,
+            symbol=symbol,
         )
         return save_plotter(pl, tmp, stem, key, title)
 
@@ -263,19 +268,24 @@ def _pressure_figures(steps: _Steps, a, tmp: Path, p_star: float) -> dict[str, F
     figs: dict[str, Figure] = {}
     figs["fig1"] = steps.run(
         "render Figure 1 (static pressure)",
-        render, a.static_patch, "fig1_static", "fig1", "Figure 1: static contact pressure",
+        render, a.static_patch, "fig1_static", "fig1", "Figure 1: static contact pressure", "σ₀",
     )  # fmt: skip
     if a.rolling_patch is not None:
         label = rolling_label(a.rolling_field.sidecar if a.rolling_field is not None else None)
         figs["fig2"] = steps.run(
             "render Figure 2 (rolling pressure)",
-            render, a.rolling_patch, "fig2_rolling", "fig2", f"Figure 2: contact pressure, {label.short}",
+            render, a.rolling_patch, "fig2_rolling", "fig2",
+            f"Figure 2: contact pressure, {label.short}", "σᵥ",
         )  # fmt: skip
     figs["fig3"] = steps.run("Figure 3 (diameter sections)", fig3)
     figs["patch"] = steps.run(
         "patch plan figure",
         lambda: save_matplotlib(
-            plot_patch_plan(a.static_patch), tmp, "patch_plan", "patch", "The loaded region in plan"
+            plot_patch_plan(a.static_patch, clim=clim),
+            tmp,
+            "patch_plan",
+            "patch",
+            "The loaded region in plan",
         ),
     )
     return figs

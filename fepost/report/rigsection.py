@@ -39,6 +39,16 @@ def rig_runs(folder: Path) -> list[Path]:
     return out
 
 
+#: Values below this (in f N or f N R) are rounding of sums that cancel: shown as 0.
+ROUNDOFF = 1e-9
+
+
+def shown(value: float) -> float:
+    """``value`` as the table shows it: 0 (never −0, never −3.6e−16) within `ROUNDOFF` of zero."""
+    v = float(value)
+    return 0.0 if abs(v) < ROUNDOFF else v
+
+
 def _text(m: dict) -> str:
     return (
         f"RMS |dF| {m['rms_F']:.4f} fN (max {m['max_F']:.4f}), "
@@ -90,7 +100,7 @@ def rig_section(data: ReportData, folder: Path) -> Section | None:
         db = cmp.static[i, :2] - cmp.fe[i, :2]
         de = cmp.shifted[i, :2] - cmp.fe[i, :2]
         rows.append(
-            (name, *(float(v) for v in cmp.kinematics[i]), *(float(v) for v in cmp.fe[i]),
-             float((db**2).sum() ** 0.5), float((de**2).sum() ** 0.5))
+            (name, *(shown(v) for v in cmp.kinematics[i]), *(shown(v) for v in cmp.fe[i]),
+             shown((db**2).sum() ** 0.5), shown((de**2).sum() ** 0.5))
         )  # fmt: skip
     return Section(key="rig", title=TITLE, paragraphs=paragraphs, table=(head, *rows))

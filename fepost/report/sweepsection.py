@@ -52,18 +52,47 @@ TABLE = (
     ("aR2", "a·R² (m²)"),
     ("m_over_R2", "m/R² (m⁻²)"),
     ("aspect", "aspect"),
-    ("k_x", "k_x"),
+    ("k_x", "k_x (its rolling map)"),
     ("status", "status"),
 )
 
 
-def _cell(row, key: str):
+def _cell(row, key: str, kinds: dict | None = None):
     v = row.get(key)
     if key == "case" and not v:
         return Path(str(row.get("source", ""))).stem
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "—"
+    if key == "k_x" and kinds is not None:  # a k_x is never shown without what its map is
+        kind = kinds.get(_resolved(row.get("rolling"))) or "rolling map of unstated kind"
+        return f"{_signed(float(v), '{:.4g}')} ({kind})"
     return v
+
+
+def _resolved(path) -> str:
+    try:
+        return str(Path(str(path)).resolve()) if path else ""
+    except OSError:
+        return str(path)
+
+
+def _rolling_kinds(pairings) -> dict[str, str]:
+    """The short label (`fepost.report.rollinglabel.RollingLabel.short`) of each rolling map
+    the sweep pairs, by its resolved path."""
+    from ..errors import InputFileError
+    from ..reader.sidecar import read_sidecar
+    from .rollinglabel import rolling_label
+
+    out = {}
+    for pr in pairings:
+        if pr.rolling is None:
+            continue
+        try:
+            side = read_sidecar(Path(pr.rolling))
+        except InputFileError:
+            side = None
+        out[_resolved(pr.rolling)] = rolling_label(side).short
+    return out
 
 
 def _signed(v: float, fmt: str) -> str:
@@ -241,7 +270,8 @@ def sweep_provider(
             name = _cell(rows[own], "case") if own < len(rows) else pairings[own].static.given
             ending = _other_rolling_map(data, pairings[own])  # "." when the report's pair is the sweep's
             intro += f" The report above is the case {name} of this sweep{ending}"
-        table = (tuple(h for _, h in TABLE), *(tuple(_cell(r, k) for k, _ in TABLE) for r in rows))
+        kinds = _rolling_kinds(pairings)
+        table = (tuple(h for _, h in TABLE), *(tuple(_cell(r, k, kinds) for k, _ in TABLE) for r in rows))
         return Section(
             key=key,
             title=title,
