@@ -142,6 +142,10 @@ def test_free_text_is_written_in_one_notation():
     assert normalise("widths scale as 1/sqrt(n): +-9 %") == "widths scale as 1/√n: ±9 %"
     assert normalise("(aR^2, m/R^2 do not); a = 0.052 m^1/2") == "(aR², m/R² do not); a = 0.052 √m"
     assert normalise("theta = F0; sigma_x") == "θ = F0; sigma_x"  # whole words only
+    assert (
+        normalise("largest |dF|/F0 0.5%, |dMz|/M0 0.8% (0-180 deg)")
+        == "largest |ΔF|/F0 0.5%, |ΔMz|/M0 0.8% (0–180°)"
+    )
 
 
 # ---------------------------------------------------------------- Figures 1-2 and the patch plan

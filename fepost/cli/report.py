@@ -51,8 +51,8 @@ def add_parser(sub) -> None:
         type=v.pressure,
         metavar="P",
         help="inflation pressure P* for sigma/P* of Figures 1-3, a number in Pa or with a unit "
-        "(1380kPa, 1.38MPa, 13.8bar, 200psi); default: the sidecar's inflation_pressure, else the "
-        "paper's 200 kPa, with a warning",
+        "(1380kPa, 1.38MPa, 13.8bar, 200psi); default: the sidecar's inflation_pressure (or "
+        "model.inflation_pressure), else the paper's 200 kPa, with a warning",
     )
     p.add_argument(
         "--seed",

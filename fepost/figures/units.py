@@ -65,6 +65,9 @@ _UNIT_AFTER_NUMBER = re.compile(r"(\d) (N m|N·m|kPa|MPa|Pa|m²|m|N|s)(?![\w²])
 ASCII_MATH = (
     ("<x^2>", "⟨x²⟩"),
     (" m^1/2", " √m"),
+    ("|dF|", "|ΔF|"),
+    ("|dMz|", "|ΔMz|"),
+    ("0-180 deg", "0–180°"),
     ("^2", "²"),
     ("+-", "±"),
 )
