@@ -237,3 +237,57 @@ def test_formats_page_documents_every_report_file(tutorial):
     for name in documented:
         if "*" not in name:
             assert name in written, name
+
+
+# ---------------------------------------------------------------- one source per headline number
+def _headline() -> dict:
+    """The numbers docs/numbers.md shows (the output of scripts/headline_numbers.py, which the
+    doc-example tests run and compare), parsed."""
+    text = (DOCS / "numbers.md").read_text(encoding="utf-8")
+    out: dict = {"families": {}, "meshes": {}, "k_x": {}}
+    for name, f1, t1, flo, fhi, tlo, thi in re.findall(
+        r"^  (\S.*?\S) +aspect 1: ([\d.]+), ([\d.]+); aspects 1-3: ([\d.]+)-([\d.]+), ([\d.]+)-([\d.]+)$",
+        text,
+        re.M,
+    ):
+        out["families"][name] = [float(v) for v in (f1, t1, flo, fhi, tlo, thi)]
+    for mesh, r, force, torque in re.findall(
+        r"^  (\S+\.vtu) +\d+ +([\d.]+) +[\d.]+ +[\d.]+ +([\d.]+), ([\d.]+)", text, re.M
+    ):
+        out["meshes"][mesh] = (float(r), float(force), float(torque))
+    for partner, k in re.findall(r"^  .*?(\S+\.vtu).*k_x = ([\d.]+)$", text, re.M):
+        out["k_x"][Path(partner).name] = float(k)
+    return out
+
+
+def _pct(lo: float, hi: float) -> str:
+    return f"{round(100 * lo)}–{round(100 * hi)} %"
+
+
+def test_pages_quote_the_headline_numbers_of_their_one_source():
+    """The closed forms' error, k_x of free rolling and R by mesh, as README.md, docs/model.md
+    and docs/tutorial.md state them, are those of docs/numbers.md (rounded as quoted)."""
+    h = _headline()
+    fam = h["families"]
+    assert set(fam) == {"uniform", "Hertz", "tire-like", "asymmetric rolling-like"}
+    axisym = [fam[k] for k in ("uniform", "Hertz", "tire-like")]
+    circle_f = _pct(min(v[0] for v in axisym), max(v[0] for v in axisym))
+    circle_t = _pct(min(v[1] for v in axisym), max(v[1] for v in axisym))
+    every_f = _pct(min(v[2] for v in fam.values()), max(v[3] for v in fam.values()))
+    every_t = _pct(min(v[4] for v in fam.values()), max(v[5] for v in fam.values()))
+    readme = " ".join((REPO / "README.md").read_text(encoding="utf-8").split())
+    model = " ".join((DOCS / "model.md").read_text(encoding="utf-8").split())
+    assert f"by {circle_f[:-2]} % of F0 and {circle_t[:-2]} % of M0 even there" in readme
+    assert f"{round(100 * fam['asymmetric rolling-like'][0])} % of F0 for an asymmetric" in readme
+    assert f"{every_f[:-2]} % and {every_t[:-2]} % over ellipses up to aspect 3" in readme
+    assert f"{circle_f} of F0 in the force and {circle_t} of M0 in the torque" in model
+    assert f"{every_f} force, {every_t} torque over the reference maps" in model
+    fine, rolled = h["k_x"]["static_100.vtu"], h["k_x"]["roll_static.vtu"]
+    r_fine, r_roll = h["meshes"]["aircraft/static_100.vtu"][0], h["meshes"]["rig-aircraft/roll_static.vtu"][0]
+    assert f"k_x = {fine:.3f} ({rolled:.3f} with that mesh's own static map" in readme
+    assert f"whose R is {r_roll:.3f} m against {r_fine:.3f} m" in readme
+    tutorial = " ".join((DOCS / "tutorial.md").read_text(encoding="utf-8").split())
+    assert f"{rolled:.3f} against this pair's {fine:.3f}" in tutorial
+    assert f"the sliding stand-in `rolling_100.vtu` would give {h['k_x']['rolling_100.vtu']:.2f}" in tutorial
+    static = h["meshes"]["aircraft/static_100.vtu"]
+    assert f"where the closed forms miss by up to {round(100 * static[2])} %" in tutorial
