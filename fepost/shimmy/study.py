@@ -218,9 +218,8 @@ def shimmy_study(
     speeds. ``simulate_motion``: time histories at 0.8 and 1.2 times each critical
     speed (at the sweep's ends when there is none), ``duration`` seconds each, and the
     limit-cycle amplitude over speed at ``branch_speeds`` speeds (`amplitude_sweep`; 0:
-    none). ``trails``: the stability maps
-    over speed × trail, × torsional damping and × torsional stiffness at that many
-    values each (`map_values`; 0: none). ``progress``: called as
+    none). ``trails``: the stability maps over speed × trail, × torsional damping and
+    × torsional stiffness at that many values each (`map_values`; 0: none). ``progress``: called as
     ``progress(k, n, step, seconds)`` after each of the n stages.
     """
     from .anchor import anchor_record
@@ -246,43 +245,12 @@ def shimmy_study(
         )
     results, sims = [], []
     for name, contact in found.items():
-        lin, smap = stages.run(
-            f"{name}: stability over {len(speeds)} speeds",
-            f"{name}_stability_map",
-            lambda c=contact: _linear(gear, c, speeds),
-        )
-        ci, method = None, "not computed"
-        if t1 is not None:
-            if smap.critical_speed is not None:
-                ci, method = stages.run(
-                    f"{name}: 95 % interval of the critical speed",
-                    f"{name}_interval",
-                    lambda c=contact, s=smap, lin=lin: critical_interval(
-                        gear, c, s.critical_speed, speeds, t1, lin
-                    ),
-                )
-            else:
-                method = "no onset of instability in the sweep"
-                stages.run(f"{name}: no interval ({method})", f"{name}_interval", lambda: None)
-        elif smap.critical_speed is None:
-            method = "no onset of instability in the sweep"
-        info = {k: float(v) for k, v in contact.info.items() if isinstance(v, int | float)}
-        maps = {}
-        if trails:
-            maps = stages.run(
-                f"{name}: stability maps over speed x trail, damping, stiffness ({trails} values each)",
-                f"{name}_maps",
-                lambda c=contact, lin=lin: _maps(gear, lin, c, speeds, trails),
-            )
-        branch: tuple = ()
-        if simulate_motion:
-            runs, branch = _simulations(gear, contact, lin, smap, name, duration, stages, branch_speeds)
-            sims.extend(runs)
-        stab = ModelStability(
-            name, smap, ci, method, {"F0": contact.F0, "M0": contact.M0, **info}, maps.get("trail"),
-            maps, branch,
+        stab, runs = _model_study(
+            gear, name, contact, speeds, t1, stages,
+            trails=trails, simulate_motion=simulate_motion, duration=duration, branch_speeds=branch_speeds,
         )  # fmt: skip
         results.append(stab)
+        sims.extend(runs)
     c = analysis.coefficients
     source = {
         "static": str(analysis.static_field.source),
@@ -301,6 +269,45 @@ def shimmy_study(
         source=source,
         timings=timings,
     )
+
+
+def _model_study(
+    gear, name, contact, speeds, t1, stages, *, trails, simulate_motion, duration, branch_speeds
+):
+    """One friction model's part of `shimmy_study`: (its `ModelStability`, its simulations)."""
+    lin, smap = stages.run(
+        f"{name}: stability over {len(speeds)} speeds",
+        f"{name}_stability_map",
+        lambda: _linear(gear, contact, speeds),
+    )
+    ci, method = None, "not computed"
+    if smap.critical_speed is None:
+        method = "no onset of instability in the sweep"
+    if t1 is not None:
+        if smap.critical_speed is not None:
+            ci, method = stages.run(
+                f"{name}: 95 % interval of the critical speed",
+                f"{name}_interval",
+                lambda: critical_interval(gear, contact, smap.critical_speed, speeds, t1, lin),
+            )
+        else:
+            stages.run(f"{name}: no interval ({method})", f"{name}_interval", lambda: None)
+    info = {k: float(v) for k, v in contact.info.items() if isinstance(v, int | float)}
+    maps = {}
+    if trails:
+        maps = stages.run(
+            f"{name}: stability maps over speed x trail, damping, stiffness ({trails} values each)",
+            f"{name}_maps",
+            lambda: _maps(gear, lin, contact, speeds, trails),
+        )
+    branch: tuple = ()
+    runs: list = []
+    if simulate_motion:
+        runs, branch = _simulations(gear, contact, lin, smap, name, duration, stages, branch_speeds)
+    stab = ModelStability(
+        name, smap, ci, method, {"F0": contact.F0, "M0": contact.M0, **info}, maps.get("trail"), maps, branch
+    )
+    return stab, runs
 
 
 def _linear(gear: Gear, contact: Contact, speeds: np.ndarray):
