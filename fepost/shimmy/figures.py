@@ -69,9 +69,17 @@ def stability_figure(result: ShimmyResult, fig):
     ax.axhline(0.0, color="k", lw=0.8)
     ax.plot([], [], "k^", label="onset of instability")
     ax.plot([], [], "kv", label="end of an unstable range")
+    low = min(float(np.min(m.stability.growth_rate)) for m in result.models)
+    high = max(float(np.max(m.stability.growth_rate)) for m in result.models)
+    floor = -max(5.0, 4.0 * abs(high))  # the crossing readable: the deep low-speed dip clipped
+    clipped = low < floor
+    if clipped:
+        ax.set_ylim(floor, max(high, 0.0) + 0.15 * (max(high, 0.0) - floor))
     ax.set_xlabel("forward speed V (m/s)")
     ax.set_ylabel("growth rate: largest real part (1/s)")
-    ax.set_title("Stability of rolling with sliding (above 0: unstable; shaded: 95 % interval)")
+    note = f"; clipped below {floor:.1f}" if clipped else ""
+    title = "Stability of rolling with sliding: above 0 unstable"
+    ax.set_title(f"{title}\n(shaded: 95 % interval of the critical speed{note})", fontsize=9.5)
     ax.legend()
     return fig
 
