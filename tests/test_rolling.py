@@ -9,6 +9,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 import shutil
@@ -34,6 +35,11 @@ CONTRACT = ("kind", "rim_rotation_deg", "axle_travel_m", "longitudinal_slip", "a
 #: stand-in's 0.24 and the paper's 0.13 are 12 and 6 times larger.
 FREE_KX_TOL = 0.02
 
+#: the tests that mesh a tire (gmsh, the "model" extra) skip where it is absent, as their
+#: neighbours in test_tiremodel_decks.py do
+HAVE_GMSH = importlib.util.find_spec("gmsh") is not None
+needs_gmsh = pytest.mark.skipif(not HAVE_GMSH, reason="gmsh is not installed (the 'model' extra)")
+
 
 def _fepost_json(static: Path, rolling: Path, tmp_path: Path) -> dict:
     from fepost.cli import main
@@ -43,6 +49,7 @@ def _fepost_json(static: Path, rolling: Path, tmp_path: Path) -> dict:
     return json.loads(out.read_text())
 
 
+@needs_gmsh
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed")
 def test_tiny_rolling_deck_end_to_end(tmp_path):
     """A tiny tire rolled 6 degrees by CalculiX, exported, and read by `fepost coefficients --rolling`."""
@@ -202,6 +209,7 @@ def _finished_files(out: Path, spec: prog.RunSpec, plan: RollPlan) -> None:
     _fake_task(prog.Task(spec, plan, prog.Setup(), None, out, out, 0.55))
 
 
+@needs_gmsh
 def test_resume_skips_finished_runs_and_redoes_half_written_ones(tmp_path):
     setup = prog.Setup(mesh=tiny_roll_spec())
     specs = prog.programme((-0.2, 0.2, -0.04))

@@ -8,15 +8,18 @@
 - ``rig [--mesh coarse|tiny|full] [--only RUN ...] [--out DIR] [--work DIR]``:
   the slide/spin programme on the small tire (meshes/rig/: the road moves
   rigidly with a sliding velocity and a spin, Coulomb friction 0.3);
-- ``rig-aircraft [--mesh rig|fine] [--inc F] [--path S] [--only RUN ...] [--out DIR] --work DIR
-  [--workers N | --scheduler ADDRESS]``: the slide/spin programme on the
-  aircraft tire (meshes/rig-aircraft/), resumable, its runs as Dask tasks;
+- ``rig-aircraft [--mesh rig|fine|whole|whole-fine] [--inc F] [--path S] [--friction MU]
+  [--only RUN ...] [--out DIR] --work DIR [--workers N | --scheduler ADDRESS]``: the slide/spin
+  programme on the aircraft tire (the +-70 degree sector: meshes/rig-aircraft/; the whole tire:
+  meshes/rig-tire360/), resumable, its runs as Dask tasks;
 - ``roll --work DIR [--only RUN ...] [--out DIR] [--scheduler ADDRESS]``: the
   aircraft tire rolling quasi-statically (free, braking, driving; meshes/rig-aircraft/roll_*);
 - ``check-elements``: tip deflection of a rubber cantilever (C3D8I / C3D8,
   K/G = 100 / 1000) against Timoshenko's beam, the locking check behind the
   element choice.
 
+Outputs go to ``--out DIR`` if given, else to ``out/tiremodel/<folder>`` (ignored by git);
+only ``--update`` rewrites the tracked folder under ``meshes/`` named above.
 Every case is solved in a temporary folder; the exported files are moved into
 ``--out`` only when all requested cases have succeeded, so a failed or
 interrupted run leaves existing results untouched. Problems (no ``ccx``, no
@@ -44,7 +47,7 @@ def _parser() -> argparse.ArgumentParser:
     b = sub.add_parser("build", help="mesh, solve with CalculiX and export sample results")
     b.add_argument("--case", choices=[*dk.CASES, "all"], default="all")
     b.add_argument("--coarse", action="store_true", help="cheap mesh (tests, quick looks)")
-    b.add_argument("--out", type=Path, default=REPO / "meshes", help="output folder (default: meshes/)")
+    _out_options(b, "meshes")
     b.add_argument("--keep", type=Path, default=None, help="also copy the CalculiX work files here")
     b.add_argument("--threads", type=int, default=2)
     b.add_argument("--debug", action="store_true", help="show tracebacks")
@@ -52,12 +55,7 @@ def _parser() -> argparse.ArgumentParser:
         "aircraft", help="aircraft main-gear tire: load sweep + rolling stand-in (meshes/aircraft/)"
     )
     a.add_argument("--coarse", action="store_true", help="solve the sweep on the coarse mesh (quick look)")
-    a.add_argument(
-        "--out",
-        type=Path,
-        default=REPO / "meshes" / "aircraft",
-        help="output folder (default: meshes/aircraft/)",
-    )
+    _out_options(a, "meshes/aircraft")
     a.add_argument("--jobs", type=int, default=2, help="CalculiX runs at a time (one thread each)")
     a.add_argument(
         "--work",
@@ -70,7 +68,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--mesh", choices=["tiny", "coarse", "full"], default="tiny")
     r.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
     r.add_argument("--only", nargs="+", default=None, help="solve only these runs (names)")
-    r.add_argument("--out", type=Path, default=REPO / "meshes" / "rig")
+    _out_options(r, "meshes/rig")
     r.add_argument(
         "--work", type=Path, required=True, help="CalculiX work folder; finished runs there are reused"
     )
@@ -78,13 +76,28 @@ def _parser() -> argparse.ArgumentParser:
     ra = sub.add_parser(
         "rig-aircraft", help="slide/spin programme on the aircraft tire (meshes/rig-aircraft/)"
     )
-    ra.add_argument("--mesh", choices=["rig", "fine"], default="rig")
+    ra.add_argument(
+        "--mesh",
+        choices=["rig", "fine", "whole", "whole-fine", "whole-test"],
+        default="rig",
+        help="rig, fine: the +-70 degree sector (meshes/rig-aircraft/); whole, whole-fine: the whole "
+        "360-degree tire (meshes/rig-tire360/); whole-test: its tiny version",
+    )
     ra.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
-    ra.add_argument("--only", nargs="+", default=None, help="solve only these runs (names)")
+    ra.add_argument(
+        "--only", nargs="+", default=None, help="solve only these runs (names; static: the base alone)"
+    )
     ra.add_argument(
         "--path", type=float, default=None, help="reference path S of every slide, m (default: 0.30)"
     )
-    ra.add_argument("--out", type=Path, default=REPO / "meshes" / "rig-aircraft")
+    ra.add_argument(
+        "--friction",
+        type=float,
+        default=None,
+        help="Coulomb coefficient of base and runs (default 0.3; 0: frictionless, the mu = 0 "
+        "check); the base differs: give it a --work of its own",
+    )
+    _out_options(ra, "meshes/rig-aircraft (meshes/rig-tire360 for the whole tire)")
     ra.add_argument(
         "--work", type=Path, required=True, help="CalculiX work folder; finished solves there are reused"
     )
@@ -92,7 +105,7 @@ def _parser() -> argparse.ArgumentParser:
     ra.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     ra.add_argument("--debug", action="store_true", help="show tracebacks")
     ro = sub.add_parser("roll", help="aircraft tire rolling: free, braking, driving (rig-aircraft/roll_*)")
-    ro.add_argument("--out", type=Path, default=REPO / "meshes" / "rig-aircraft")
+    _out_options(ro, "meshes/rig-aircraft")
     ro.add_argument("--work", type=Path, required=True, help="CalculiX work folder; finished solves reused")
     ro.add_argument("--only", nargs="+", default=None, help="solve only these runs (names, e.g. roll_free)")
     ro.add_argument("--scheduler", default=None, help="Dask scheduler ADDRESS (default: one local worker)")
@@ -100,6 +113,42 @@ def _parser() -> argparse.ArgumentParser:
     c = sub.add_parser("check-elements", help="cantilever check of the rubber elements against Timoshenko")
     c.add_argument("--debug", action="store_true", help="show tracebacks")
     return ap
+
+
+def _out_options(p: argparse.ArgumentParser, tracked: str) -> None:
+    """``--out DIR`` and ``--update``: outputs go to out/tiremodel/... unless the user names a
+    folder or asks, with ``--update``, to rewrite the tracked files under meshes/."""
+    p.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="output folder (default: out/tiremodel/..., beside the tracked folder's name)",
+    )
+    p.add_argument(
+        "--update",
+        action="store_true",
+        help=f"write into the tracked folder {tracked} (rewrites committed files)",
+    )
+
+
+def out_folder(args: argparse.Namespace) -> Path:
+    """Where a command writes: ``--out``, else with ``--update`` the tracked folder under meshes/,
+    else the same name under out/tiremodel/ (ignored by git): a clean clone's tracked files stay."""
+    if args.out is not None:
+        if args.update:
+            raise ValueError("--out and --update: give one (--update writes the tracked folder)")
+        return args.out
+    if args.command == "build":
+        sub = ""
+    elif args.command == "aircraft":
+        sub = "aircraft"
+    elif args.command == "rig":
+        sub = "rig"
+    elif args.command == "rig-aircraft" and args.mesh.startswith("whole"):
+        sub = "rig-tire360"
+    else:  # rig-aircraft on the sector, roll
+        sub = "rig-aircraft"
+    return (REPO / "meshes" / sub) if args.update else (REPO / "out" / "tiremodel" / (sub or "meshes"))
 
 
 def build(
@@ -152,18 +201,19 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "rig":
             from .rig_programme import run_programme
 
-            run_programme(args.out, args.work, mesh_kind=args.mesh, inc=args.inc, only=args.only)
+            run_programme(out_folder(args), args.work, mesh_kind=args.mesh, inc=args.inc, only=args.only)
             return 0
         if args.command == "rig-aircraft":
             from .aircraft_rig_deck import AIRCRAFT
             from .aircraft_rig_programme import run_programme as run_aircraft_programme
 
             run_aircraft_programme(
-                args.out,
+                out_folder(args),
                 args.work,
                 mesh_kind=args.mesh,
                 inc=args.inc,
                 path=AIRCRAFT.slide_path if args.path is None else args.path,
+                friction=args.friction,
                 only=args.only,
                 workers=None if args.scheduler else args.workers,
                 scheduler=args.scheduler,
@@ -179,15 +229,15 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"tiremodel: error: {msg}", file=sys.stderr)
                 return 2
             specs = [s for s in programme() if args.only is None or s.name in args.only]
-            run_programme(args.out, args.work, specs, scheduler=args.scheduler)
+            run_programme(out_folder(args), args.work, specs, scheduler=args.scheduler)
             return 0
         if args.command == "aircraft":
             from .aircraft_build import build_aircraft
 
-            build_aircraft(args.out, coarse=args.coarse, jobs=args.jobs, work=args.work)
+            build_aircraft(out_folder(args), coarse=args.coarse, jobs=args.jobs, work=args.work)
         else:
             cases = list(dk.CASES) if args.case == "all" else [args.case]
-            build(cases, args.coarse, args.out, args.keep, args.threads)
+            build(cases, args.coarse, out_folder(args), args.keep, args.threads)
     except ModelError as exc:
         if args.debug:
             raise

@@ -208,13 +208,25 @@ def write_aircraft_deck(
     )
 
 
+def incompatible_mask(mesh: AircraftMesh) -> np.ndarray:
+    """(e,) bool: the elements that are C3D8I (the others are C3D8).
+
+    The sweep's tire: incompatible-mode hexahedra (good in bending) in the refined
+    region around the patch; plain C3D8 in the coarse upper part, which only
+    carries the inflation, and in the shoulder rubber: there the incompatible
+    modes of the elements under the lateral patch edge oscillated without
+    converging once the edge reached them (one element through the rubber). A
+    mesh whose parameters set ``incompatible_all`` (the whole rig tire, two
+    elements through the rubber) is C3D8I everywhere: plain C3D8 lock in bending.
+    """
+    if getattr(mesh.params, "incompatible_all", False):
+        return np.ones(mesh.hexes.shape[0], dtype=bool)
+    return mesh.fine & ~((mesh.region == 1) & (mesh.layer == 0))
+
+
 def tire_elements(mesh: AircraftMesh) -> list[str]:
-    """The tire's ``*ELEMENT`` cards (set TIRE), C3D8I or C3D8 by region."""
-    # incompatible-mode hexahedra (good in bending) in the refined region around the
-    # patch; plain C3D8 in the coarse upper part, which only carries the inflation, and
-    # in the shoulder rubber: there the incompatible modes of the elements under the
-    # lateral patch edge oscillated without converging once the edge reached them
-    incompatible = mesh.fine & ~((mesh.region == 1) & (mesh.layer == 0))
+    """The tire's ``*ELEMENT`` cards (set TIRE), C3D8I or C3D8 by region (``incompatible_mask``)."""
+    incompatible = incompatible_mask(mesh)
     out: list[str] = []
     for etype, sel in (("C3D8I", incompatible), ("C3D8", ~incompatible)):
         out += cx.element_block(etype, "TIRE", np.flatnonzero(sel) + 1, mesh.hexes[sel])

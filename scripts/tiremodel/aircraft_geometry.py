@@ -54,6 +54,11 @@ class AircraftParams(mg.TireProfile):
     n_crown: int = 7
     n_shoulder: int = 4
     n_side: int = 5
+    # elements through the outer rubber layer (tread and sidewall cover); the carcass has one
+    n_rubber: int = 1
+    # incompatible-mode hexahedra (C3D8I) in every element instead of only the fine region
+    # outside the shoulder rubber (see ``aircraft_deck.incompatible_mask``)
+    incompatible_all: bool = False
     # circumferential layers, per side of the bottom: the first layer spans
     # ``first_deg`` and each next one is ``growth`` times longer up to ``fine_deg``;
     # beyond it ``n_coarse`` layers of geometrically growing size up to 180 deg
@@ -162,7 +167,8 @@ def build_aircraft_mesh(p: AircraftParams, verbose: bool = False) -> AircraftMes
             )
             for layer, (top, bot) in enumerate(((outer, mid), (mid, inner))):
                 corners = [p0[layer], p1[layer], p1[layer + 1], p0[layer + 1]]
-                s = mg.structured_patch(geo, top, l1[layer], bot, l0[layer], corners, counts[k], 1)
+                through = p.n_rubber if layer == 0 else 1
+                s = mg.structured_patch(geo, top, l1[layer], bot, l0[layer], corners, counts[k], through)
                 surfaces.append((s, k, layer))
             prev = (p1, l1)
 

@@ -19,6 +19,9 @@ Base and slide each run as one CalculiX step driven by amplitudes
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+
 from . import aircraft_deck as ad
 from . import ccxdeck as cx
 from . import deck as dk
@@ -26,6 +29,7 @@ from . import rig_deck as rd
 from .meshing import face_lookup
 
 DEFLECTION = 0.088  # m: about the rated load on the rig mesh (see the module docstring)
+WHOLE_DEFLECTION = 0.1023  # m: the whole tire at the static sweep's rated-load deflection
 SLIDE_PATH = 0.30  # m, reference path of a run: the lateral force needs about 0.15 m to build up
 R_REF = 0.30  # m, reference radius that scales the spin (pure spin turns the tire by 1 rad)
 CONTROLS = (
@@ -43,6 +47,14 @@ def road() -> cx.Road:
 
 def model_lines(mesh, title: str, road: cx.Road, cut_refs: int | None = None) -> list[str]:
     """Deck lines of the aircraft tire sector on the road, before boundary conditions and steps."""
+    return model_lines_with(ad.FRICTION, mesh, title, road, cut_refs)
+
+
+def model_lines_with(
+    friction: float, mesh, title: str, road: cx.Road, cut_refs: int | None = None
+) -> list[str]:
+    """``model_lines`` with the Coulomb coefficient ``friction``; 0: frictionless contact (no
+    ``*FRICTION`` card: CalculiX takes only a coefficient > 0 there)."""
     nt, et = mesh.nodes.shape[0], mesh.hexes.shape[0]
     out = ["*HEADING", title]
     out += cx.node_block(mesh.nodes, road)
@@ -52,9 +64,13 @@ def model_lines(mesh, title: str, road: cx.Road, cut_refs: int | None = None) ->
     out += cx.node_sets({"BEAD": (int(n) + 1 for n in mesh.bead_nodes), **cx.tire_road_sets(nt, road)})
     out += cx.contact_surfaces(mesh.hexes, mesh.contact_quads, road, face_lookup(mesh.hexes))
     out += ad.material_lines(mesh)
-    out += dk.cut_equations(mesh, cut_refs)
-    out += cx.contact_pair(ad.CONTACT_SLOPE, ad.CONTACT_TENSION, ad.FRICTION, ad.STICK_SLOPE)
-    return out
+    if dk.cut_nodes(mesh):  # a sector: its cut faces follow the rim (the whole tire has none)
+        out += dk.cut_equations(mesh, cut_refs)
+    pair = cx.contact_pair(ad.CONTACT_SLOPE, ad.CONTACT_TENSION, friction, ad.STICK_SLOPE)
+    if friction == 0.0:
+        k = pair.index("*FRICTION")
+        del pair[k : k + 2]
+    return out + pair
 
 
 AIRCRAFT = rd.RigTire(
@@ -72,3 +88,35 @@ AIRCRAFT = rd.RigTire(
     # on a shared, loaded machine the base took 20 min and the fine mesh's base over 30
     timeout=6 * 3600.0,
 )
+
+#: the whole 360-degree tire (issue 39; mesh kinds ``whole*``): no cut faces, C3D8I everywhere,
+#: two elements through the rubber, pressed by the static sweep's rated-load deflection
+#: (``meshes/aircraft/static_100``: 102.3 mm, 198.6 kN) so that the loads compare directly,
+#: and, in the base, CalculiX's default convergence criteria (force residual 0.005 of the average
+#: nodal force, displacement correction 0.01)
+WHOLE = dataclasses.replace(
+    AIRCRAFT,
+    name="aircraft-whole",
+    deflection=WHOLE_DEFLECTION,
+    controls=("*CONTROLS, PARAMETERS=TIME INCREMENTATION", "4, 8, 9, 16, 10, 4, 0, 10"),
+    # the slides: the sector's relaxed criteria (a node pair at the sliding patch's edge flips in
+    # and out of contact with a residual of a few N to a few hundred N under the defaults)
+    slide_controls=CONTROLS,
+)
+
+
+def tire_for(mesh_kind: str, friction: float | None = None) -> rd.RigTire:
+    """The rig tire of a mesh kind: the whole tire for ``whole*``, else the +-70 degree sector;
+    ``friction``: another Coulomb coefficient for base and runs alike (0: frictionless; the mu = 0
+    check runs, which need a base of their own: give them their own work folder)."""
+    tire = WHOLE if mesh_kind.startswith("whole") else AIRCRAFT
+    if friction is None:
+        return tire
+    if not 0.0 <= friction <= 10.0:
+        raise ValueError(f"friction {friction} outside [0, 10]")
+    return dataclasses.replace(
+        tire,
+        name=f"{tire.name}-mu{friction:g}",
+        friction=friction,
+        model_lines=functools.partial(model_lines_with, friction),
+    )

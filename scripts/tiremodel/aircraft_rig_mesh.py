@@ -63,6 +63,47 @@ MESHES = {
     "test": AircraftRigParams(
         n_crown=2, n_shoulder=1, n_side=2, first_deg=6.0, growth=1.0, fine_deg=30.0, n_coarse=2
     ),
+    # the whole tire (issue 39): 360 degrees, no cut faces, two elements through the rubber
+    # layer; the fine region as the sector's rig mesh, 12 geometrically growing layers per
+    # side from 33 degrees up to the top
+    "whole": AircraftRigParams(
+        n_crown=4,
+        n_shoulder=2,
+        n_side=3,
+        n_rubber=2,
+        incompatible_all=True,
+        first_deg=2.2,
+        growth=1.0,
+        fine_deg=33.0,
+        n_coarse=12,
+        sector_deg=180.0,
+    ),
+    # its convergence partner: 1.5 x the counts along the section and around the fine region
+    "whole-fine": AircraftRigParams(
+        n_crown=6,
+        n_shoulder=3,
+        n_side=4,
+        n_rubber=2,
+        incompatible_all=True,
+        first_deg=1.5,
+        growth=1.0,
+        fine_deg=33.0,
+        n_coarse=12,
+        sector_deg=180.0,
+    ),
+    # the whole tire at the test's size (deck checks and the tiny CalculiX case)
+    "whole-test": AircraftRigParams(
+        n_crown=2,
+        n_shoulder=1,
+        n_side=2,
+        n_rubber=2,
+        incompatible_all=True,
+        first_deg=8.0,
+        growth=1.0,
+        fine_deg=32.0,
+        n_coarse=3,
+        sector_deg=180.0,
+    ),
 }
 
 
@@ -121,7 +162,9 @@ def build_rig_mesh(kind: str = "rig") -> AircraftRigMesh:
     flip = np.array([1.0, -1.0, 1.0])
     ang = _angle_deg(p, nodes)
     sector = max(abs(ang.min()), ang.max())
-    cut = np.flatnonzero(np.abs(np.abs(ang) - sector) < 1e-6)
+    whole = p.sector_deg >= 180.0
+    # the whole tire has no cut faces: its two revolutions were merged at +-180 degrees
+    cut = np.zeros(0, dtype=np.int64) if whole else np.flatnonzero(np.abs(np.abs(ang) - sector) < 1e-6)
     mesh = AircraftRigMesh(
         kind=kind,
         params=p,
@@ -141,7 +184,8 @@ def build_rig_mesh(kind: str = "rig") -> AircraftRigMesh:
             "nodes": int(nodes.shape[0]),
             "hexahedra": int(hexes.shape[0]),
             "contact_faces": int(2 * half.contact_quads.shape[0]),
-            "sector_deg": float(sector),
+            "sector_deg": 180.0 if whole else float(sector),
+            "whole_tire": whole,
             "fine_layers_per_side": len(p.fine_layers()),
             "coarse_layers_per_side": p.n_coarse,
             "section_width_m": p.section_width(),

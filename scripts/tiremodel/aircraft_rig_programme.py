@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import rig_deck as rd
-from .aircraft_rig_deck import AIRCRAFT
+from .aircraft_rig_deck import AIRCRAFT, tire_for
 from .aircraft_rig_mesh import build_rig_mesh
 from .rig_programme import run_name
 
@@ -73,11 +73,13 @@ class Setup:
     work: str
     inc: float
     path: float = AIRCRAFT.slide_path
+    friction: float | None = None  # Coulomb coefficient of base and slides (None: the tire's 0.3)
 
     @property
     def tire(self) -> rd.RigTire:
-        """The aircraft rig tire with this set-up's reference path (the base does not depend on it)."""
-        return dataclasses.replace(AIRCRAFT, slide_path=self.path)
+        """The mesh's rig tire (``tire_for``, with this set-up's friction) and reference path (the
+        base does not depend on the path)."""
+        return dataclasses.replace(tire_for(self.mesh_kind, self.friction), slide_path=self.path)
 
 
 @functools.lru_cache(maxsize=4)
@@ -94,8 +96,8 @@ def base_task(setup: Setup, mesh):
     from .solve import find_ccx
 
     exe, work = find_ccx(), Path(setup.work)
-    rim_travel, clearance, _ = inflation_rim_travel(mesh, work, exe, AIRCRAFT)
-    return rim_travel, clearance, solve_base(mesh, rim_travel, work / "base", exe, AIRCRAFT)
+    rim_travel, clearance, _ = inflation_rim_travel(mesh, work, exe, setup.tire)
+    return rim_travel, clearance, solve_base(mesh, rim_travel, work / "base", exe, setup.tire)
 
 
 def run_deck_sha256(setup: Setup, spec: RunSpec, rim_travel: float, base_sha: str) -> str:
@@ -124,8 +126,8 @@ def run_task(setup: Setup, spec: RunSpec, info: dict, mesh) -> dict[str, bytes]:
     from .solve import find_ccx
 
     exe, work = find_ccx(), Path(setup.work)
-    rim_travel, _, _ = inflation_rim_travel(mesh, work, exe, AIRCRAFT)
-    base = solve_base(mesh, rim_travel, work / "base", exe, AIRCRAFT)
+    rim_travel, _, _ = inflation_rim_travel(mesh, work, exe, setup.tire)
+    base = solve_base(mesh, rim_travel, work / "base", exe, setup.tire)
     kin = rd.kinematics(spec.direction, spec.angle, spec.sign, setup.tire)
     res = solve_run(mesh, base, spec.name, kin, rim_travel, work / spec.name, exe, setup.inc, setup.tire)
     extra = {"direction_deg": spec.direction, "spin_angle_deg": spec.angle, "spin_sign": spec.sign}
@@ -198,8 +200,8 @@ def model_info(mesh, setup: Setup, rim_travel: float, clearance: float, solver: 
     from .aircraft_export import model_description
 
     hexes = mesh.hexes.shape[0]
-    incompatible = int((mesh.fine & ~((mesh.region == 1) & (mesh.layer == 0))).sum())
-    return {
+    incompatible = int(ad.incompatible_mask(mesh).sum())
+    info = {
         "solver": solver,
         "mesh": {
             "name": f"aircraft-{setup.mesh_kind}",
@@ -218,19 +220,45 @@ def model_info(mesh, setup: Setup, rim_travel: float, clearance: float, solver: 
         "model": {
             **model_description(mesh),
             "rim": "rigid: the bead nodes prescribed (inflation, vertical travel, the rig's rigid motion)",
-            "deflection": AIRCRAFT.deflection,
+            "deflection": setup.tire.deflection,
             "rim_travel_z": round(rim_travel, 9),
             "inflated_clearance": round(clearance, 9),
             "inflation_pressure": ad.PRESSURE,
             "rated_load": ad.RATED_LOAD,
             "road": "rigid body (*RIGID BODY), held at its reference and rotation nodes; the rim moves",
             "slide_path": setup.path,
-            "r_ref": AIRCRAFT.r_ref,
+            "r_ref": setup.tire.r_ref,
             "max_increment": setup.inc,
             "slide_steps": rd.substeps(setup.inc),
-            "convergence": "CalculiX field controls 0.02 (force residual), 0.5 (displacement correction)",
+            "convergence": _convergence(setup.tire),
         },
     }
+    if mesh.info.get("whole_tire"):
+        info["mesh"]["whole_tire"] = True
+        info["mesh"]["n_rubber"] = mesh.params.n_rubber
+        info["model"]["rim"] = (
+            "rigid: the bead nodes prescribed (inflation, vertical travel, the rig's rigid motion); "
+            "the whole 360-degree tire, no cut faces"
+        )
+    if setup.friction is not None:
+        info["model"]["friction"] = setup.friction
+    return info
+
+
+def _criteria(controls: tuple[str, ...]) -> str:
+    """The field controls of ``controls``, in words."""
+    field = [ln for i, ln in enumerate(controls[1:], 1) if controls[i - 1].endswith("FIELD")]
+    if field:
+        r, c = (v.strip() for v in field[0].split(",")[:2])
+        return f"CalculiX field controls {r} (force residual), {c} (displacement correction)"
+    return "CalculiX's default field controls: 0.005 (force residual), 0.01 (displacement correction)"
+
+
+def _convergence(tire: rd.RigTire) -> str:
+    """The convergence criteria of the tire's steps, in words (base and slides apart if they differ)."""
+    if tire.slide_controls is None or tire.slide_controls == tire.controls:
+        return _criteria(tire.controls)
+    return f"base: {_criteria(tire.controls)}; slides: {_criteria(tire.slide_controls)}"
 
 
 def run_programme(
@@ -240,6 +268,7 @@ def run_programme(
     mesh_kind: str = "rig",
     inc: float = 0.1,
     path: float = AIRCRAFT.slide_path,
+    friction: float | None = None,
     only: list[str] | None = None,
     workers: int | None = 2,
     scheduler: str | None = None,
@@ -253,10 +282,11 @@ def run_programme(
     from .solve import ccx_version, find_ccx
 
     exe = find_ccx()
-    setup = Setup(mesh_kind, str(work.resolve()), inc, path)
+    setup = Setup(mesh_kind, str(work.resolve()), inc, path, friction)
     specs = programme()
     if only:
-        unknown = sorted(set(only) - {s.name for s in specs})
+        # "static": the base and its static map (always solved and written) without any run
+        unknown = sorted(set(only) - {s.name for s in specs} - {"static"})
         if unknown:
             raise ValueError(f"--only: unknown run(s) {', '.join(unknown)}")
         specs = [s for s in specs if s.name in only]
@@ -271,7 +301,7 @@ def run_programme(
         shared = client.scatter(mesh, broadcast=True)
         rim_travel, clearance, base = client.submit(base_task, setup, shared, pure=False).result()
         _log(
-            f"base (inflation + {AIRCRAFT.deflection * 1e3:.1f} mm): "
+            f"base (inflation + {setup.tire.deflection * 1e3:.1f} mm): "
             f"load {base.static_load[2] / 1e3:.1f} kN, "
             f"{(base.static_cpress > 0).sum()} loaded nodes, solve {base.runtime_s:.0f} s "
             f"(wall {time.perf_counter() - t0:.0f} s)"
@@ -279,7 +309,7 @@ def run_programme(
         info = model_info(mesh, setup, rim_travel, clearance, ccx_version(exe))
         static = out / "static.json"
         if not static.exists() or json.loads(static.read_text()).get("base_deck_sha256") != base.deck_sha256:
-            write_static(mesh, base, out, {**info, "base_deck_sha256": base.deck_sha256}, tire=AIRCRAFT)
+            write_static(mesh, base, out, {**info, "base_deck_sha256": base.deck_sha256}, tire=setup.tire)
         shas = {s.name: run_deck_sha256(setup, s, rim_travel, base.deck_sha256) for s in specs}
         n = len(specs)
 

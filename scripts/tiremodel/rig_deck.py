@@ -90,6 +90,8 @@ class RigTire:
     friction: float = dk.FRICTION
     one_step: bool = False  # base and slide each one step, driven by amplitudes (below)
     timeout: float = 1800.0  # s, wall time allowed to one CalculiX run
+    # the slides' lines instead of ``controls`` (None: the same as the base's)
+    slide_controls: tuple[str, ...] | None = None
 
     @property
     def slide_start(self) -> float:
@@ -151,10 +153,11 @@ class RigNodes:
     ref_xy: tuple[float, float]  # m, reference position of the reference node (z = 0)
 
 
-def _static(w, tire: RigTire, inc: str) -> None:
+def _static(w, tire: RigTire, inc: str, slide: bool = False) -> None:
     w("*STATIC")
     w(inc)
-    for line in tire.controls:
+    lines = tire.slide_controls if slide and tire.slide_controls is not None else tire.controls
+    for line in lines:
         w(line)
 
 
@@ -205,7 +208,8 @@ def write_base_deck(
     w("REFN, 1, 3")
     w("ROTN, 1, 3")
     w("BEAD, 1, 3")
-    w("CUTREF, 1, 3")
+    if dk.cut_nodes(mesh):
+        w("CUTREF, 1, 3")
     table = face_lookup(mesh.hexes)
     if tire.one_step:
         _one_step_base(out, mesh, rim_travel, tire, inflation_only)
@@ -225,8 +229,7 @@ def write_base_deck(
     w("*STEP, NLGEOM, INC=400")
     _static(w, tire, vertical_inc or tire.vertical_inc)
     w("*BOUNDARY")
-    w(f"BEAD, 3, 3, {-rim_travel:.9e}")
-    w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
+    _rim_z(w, mesh, rim_travel)
     _outputs(w, 1000)
     w("*RESTART, WRITE, FREQUENCY=1")
     w("*END STEP")
@@ -253,14 +256,20 @@ def _one_step_base(out: list[str], mesh: TireMesh, rim_travel: float, tire: RigT
     first, _, smallest, largest = (v.strip() for v in tire.vertical_inc.split(","))
     _static(w, tire, f"{first}, {t0 if inflation_only else t1}, {smallest}, {largest}")
     w("*BOUNDARY, AMPLITUDE=ARIMZ")
-    w(f"BEAD, 3, 3, {-rim_travel:.9e}")
-    w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
+    _rim_z(w, mesh, rim_travel)
     w("*DLOAD, AMPLITUDE=APRESS")
     out += cx.pressure_load(mesh.hexes, mesh.inner_quads, tire.pressure, face_lookup(mesh.hexes))
     _outputs(w, 1000)
     if not inflation_only:
         w("*RESTART, WRITE, FREQUENCY=1")
     w("*END STEP")
+
+
+def _rim_z(w, mesh: TireMesh, rim_travel: float) -> None:
+    """The rim's vertical travel on the bead nodes and, for a sector, the cut faces' reference nodes."""
+    w(f"BEAD, 3, 3, {-rim_travel:.9e}")
+    if dk.cut_nodes(mesh):
+        w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
 
 
 def tire_motion(kin: Kinematics, origin: tuple[float, float], t: float) -> tuple[float, np.ndarray]:
@@ -315,7 +324,7 @@ def write_slide_deck(
     pos = np.vstack([mesh.nodes[bead, :2], mesh.nodes[cut, :2]])
     xy1 = np.column_stack([pos, np.ones(len(numbers))])
     if tire.one_step:
-        _one_step_slide(path, kin, origin, k, numbers, xy1, rim_travel, tire)
+        _one_step_slide(path, kin, origin, k, numbers, xy1, rim_travel, tire, bool(cut))
         return
     out = ["*RESTART, READ, STEP=2"]
     w = out.append
@@ -323,20 +332,21 @@ def write_slide_deck(
         _, a = tire_motion(kin, origin, i * dt)
         u = xy1 @ a.T - xy1[:, :2]
         w("*STEP, NLGEOM, INC=400")
-        _static(w, tire, f"{dt / 2 if i == 1 else dt:.6g}, {dt:.6g}, 1e-8, {dt:.6g}")
+        _static(w, tire, f"{dt / 2 if i == 1 else dt:.6g}, {dt:.6g}, 1e-8, {dt:.6g}", slide=True)
         w("*BOUNDARY")
         for n, (ux, uy) in zip(numbers, u, strict=True):
             w(f"{n}, 1, 1, {ux:.12e}")
             w(f"{n}, 2, 2, {uy:.12e}")
-        w(f"BEAD, 3, 3, {-rim_travel:.9e}")
-        w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
+        _rim_z(w, mesh, rim_travel)
         _outputs(w, 1)
         w("*END STEP")
     with open(path, "w") as fh:
         fh.write("\n".join(out) + "\n")
 
 
-def _one_step_slide(path, kin: Kinematics, origin, k: int, numbers, xy1, rim_travel: float, tire: RigTire):
+def _one_step_slide(
+    path, kin: Kinematics, origin, k: int, numbers, xy1, rim_travel: float, tire: RigTire, cuts: bool = True
+):
     """The slide as one step: each rim node and cut-face reference node follows its own
     piecewise-linear amplitude through the exact rigid positions at t = i / k (the chords
     of ``write_slide_deck``'s steps), so the first-increment failure of a new step
@@ -357,13 +367,14 @@ def _one_step_slide(path, kin: Kinematics, origin, k: int, numbers, xy1, rim_tra
     # the first increment starts small: at dt / 2 the aircraft tire's first iteration diverged
     # (the stick predictor of the whole patch against a rim move of several mm) and CalculiX
     # cut back five or six times to a few 1e-5 before it converged
-    _static(w, tire, f"{FIRST_SLIDE_INC:.6g}, 1.0, 1e-8, {dt:.6g}")
+    _static(w, tire, f"{FIRST_SLIDE_INC:.6g}, 1.0, 1e-8, {dt:.6g}", slide=True)
     for n, dof, name in names:
         w(f"*BOUNDARY, AMPLITUDE={name}")
         w(f"{n}, {dof}, {dof}, 1.0")
     w("*BOUNDARY")
     w(f"BEAD, 3, 3, {-rim_travel:.9e}")
-    w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
+    if cuts:
+        w(f"CUTREF, 3, 3, {-rim_travel:.9e}")
     _outputs(w, 1)
     w("*END STEP")
     with open(path, "w") as fh:

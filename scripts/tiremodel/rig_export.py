@@ -160,6 +160,7 @@ def write_static(mesh: TireMesh, res: RunResult, out: Path, info: dict, tire: rd
             [quad_integral(x, quads, cp * x[:, 0]) / n, quad_integral(x, quads, cp * x[:, 1]) / n], 4
         ),
         "friction": tire.friction,
+        **_static_extra(mesh, res, tire),
         "arrays": STATIC_ARRAYS,
         "points": "reference (undeformed) coordinates of the contact faces (crown and shoulder "
         "within the refined sector), m; road plane z = 0, x rolling direction, y axle",
@@ -187,6 +188,66 @@ def _history_block(res: RunResult, origin, r_ref: float) -> dict:
         "sqrt(|v|^2 + (wz R_ref)^2) t (m, R_ref = rig reference radius); Fx, Fy: road's force "
         "on the tire in the tire's frame (N); Mz about the (moved) static patch origin (N m); "
         "tire_rotation: the rim's rotation wz t (rad)",
+    }
+
+
+#: the sidecars' note on the rim's force
+RIM_NOTE = (
+    "N, road's frame: road_force = the rigid road's reference-node reaction (the road's force on the "
+    "tire); rim_force = CalculiX's total RF of the rim (bead) nodes, which includes the cavity "
+    "pressure applied at those nodes; rim_pressure_load = that pressure load (the consistent nodal "
+    "load of the follower pressure on the deformed cavity faces at the bead nodes, 2 x 2 Gauss, "
+    "exact for the bilinear faces). The tire's equilibrium: road_force + rim_force - "
+    "rim_pressure_load = 0 (the cavity pressure's total is zero)"
+)
+_GAUSS = (-1.0 / math.sqrt(3.0), 1.0 / math.sqrt(3.0))
+
+
+def bead_pressure_load(mesh: TireMesh, u: np.ndarray, pressure: float) -> np.ndarray:
+    """(3,) N: the follower pressure's consistent nodal load at the bead nodes (force on the tire),
+    on the cavity faces deformed by ``u``: -p sum_faces sum_gauss N_i (dx/dxi x dx/deta)."""
+    x = mesh.nodes + u[: mesh.nodes.shape[0]]
+    bead = np.zeros(mesh.nodes.shape[0], dtype=bool)
+    bead[np.asarray(mesh.bead_nodes, dtype=np.int64)] = True
+    quads = mesh.inner_quads[bead[mesh.inner_quads].any(axis=1)]
+    total = np.zeros(3)
+    xi = np.array([-1.0, 1.0, 1.0, -1.0])
+    eta = np.array([-1.0, -1.0, 1.0, 1.0])
+    for q in quads:
+        xq = x[q]
+        for a in _GAUSS:
+            for b in _GAUSS:
+                shape = 0.25 * (1 + xi * a) * (1 + eta * b)
+                n = np.cross(0.25 * (xi * (1 + eta * b)) @ xq, 0.25 * (eta * (1 + xi * a)) @ xq)
+                total += (shape * bead[q]).sum() * n
+    # the faces are oriented out of the solid (into the cavity): the pressure pushes against n
+    return -pressure * total
+
+
+def _static_extra(mesh: TireMesh, base, tire: rd.RigTire) -> dict:
+    """The whole tire's base (no cut faces: the rim carries the road's load alone): the rim's
+    total reaction and, where measured, the solver's CPU time."""
+    out: dict = {}
+    rim = getattr(base, "static_rim_force", None)
+    if rim is not None and getattr(mesh, "info", {}).get("whole_tire"):
+        out["road_force"] = _vec(base.static_load)
+        out["rim_force"] = _vec(rim)
+        out["rim_pressure_load"] = _vec(bead_pressure_load(mesh, base.static_u, tire.pressure))
+        out["rim_force_note"] = "end of the vertical step, " + RIM_NOTE
+        if getattr(base, "cpu_s", None) is not None:
+            out["base_cpu_s"] = round(base.cpu_s, 1)
+    return out
+
+
+def _cpu_block(res: RunResult) -> dict:
+    """The solver's CPU times (user + system, s) where they were measured (none: nothing)."""
+    if res.cpu_s is None:
+        return {}
+    return {
+        "cpu_s": round(res.cpu_s, 1),
+        "base_cpu_s": None if res.base_cpu_s is None else round(res.base_cpu_s, 1),
+        "cpu_s_note": "CPU time (user + system) of this run's CalculiX solve and of the shared "
+        "base's, measured by os.wait4 on the solver process; one thread",
     }
 
 
@@ -223,6 +284,14 @@ def write_run(
             "force": _vec(f),
             "moment": _vec(h.rot_rf[-1]),
             "rim_force": _vec(h.bead_rf[-1]),
+            **(
+                {
+                    "rim_pressure_load": _vec(bead_pressure_load(mesh, res.u, tire.pressure)),
+                    "rim_force_note": "end of the slide, " + RIM_NOTE,
+                }
+                if getattr(mesh, "info", {}).get("whole_tire")
+                else {}
+            ),
             "time": _num(h.time[-1] + tire.slide_start, 7),
             "source": f"CalculiX .dat, last increment of the slide step ({res.name}.dat.txt): RF of "
             "the rigid road's reference node (force) and rotation node (moment)",
@@ -252,6 +321,7 @@ def write_run(
         "runtime_s_note": "wall time of this run's CalculiX solve (the slide, restarted from the "
         "shared base run of inflation and vertical load, whose wall time is base_runtime_s); one "
         "thread, nice 10, on a shared 2-core machine",
+        **_cpu_block(res),
         **info,
     }
     _write_text(out / f"{res.name}.json", json.dumps(side, indent=2) + "\n")

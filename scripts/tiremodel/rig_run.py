@@ -50,6 +50,8 @@ class Base:
     static_u: np.ndarray  # (n_tire, 3) m
     runtime_s: float
     deck_sha256: str
+    cpu_s: float | None = None  # the solver's CPU time (user + system), where it was measured
+    static_rim_force: np.ndarray | None = None  # (3,) N, total reaction on the rim, end of the base
 
 
 @dataclass(frozen=True)
@@ -67,6 +69,8 @@ class RunResult:
     base_runtime_s: float
     deck_sha256: str
     dat_excerpt: str  # the .dat records of the last slide increment, verbatim
+    cpu_s: float | None = None  # the run's CPU time (user + system), where it was measured
+    base_cpu_s: float | None = None
 
 
 def inflation_rim_travel(
@@ -101,8 +105,16 @@ def _solve_once(exe: str, inp: Path, key: str, timeout: float = 1800.0) -> float
         return float(stamp.read_text().split()[1])
     stamp.unlink(missing_ok=True)
     t = run_ccx(exe, inp, threads=1, timeout=timeout)
-    stamp.write_text(f"{digest} {t:.1f}\n")
+    cpu = inp.with_suffix(".cpu")
+    stamp.write_text(f"{digest} {t:.1f}" + (f" {cpu.read_text().strip()}" if cpu.exists() else "") + "\n")
     return t
+
+
+def cpu_of(inp: Path) -> float | None:
+    """The CPU seconds of a finished solve of ``inp`` (its stamp's third field), if measured."""
+    stamp = inp.with_suffix(".done")
+    fields = stamp.read_text().split() if stamp.exists() else []
+    return float(fields[2]) if len(fields) > 2 else None
 
 
 def _nodal(mesh: TireMesh, frd: Path, step: int | None = None):
@@ -133,6 +145,11 @@ def solve_base(
     contact, u = _nodal(mesh, inp.with_suffix(".frd"), 1 if tire.one_step else 2)
     recs = [r for r in read_dat_blocks(inp.with_suffix(".dat")) if r[0] == "forces" and r[1] == "REFN"]
     load = next(arr[-1, -3:] for _, _, t_, arr in recs if abs(t_ - tire.slide_start) < 1e-9)
+    rim = [
+        r[3][-1, -3:]
+        for r in read_dat_blocks(inp.with_suffix(".dat"))
+        if r[0] == "total force" and r[1] == "BEAD" and abs(r[2] - tire.slide_start) < 1e-9
+    ]
     return Base(
         nodes=nodes,
         restart=inp.with_suffix(".rout"),
@@ -141,6 +158,8 @@ def solve_base(
         static_u=u,
         runtime_s=t,
         deck_sha256=hashlib.sha256(inp.read_bytes()).hexdigest(),
+        cpu_s=cpu_of(inp),
+        static_rim_force=rim[-1] if rim else None,
     )
 
 
@@ -208,4 +227,6 @@ def solve_run(
         base_runtime_s=base.runtime_s,
         deck_sha256=hashlib.sha256(inp.read_bytes() + base.deck_sha256.encode()).hexdigest(),
         dat_excerpt=_excerpt(inp.with_suffix(".dat")),
+        cpu_s=cpu_of(inp),
+        base_cpu_s=base.cpu_s,
     )

@@ -43,6 +43,8 @@ def ccx_version(exe: str) -> str:
 def run_ccx(exe: str, inp: Path, threads: int = 2, timeout: float = 1800.0, niceness: int = 0) -> float:
     """Run ``ccx -i <job>`` in the deck's folder; return the wall time (s).
 
+    The solver's CPU time (user + system, s) is written beside the deck as ``<job>.cpu``.
+
     ``threads``: OpenMP and equation-solver threads; ``niceness`` > 0 starts
     ccx through ``nice -n``. The solver's output goes to ``<job>.log``; raises
     ModelError on a timeout, a non-zero exit, an ``*ERROR`` line or a run that
@@ -55,22 +57,39 @@ def run_ccx(exe: str, inp: Path, threads: int = 2, timeout: float = 1800.0, nice
         cmd = ["nice", "-n", str(niceness), *cmd]
     t0 = time.perf_counter()
     log = inp.with_suffix(".log")
-    try:
-        with open(log, "w") as fh:
-            proc = subprocess.run(
-                cmd, cwd=inp.parent, stdout=fh, stderr=subprocess.STDOUT, env=env, timeout=timeout
-            )
-    except subprocess.TimeoutExpired as exc:
-        raise ModelError(f"ccx run {job.name} exceeded {timeout:.0f} s") from exc
+    with open(log, "w") as fh:
+        proc = subprocess.Popen(cmd, cwd=inp.parent, stdout=fh, stderr=subprocess.STDOUT, env=env)
+        returncode, cpu = _wait_cpu(proc, timeout)
+    if returncode is None:
+        raise ModelError(f"ccx run {job.name} exceeded {timeout:.0f} s")
     dt = time.perf_counter() - t0
+    inp.with_suffix(".cpu").write_text(f"{cpu:.1f}\n")
     text = log.read_text(errors="replace")
-    if "*ERROR" in text or proc.returncode != 0 or "Job finished" not in text:
+    if "*ERROR" in text or returncode != 0 or "Job finished" not in text:
         msg = next((ln.strip() for ln in text.splitlines() if "*ERROR" in ln), "")
         raise ModelError(
-            f"ccx run {job.name} did not converge or failed (exit {proc.returncode}) {msg}; "
-            f"see {log}".replace("  ", " ")
+            f"ccx run {job.name} did not converge or failed (exit {returncode}) {msg}; see {log}".replace(
+                "  ", " "
+            )
         )
     return dt
+
+
+def _wait_cpu(proc: subprocess.Popen, timeout: float) -> tuple[int | None, float]:
+    """(exit status, user + system CPU seconds) of ``proc``; (None, CPU) after killing it on a
+    timeout. The CPU time is the solver's own (``os.wait4``; ``nice`` execs ccx in place)."""
+    t0 = time.perf_counter()
+    while True:
+        pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
+        if pid:
+            proc.returncode = os.waitstatus_to_exitcode(status)
+            return proc.returncode, usage.ru_utime + usage.ru_stime
+        if time.perf_counter() - t0 > timeout:
+            proc.kill()
+            _, status, usage = os.wait4(proc.pid, 0)
+            proc.returncode = os.waitstatus_to_exitcode(status)
+            return None, usage.ru_utime + usage.ru_stime
+        time.sleep(0.2)
 
 
 @dataclass
