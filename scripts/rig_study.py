@@ -88,8 +88,9 @@ def _runs(rig: Path) -> list[Path]:
     return out
 
 
-def predictions(rig: Path, runs: list[Path], friction: float):
-    """FE table, static analysis, a dict model -> (n, 3) predicted (Fx, Fy, Mz) and the runs' maps."""
+def predictions(rig: Path, runs: list[Path], friction: float, tick=None):
+    """FE table, static analysis, a dict model -> (n, 3) predicted (Fx, Fy, Mz) and the runs' maps;
+    ``tick()`` is called after each run's own map (the progress line's dots)."""
     from fepost.analysis import analyse
     from fepost.friction.exact import friction_resultants
     from fepost.friction.law import FrictionLaw
@@ -118,6 +119,8 @@ def predictions(rig: Path, runs: list[Path], friction: float):
         q = friction_resultants(PressureQuadrature.from_polar(a.rolling_map), vx[i], vy[i], wz[i], law)
         own.append([float(q.Fx[()]), float(q.Fy[()]), float(q.Mz[()])])
         shifts.append(np.array(a.rolling_moments.centroid) - c0)
+        if tick is not None:
+            tick()
     out["own"] = np.array(own)
     return table, static, out, np.array(shifts)
 
@@ -525,6 +528,11 @@ class _Progress:
         print(f" done in {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
         return value
 
+    @staticmethod
+    def tick() -> None:
+        """One dot on the current step's line (one unit of its work done)."""
+        print(".", end="", file=sys.stderr, flush=True)
+
 
 def output_folder(rig: Path, out: Path | None, update: bool) -> Path:
     """Where the study writes: ``--out``, the tracked folder with ``--update``, else
@@ -562,7 +570,12 @@ def main(argv=None) -> int:
         return 2
     step = _Progress(8)
     table, static, preds, shifts = step(
-        f"predictions (a)-(d) over {len(runs)} runs", predictions, args.rig, runs, args.friction
+        f"predictions (a)-(d) over {len(runs)} runs, a dot per run's own map",
+        predictions,
+        args.rig,
+        runs,
+        args.friction,
+        step.tick,
     )
     ext, shift_law = step(
         "load-transfer extension (e), held out by direction", extension, table, static, shifts, args.friction
