@@ -29,6 +29,7 @@ from .patch import Patch, build_patch
 from .polar import PolarGrid, PolarMap
 from .reader import isolate, start_reading
 from .reader.units import describe
+from .refine import refined_map
 from .resample import resample
 
 
@@ -227,6 +228,15 @@ def _check_resampling(patch: Patch, mom: Moments) -> None:
         )
 
 
+def _default_grid(options: AnalysisOptions) -> bool:
+    """Whether the analysis runs on the library's default polar grid, which `fepost.refine`
+    refines where a map's pressure is when it misses the map's load or polar moment (a grid
+    the caller chose is kept, with the warning of `_check_resampling`)."""
+    from .polar import DEFAULT_NPHI, DEFAULT_NR
+
+    return (options.nr, options.nphi, options.rule) == (DEFAULT_NR, DEFAULT_NPHI, "gauss")
+
+
 def _warm_up() -> None:
     """Import, while the files are read, what the results need later: the generalised model
     (`Analysis.model_summary`, in `Analysis.to_dict` by default)."""
@@ -323,6 +333,9 @@ def _pipeline(pending, *, with_rolling: bool, friction: float, options: Analysis
     _check_reaction(sf, sp)
     sm = resample(sp, grid, radius=sp.r_max)
     smo = moments(sm)
+    refine = _default_grid(options)  # a map the default grid misses: refined where its pressure is
+    if refine:
+        sm, smo = refined_map(sp, sm, smo)
     _check_resampling(sp, smo)
     rf = rp = rm = rmo = None
     if with_rolling:
@@ -332,6 +345,8 @@ def _pipeline(pending, *, with_rolling: bool, friction: float, options: Analysis
         r_roll = float(np.max(np.hypot(rp.xy[:, 0], rp.xy[:, 1])))
         rm = resample(rp, grid, radius=max(sp.r_max, r_roll))
         rmo = moments(rm)
+        if refine:
+            rm, rmo = refined_map(rp, rm, rmo)
         _check_resampling(rp, rmo)
     coef = coefficients_from_moments(smo, rmo, friction=friction)
     return Analysis(sf, sp, sm, smo, coef, rf, rp, rm, rmo, options=options)
