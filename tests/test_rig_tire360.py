@@ -99,7 +99,7 @@ def test_whole_decks(whole, tmp_path):
         slide = tmp_path / f"slide{friction}.inp"
         rd.write_slide_deck(slide, whole, rd.kinematics(0.0, 90.0, 1, tire), 0.12, (0.0, 0.0), 0.25, tire)
         text = slide.read_text()
-        assert "CUTREF" not in text and "0.02, 0.5" in text  # the slides' relaxed criteria
+        assert "CUTREF" not in text and "0.02, 0.5" in text  # the sector's relaxed criteria
     assert ard.tire_for("rig") is ard.AIRCRAFT and ard.tire_for("whole") is ard.WHOLE
     with pytest.raises(ValueError, match="friction"):
         ard.tire_for("whole", -0.1)

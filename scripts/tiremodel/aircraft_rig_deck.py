@@ -92,17 +92,12 @@ AIRCRAFT = rd.RigTire(
 #: the whole 360-degree tire (issue 39; mesh kinds ``whole*``): no cut faces, C3D8I everywhere,
 #: two elements through the rubber, pressed by the static sweep's rated-load deflection
 #: (``meshes/aircraft/static_100``: 102.3 mm, 198.6 kN) so that the loads compare directly,
-#: and, in the base, CalculiX's default convergence criteria (force residual 0.005 of the average
-#: nodal force, displacement correction 0.01)
-WHOLE = dataclasses.replace(
-    AIRCRAFT,
-    name="aircraft-whole",
-    deflection=WHOLE_DEFLECTION,
-    controls=("*CONTROLS, PARAMETERS=TIME INCREMENTATION", "4, 8, 9, 16, 10, 4, 0, 10"),
-    # the slides: the sector's relaxed criteria (a node pair at the sliding patch's edge flips in
-    # and out of contact with a residual of a few N to a few hundred N under the defaults)
-    slide_controls=CONTROLS,
-)
+#: and the sector's relaxed convergence criteria (force residual 0.02 of the average nodal force,
+#: displacement correction 0.5): under CalculiX's defaults (0.005, 0.01) the base stalled at 77 mm of
+#: its 102.3 mm deflection, the largest residual flipping between 2.6 and 7.8 N (average nodal
+#: force 381 N) as a patch-edge node went in and out of contact, the incompatible-mode unknowns of
+#: the edge elements moving by 0.8 of their increment, with increments cut to 0.001 of the travel
+WHOLE = dataclasses.replace(AIRCRAFT, name="aircraft-whole", deflection=WHOLE_DEFLECTION)
 
 
 def tire_for(mesh_kind: str, friction: float | None = None) -> rd.RigTire:
