@@ -27,6 +27,18 @@ sliding κV: ψ̇ = ẏ = 0 and (ψ, y) at the equilibrium `equilibrium` finds
 (zero for a map symmetric about x; a rolling map's small asymmetry moves it).
 Since the friction forces depend only on the direction of (v, R wz), the
 equilibrium does not depend on V.
+
+Optional gear terms (`fepost.shimmy.gear`; absent, the equations above hold to
+the last bit):
+
+* strut rake γ: the wheels steer by δ = ψ cos γ about the vertical (δ and δ̇
+  replace ψ and ψ̇ in the kinematics and in the lateral force's projection), and the ground's
+  moment about the tilted strut axis is cos γ times its vertical moment. The
+  camber ψ sin γ and the vertical load's moment on a raked caster are left out.
+* wheel spin: each wheel (spin inertia I_w) turns at Ω = (1 − κ) V / R_e; the
+  lateral bending rolls the axle by φ = s y. The angular momentum I_w Ω along the
+  axle then couples the two degrees of freedom gyroscopically, with
+  G = s Σ_j I_w Ω:  I_ψ ψ̈ = … + G ẏ,  m_y ÿ = … − G ψ̇ (skew: no work).
 """
 
 from __future__ import annotations
@@ -45,6 +57,8 @@ STATE = ("psi", "psi_dot", "y", "y_dot")
 def kinematics(x, V: float, gear: Gear):
     """(vx, vy, wz) of each wheel's contact (arrays over the wheels; complex x allowed)."""
     psi, dpsi, _, dy = x
+    if gear.rake:
+        psi, dpsi = psi * math.cos(gear.rake), dpsi * math.cos(gear.rake)
     c, s = np.cos(psi), np.sin(psi)
     d = np.asarray(gear.offsets)
     vx = V * c + dy * s - dpsi * d - (1.0 - gear.slip_ratio) * V
@@ -55,18 +69,29 @@ def kinematics(x, V: float, gear: Gear):
 
 def loads(x, forces, gear: Gear):
     """(yaw moment about the strut axis, lateral force on the strut) from the wheels' forces."""
-    psi = x[0]
+    psi = x[0] * math.cos(gear.rake) if gear.rake else x[0]
     fx, fy, mz = (np.asarray(f) for f in forces)
     d = np.asarray(gear.offsets)
     moment = np.sum(-gear.trail * fy - d * fx + mz)
+    if gear.rake:
+        moment = moment * math.cos(gear.rake)
     lateral = np.sum(fx * np.sin(psi) + fy * np.cos(psi))
     return moment, lateral
+
+
+def gyroscopic(gear: Gear, V: float) -> float:
+    """G (N m s/m): the wheels' gyroscopic coupling of yaw and lateral bending at speed V."""
+    return gear.gyroscopic * (1.0 - gear.slip_ratio) * V
 
 
 def rhs(x, V: float, gear: Gear, contact):
     """dx/dt for the state ``x`` at speed ``V`` with ``contact(vx, vy, wz) -> (Fx, Fy, Mz)``."""
     psi, dpsi, y, dy = x
     moment, lateral = loads(x, contact(*kinematics(x, V, gear)), gear)
+    g = gyroscopic(gear, V)
+    if g:
+        moment = moment + g * dy
+        lateral = lateral - g * dpsi
     ddpsi = (-gear.torsional_stiffness * psi - gear.torsional_damping * dpsi + moment) / gear.yaw_inertia
     ddy = (-gear.lateral_stiffness * y - gear.lateral_damping * dy + lateral) / gear.lateral_mass
     return np.array([dpsi, ddpsi, dy, ddy])
@@ -123,17 +148,21 @@ def scalar_rhs(gear: Gear, V: float, one):
     offsets = gear.offsets
     slip = (1.0 - kap) * V
     cos, sin = math.cos, math.sin
+    cos_rake, gyro = math.cos(gear.rake), gyroscopic(gear, V)
 
     def f(t, x):
         psi, dpsi, y, dy = x
-        c, s = cos(psi), sin(psi)
+        steer, rate = psi * cos_rake, dpsi * cos_rake
+        c, s = cos(steer), sin(steer)
         bx = V * c + dy * s - slip
-        by = -V * s + dy * c - dpsi * e
+        by = -V * s + dy * c - rate * e
         moment = lateral = 0.0
         for d in offsets:
-            fx, fy, mz = one(bx - dpsi * d, by, dpsi)
+            fx, fy, mz = one(bx - rate * d, by, rate)
             moment += -e * fy - d * fx + mz
             lateral += fx * s + fy * c
+        moment = moment * cos_rake + gyro * dy
+        lateral -= gyro * dpsi
         return [
             dpsi,
             (-k_psi * psi - c_psi * dpsi + moment) / i_psi,

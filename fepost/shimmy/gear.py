@@ -17,7 +17,28 @@ model they enter):
 ``half_track``           m         lateral offset of each twin wheel from the strut axis
 ``slip_ratio``           –         κ in (0, 1]: the steady longitudinal sliding speed is κV
                                    (1 = locked wheel at touchdown; small = nearly spun up)
+``wheel_spin_inertia``   kg m²     I_w: one wheel-tire-brake assembly about its axle (0: no
+                                   gyroscopic coupling); needs ``rolling_radius``
+``rolling_radius``       m         R_e: the wheel turns at Ω = (1 − κ) V / R_e
+``bending_slope``        rad/m     s: roll of the axle per metre of lateral bending (φ = s y;
+                                   1.5/L for a cantilever strut of length L)
+``rake``                 rad       γ: tilt of the strut axis from the vertical (0: vertical)
+``tire_stiffness_x``     N/m       the tire's tangential stiffness against the road, along x
+``tire_stiffness_y``     N/m       … along y (the brush tire, `fepost.shimmy.brush`)
+``tire_deflection``      m         the tire's vertical deflection under its full load (touchdown)
 =======================  ========  ==============================================
+
+The last three serve the gripping tire and the touchdown (`fepost.shimmy.touchdown`).
+The four before them are optional and default to 0, which leaves the equations as they
+were (no gyroscopic coupling, vertical strut). With them the wheels' spin couples
+yaw and lateral bending gyroscopically, G = s Σ I_w Ω (`fepost.shimmy.equations`),
+and a raked strut steers the wheels by ψ cos γ and takes the ground's moment
+about its axis times cos γ.
+
+Refused besides: twin wheels without a ``half_track`` (they would sit on the strut
+axis, one on the other), and inertias or masses outside `INERTIA_RANGE` or whose mode
+with the gear's stiffness lies above `MAX_MODE_HZ` (a typo of a few orders of
+magnitude, which would make the time integration crawl or blow up).
 
 Optional: ``name`` (text), ``sources`` (an object: parameter name → where the value
 comes from), ``notes`` (text). Every problem is one `GearFileError` line naming the
@@ -48,9 +69,38 @@ PARAMETERS: dict[str, tuple[str, bool]] = {
     "wheels": ("count", False),
     "half_track": ("m", True),
     "slip_ratio": ("", False),
+    "wheel_spin_inertia": ("kg m^2", True),
+    "rolling_radius": ("m", True),
+    "bending_slope": ("rad/m", True),
+    "rake": ("rad", True),
+    "tire_stiffness_x": ("N/m", True),
+    "tire_stiffness_y": ("N/m", True),
+    "tire_deflection": ("m", True),
 }
 #: Optional keys besides the parameters.
 OPTIONAL = ("name", "sources", "notes")
+#: Parameters a gear file may leave out (defaults in `Gear`).
+DEFAULTED = (
+    "wheels",
+    "half_track",
+    "slip_ratio",
+    "wheel_spin_inertia",
+    "rolling_radius",
+    "bending_slope",
+    "rake",
+    "tire_stiffness_x",
+    "tire_stiffness_y",
+    "tire_deflection",
+)
+#: Plausible range of an inertia (kg m²) or modal mass (kg) of a landing gear, SI.
+INERTIA_RANGE = (1e-4, 1e7)
+#: Highest plausible frequency (Hz) of the gear's torsional or lateral mode.
+MAX_MODE_HZ = 2000.0
+#: Inertias with the stiffness their mode needs and that mode's name.
+_MODES = (
+    ("yaw_inertia", "torsional_stiffness", "torsional"),
+    ("lateral_mass", "lateral_stiffness", "lateral bending"),
+)
 
 
 class GearFileError(FepostError, ValueError):
@@ -71,6 +121,13 @@ class Gear:
     wheels: int = 1
     half_track: float = 0.0
     slip_ratio: float = 1.0
+    wheel_spin_inertia: float = 0.0
+    rolling_radius: float = 0.0
+    bending_slope: float = 0.0
+    rake: float = 0.0
+    tire_stiffness_x: float = 0.0
+    tire_stiffness_y: float = 0.0
+    tire_deflection: float = 0.0
     name: str = ""
     sources: Any = field(default_factory=dict)
     notes: str = ""
@@ -82,9 +139,30 @@ class Gear:
             raise GearFileError(f"Gear: wheels must be 1 or 2, got {self.wheels!r}")
         if self.wheels == 1 and self.half_track != 0.0:
             raise GearFileError("Gear: half_track must be 0 with one wheel (it sits on the strut axis)")
+        if self.wheels == 2 and self.half_track == 0.0:
+            raise GearFileError(
+                "Gear: twin wheels (wheels = 2) need half_track > 0, the offset of each wheel"
+            )
         if self.slip_ratio > 1.0:
             raise GearFileError(f"Gear: slip_ratio must be in (0, 1], got {self.slip_ratio!r}")
+        if self.wheel_spin_inertia > 0 and self.rolling_radius == 0.0:
+            raise GearFileError(
+                "Gear: wheel_spin_inertia needs rolling_radius > 0 (the wheel's spin is V/R_e)"
+            )
+        if self.rake >= math.pi / 2:
+            raise GearFileError(
+                f"Gear: rake must be below pi/2 rad (a strut tilted to the ground), got {self.rake!r}"
+            )
+        _check_inertias(self)
         object.__setattr__(self, "sources", MappingProxyType(dict(self.sources)))
+
+    @property
+    def gyroscopic(self) -> float:
+        """G / V (N m s/m per m/s): the gyroscopic coupling of yaw and lateral bending per
+        forward speed at zero slip, s Σ I_w / R_e (0 without ``wheel_spin_inertia``)."""
+        if self.wheel_spin_inertia == 0.0 or self.bending_slope == 0.0:
+            return 0.0
+        return self.bending_slope * self.wheels * self.wheel_spin_inertia / self.rolling_radius
 
     @property
     def offsets(self) -> tuple[float, ...]:
@@ -110,6 +188,28 @@ class Gear:
         return out
 
 
+def _check_inertias(g: Gear) -> None:
+    lo, hi = INERTIA_RANGE
+    for key in ("yaw_inertia", "lateral_mass", "wheel_spin_inertia"):
+        value = getattr(g, key)
+        if key == "wheel_spin_inertia" and value == 0.0:
+            continue
+        unit = PARAMETERS[key][0]
+        if not lo <= value <= hi:
+            raise GearFileError(
+                f"Gear: {key} = {value:g} {unit} is outside the plausible range {lo:g} to {hi:g} {unit} "
+                "of a landing gear (SI units?)"
+            )
+    for inertia, stiffness, mode in _MODES:
+        hz = math.sqrt(getattr(g, stiffness) / getattr(g, inertia)) / (2 * math.pi)
+        if hz > MAX_MODE_HZ:
+            raise GearFileError(
+                f"Gear: {inertia} = {getattr(g, inertia):g} {PARAMETERS[inertia][0]} with {stiffness} = "
+                f"{getattr(g, stiffness):g} gives a {mode} mode at {hz:.3g} Hz, above {MAX_MODE_HZ:g} Hz: "
+                f"{inertia} is implausibly small"
+            )
+
+
 def _check_value(value, key: str, where: str) -> None:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise GearFileError(f"{where}: {key} must be a number, got {value!r}")
@@ -133,7 +233,7 @@ def gear_from_dict(data: Any, where: str = "gear") -> Gear:
         close = difflib.get_close_matches(unknown[0], [*PARAMETERS, *OPTIONAL], n=1, cutoff=0.6)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         raise GearFileError(f"{where}: unknown key {unknown[0]!r}{hint} (known: {known})")
-    missing = [k for k in PARAMETERS if k not in ("wheels", "half_track", "slip_ratio") and k not in data]
+    missing = [k for k in PARAMETERS if k not in DEFAULTED and k not in data]
     if missing:
         raise GearFileError(f"{where}: missing key {missing[0]!r}")
     for key in PARAMETERS:
