@@ -10,7 +10,10 @@ carries about 43 % of the load of the 2 mm legs of the planar-sliding block
 the load within 0.5 % but the pure-spin moment ∬ σ r dA 1.3 % off.
 `recommended_grid` tries the grids of `LADDER` in turn and returns the first
 that carries both the load and that moment within `GRID_TOL`: the map command
-prints it and the sidecar records it, for ``--nr``/``--nphi``.
+prints it and the sidecar records it, for ``--nr``/``--nphi``. With the default
+options fepost needs neither: the analysis refines its grid where a map's pressure
+is when the default grid misses it (`fepost.refine`, a tenth of these nodes on the
+legs); the uniform grid recommended here is for a caller who wants one.
 """
 
 from __future__ import annotations
