@@ -69,6 +69,10 @@ PARAMETERS: dict[str, tuple[str, bool]] = {
     "wheels": ("count", False),
     "half_track": ("m", True),
     "slip_ratio": ("", False),
+}
+#: Parameters added for the wheels' spin, the strut's rake, the gripping tire and the touchdown:
+#: optional, 0 when absent (and then left out of `Gear.to_dict`).
+ADDED: dict[str, tuple[str, bool]] = {
     "wheel_spin_inertia": ("kg m^2", True),
     "rolling_radius": ("m", True),
     "bending_slope": ("rad/m", True),
@@ -77,6 +81,7 @@ PARAMETERS: dict[str, tuple[str, bool]] = {
     "tire_stiffness_y": ("N/m", True),
     "tire_deflection": ("m", True),
 }
+ALL_PARAMETERS = {**PARAMETERS, **ADDED}
 #: Optional keys besides the parameters.
 OPTIONAL = ("name", "sources", "notes")
 #: Parameters a gear file may leave out (defaults in `Gear`).
@@ -133,7 +138,7 @@ class Gear:
     notes: str = ""
 
     def __post_init__(self) -> None:
-        for key in PARAMETERS:
+        for key in ALL_PARAMETERS:
             _check_value(getattr(self, key), key, "Gear")
         if self.wheels not in (1, 2):
             raise GearFileError(f"Gear: wheels must be 1 or 2, got {self.wheels!r}")
@@ -179,8 +184,9 @@ class Gear:
     def to_dict(self) -> dict:
         """The parameters with units (the ``gear`` key of shimmy.json)."""
         out: dict[str, Any] = {"name": self.name}
-        for key, (unit, _) in PARAMETERS.items():
-            out[key] = {"value": getattr(self, key), "unit": unit}
+        for key, (unit, _) in ALL_PARAMETERS.items():
+            if key in PARAMETERS or getattr(self, key):
+                out[key] = {"value": getattr(self, key), "unit": unit}
         if self.sources:
             out["sources"] = dict(self.sources)
         if self.notes:
@@ -194,7 +200,7 @@ def _check_inertias(g: Gear) -> None:
         value = getattr(g, key)
         if key == "wheel_spin_inertia" and value == 0.0:
             continue
-        unit = PARAMETERS[key][0]
+        unit = ALL_PARAMETERS[key][0]
         if not lo <= value <= hi:
             raise GearFileError(
                 f"Gear: {key} = {value:g} {unit} is outside the plausible range {lo:g} to {hi:g} {unit} "
@@ -204,7 +210,7 @@ def _check_inertias(g: Gear) -> None:
         hz = math.sqrt(getattr(g, stiffness) / getattr(g, inertia)) / (2 * math.pi)
         if hz > MAX_MODE_HZ:
             raise GearFileError(
-                f"Gear: {inertia} = {getattr(g, inertia):g} {PARAMETERS[inertia][0]} with {stiffness} = "
+                f"Gear: {inertia} = {getattr(g, inertia):g} {ALL_PARAMETERS[inertia][0]} with {stiffness} = "
                 f"{getattr(g, stiffness):g} gives a {mode} mode at {hz:.3g} Hz, above {MAX_MODE_HZ:g} Hz: "
                 f"{inertia} is implausibly small"
             )
@@ -215,7 +221,7 @@ def _check_value(value, key: str, where: str) -> None:
         raise GearFileError(f"{where}: {key} must be a number, got {value!r}")
     if not math.isfinite(value):
         raise GearFileError(f"{where}: {key} must be finite, got {value!r}")
-    zero_ok = PARAMETERS[key][1]
+    zero_ok = ALL_PARAMETERS[key][1]
     if value < 0 or (value == 0 and not zero_ok):
         need = ">= 0" if zero_ok else "> 0"
         raise GearFileError(f"{where}: {key} must be {need}, got {value!r}")
@@ -227,16 +233,16 @@ def gear_from_dict(data: Any, where: str = "gear") -> Gear:
     """A `Gear` from a parsed gear file; ``where`` names it in messages."""
     if not isinstance(data, dict):
         raise GearFileError(f"{where}: must hold a JSON object, got {type(data).__name__}")
-    unknown = sorted(set(data) - set(PARAMETERS) - set(OPTIONAL))
+    unknown = sorted(set(data) - set(ALL_PARAMETERS) - set(OPTIONAL))
     if unknown:
-        known = ", ".join([*PARAMETERS, *OPTIONAL])
-        close = difflib.get_close_matches(unknown[0], [*PARAMETERS, *OPTIONAL], n=1, cutoff=0.6)
+        known = ", ".join([*ALL_PARAMETERS, *OPTIONAL])
+        close = difflib.get_close_matches(unknown[0], [*ALL_PARAMETERS, *OPTIONAL], n=1, cutoff=0.6)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         raise GearFileError(f"{where}: unknown key {unknown[0]!r}{hint} (known: {known})")
     missing = [k for k in PARAMETERS if k not in DEFAULTED and k not in data]
     if missing:
         raise GearFileError(f"{where}: missing key {missing[0]!r}")
-    for key in PARAMETERS:
+    for key in ALL_PARAMETERS:
         if key in data:
             _check_value(data[key], key, where)
     if "sources" in data and not (
@@ -246,7 +252,7 @@ def gear_from_dict(data: Any, where: str = "gear") -> Gear:
     for key in ("name", "notes"):
         if key in data and not isinstance(data[key], str):
             raise GearFileError(f"{where}: {key} must be a text, got {data[key]!r}")
-    values = {k: data[k] for k in PARAMETERS if k in data}
+    values = {k: data[k] for k in ALL_PARAMETERS if k in data}
     if "wheels" in values:
         values["wheels"] = int(values["wheels"])
     try:
