@@ -182,3 +182,25 @@ def test_committed_runs_balance_rim_and_road(side):
         load = np.array(d["reaction"]["rim_pressure_load"])
     # the rim's support force is CalculiX's RF less the cavity pressure applied at the bead nodes
     assert np.abs(road + rim - load).max() < BALANCE * abs(road[2])
+
+
+SECTOR_LONG = REPO / "meshes" / "rig-aircraft" / "long"
+
+
+@pytest.mark.skipif(not SECTOR_LONG.is_dir(), reason="meshes/rig-aircraft/long/ not committed")
+def test_steadiness_judges_every_component_and_the_load():
+    """The sector's long lateral run with spin passes the old |F| check (|F| at its Coulomb
+    ceiling moves 0.0003 fN) but its Fx moves 0.012 fN and its load 1.1 % over the last fifth;
+    the longitudinal one at 60 degrees is steady on every count."""
+    from scripts.tiremodel.steadiness import run_motion, tail_motion
+
+    m = run_motion(SECTOR_LONG / "d090_a40p.json")
+    assert m.f_abs < 0.001 and m.fx > 0.01 and m.n == pytest.approx(0.0113, abs=5e-4)
+    assert not m.steady()
+    assert run_motion(SECTOR_LONG / "d000_a60p.json").steady()
+    # by hand: Fx ramps by 0.01 fN over the tail, Fy and N stand still
+    h = {"path": [0.0, 0.5, 0.9, 1.0], "Fx": [0.0, 0.0, 0.0, 3.0], "Fy": [10, 10, 10, 10], "Fz": [1e3] * 4}
+    got = tail_motion(h, 0.3)
+    assert got.fx == pytest.approx(0.01) and got.fy == 0.0 and got.n == 0.0 and got.increments == 2
+    with pytest.raises(ValueError, match="fewer than two"):
+        tail_motion({"path": [0.0, 1.0], "Fx": [0, 0], "Fy": [0, 0], "Fz": [1, 1]}, 0.3)

@@ -187,11 +187,23 @@ def drive(
         log(
             f"[{skipped + len(done)}/{len(specs)}] {spec.name}: F = ({f[0]:.0f}, {f[1]:.0f}, {f[2]:.0f}) N, "
             f"Mz = {side['history']['Mz'][-1]:.0f} N m, solve {side['runtime_s']:.0f} s "
-            f"(programme {time.perf_counter() - t0:.0f} s)"
+            f"(programme {time.perf_counter() - t0:.0f} s); {_steadiness(side)}"
         )
     if failed:
         raise RuntimeError(f"{len(failed)} run(s) failed: {', '.join(failed)}")
     return done
+
+
+def _steadiness(side: dict) -> str:
+    """The run's steadiness over the last fifth of its path (``steadiness``), in words."""
+    from .steadiness import tail_motion
+
+    try:
+        m = tail_motion(side["history"], float(side["friction"]))
+    except (KeyError, ValueError) as exc:
+        return f"steadiness not judged ({exc})"
+    verdict = "steady" if m.steady() else "NOT steady"
+    return f"{verdict}: last fifth moves Fx {m.fx:.4f}, Fy {m.fy:.4f} fN, N {m.n:.4f} N"
 
 
 def model_info(mesh, setup: Setup, rim_travel: float, clearance: float, solver: str) -> dict:

@@ -1,0 +1,65 @@
+"""Mesh convergence of static maps on what ``fepost coefficients`` reports.
+
+``python -m scripts.tiremodel.map_convergence COARSE.vtu FINE.vtu [--tol 0.02]`` runs
+``fepost coefficients --json`` on both maps and prints, for N, the centre of pressure
+(x, y), R = r_max, a, m, b, b1 and the peak contact pressure (the largest nodal CPRESS of
+the map), the two values, the change from the coarse to the fine map (relative; the centre
+in mm of its shift, against ``tol`` times R), and whether it is within ``tol``. Exit status
+1 if any is not.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+QUANTITIES = ("N", "R", "a", "m", "b", "b1")
+
+
+def coefficients(path: Path) -> dict:
+    """``fepost coefficients --json`` of one static map, with its peak CPRESS (Pa) added."""
+    import meshio
+
+    with tempfile.TemporaryDirectory(prefix="conv-") as tmp:
+        out = Path(tmp) / "c.json"
+        cmd = [sys.executable, "-m", "fepost", "coefficients", str(path), "--json", str(out)]
+        subprocess.run(cmd, check=True, capture_output=True)
+        c = json.loads(out.read_text())
+    c["peak_pressure"] = float(meshio.read(path).point_data["CPRESS"].max())
+    return c
+
+
+def rows(coarse: dict, fine: dict, tol: float) -> list[tuple[str, float, float, float, bool]]:
+    """(name, coarse, fine, change, within tol) for each quantity."""
+    out = []
+    for k in (*QUANTITIES, "peak_pressure"):
+        a, b = float(coarse[k]), float(fine[k])
+        change = b / a - 1.0
+        out.append((k, a, b, change, abs(change) <= tol))
+    r = float(fine["R"])
+    for i, axis in enumerate("xy"):
+        a, b = (float(c["patch"]["centre"][i]) for c in (coarse, fine))
+        out.append((f"centre {axis} (m)", a, b, (b - a) / r, abs(b - a) <= tol * r))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m scripts.tiremodel.map_convergence", description=__doc__)
+    ap.add_argument("coarse", type=Path)
+    ap.add_argument("fine", type=Path)
+    ap.add_argument("--tol", type=float, default=0.02, help="relative tolerance (default 0.02)")
+    args = ap.parse_args(argv)
+    table = rows(coefficients(args.coarse), coefficients(args.fine), args.tol)
+    print(f"{'quantity':<16} {'coarse':>12} {'fine':>12} {'change':>9}  within {args.tol:g}")
+    for name, a, b, change, ok in table:
+        print(f"{name:<16} {a:12.6g} {b:12.6g} {100 * change:+8.2f}%  {'yes' if ok else 'NO'}")
+    print("(centre: change = shift / R)")
+    return 0 if all(r[4] for r in table) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
