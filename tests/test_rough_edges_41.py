@@ -123,14 +123,17 @@ def test_rounding_noise_is_shown_as_zero():
 
 
 def test_a_sweep_k_x_is_labelled_with_its_rolling_map():
-    from fepost.report.sweepsection import _cell, _resolved
+    from fepost.report.sweepsection import TABLE, _cell, _resolved
 
+    keys = [k for k, _ in TABLE]
+    assert keys.index("rolling_kind") == keys.index("k_x") + 1  # the label right beside each k_x
     stand_in = MESHES / "aircraft" / "rolling_100.vtu"
     kinds = {_resolved(stand_in): "sliding stand-in"}
-    assert _cell({"k_x": 0.240625, "rolling": str(stand_in)}, "k_x", kinds) == "0.2406 (sliding stand-in)"
-    assert _cell({"k_x": None, "rolling": ""}, "k_x", kinds) == "—"
-    assert _cell({"k_x": 0.1, "rolling": "other.vtu"}, "k_x", kinds).endswith(
-        "(rolling map of unstated kind)"
+    row = {"k_x": 0.240625, "rolling": str(stand_in)}
+    assert _cell(row, "k_x", kinds) == 0.240625 and _cell(row, "rolling_kind", kinds) == "sliding stand-in"
+    assert _cell({"k_x": None, "rolling": ""}, "rolling_kind", kinds) == "—"
+    assert (
+        _cell({"k_x": 0.1, "rolling": "other.vtu"}, "rolling_kind", kinds) == "rolling map of unstated kind"
     )
 
 

@@ -31,6 +31,15 @@ def cache_folder() -> str:
     return os.path.join(base, "fepost", "numba")
 
 
+def _writable(folder: str) -> bool:
+    """Whether ``folder`` exists or can be made, and can be written (else numba's own default)."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError:
+        return False
+    return os.access(folder, os.W_OK)
+
+
 def compile_functions(
     namespace: dict,
     names: tuple[str, ...],
@@ -51,7 +60,7 @@ def compile_functions(
         from numba.extending import overload
 
         config: Any = numba.config
-        if not config.CACHE_DIR:  # numba's default is __pycache__ beside the source
+        if not config.CACHE_DIR and _writable(cache_folder()):  # numba's default: beside the source
             config.CACHE_DIR = cache_folder()
 
         fm = fastmath or False

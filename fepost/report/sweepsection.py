@@ -52,20 +52,22 @@ TABLE = (
     ("aR2", "a·R² (m²)"),
     ("m_over_R2", "m/R² (m⁻²)"),
     ("aspect", "aspect"),
-    ("k_x", "k_x (its rolling map)"),
+    ("k_x", "k_x"),
+    ("rolling_kind", "k_x from (its rolling map)"),
     ("status", "status"),
 )
 
 
 def _cell(row, key: str, kinds: dict | None = None):
+    if key == "rolling_kind":  # a k_x is never shown without what its rolling map is
+        if not row.get("rolling"):
+            return "—"
+        return (kinds or {}).get(_resolved(row.get("rolling"))) or "rolling map of unstated kind"
     v = row.get(key)
     if key == "case" and not v:
         return Path(str(row.get("source", ""))).stem
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "—"
-    if key == "k_x" and kinds is not None:  # a k_x is never shown without what its map is
-        kind = kinds.get(_resolved(row.get("rolling"))) or "rolling map of unstated kind"
-        return f"{_signed(float(v), '{:.4g}')} ({kind})"
     return v
 
 
