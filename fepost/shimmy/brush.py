@@ -263,28 +263,26 @@ class BrushTire:
 
 
 def _return(tx: float, ty: float, kx: float, ky: float, lim: float) -> tuple[float, float]:
-    """The trial deflection, or its return to |K e| = lim: e_j = t_j / (1 + μ k_j / lim)."""
-    if math.hypot(kx * tx, ky * ty) <= lim:
+    """The trial deflection, or its return to |K e| = lim: e_j = t_j / (1 + μ k_j / lim).
+
+    |K e(μ)| is convex and decreasing in μ; its root lies between the roots of the isotropic
+    cases with k_max and k_min, and Newton's steps from the lower one approach it from the left.
+    """
+    size0 = math.hypot(kx * tx, ky * ty)
+    if size0 <= lim:
         return tx, ty
     if lim <= 0:
         return 0.0, 0.0
-
-    def size(mu: float) -> float:
-        return math.hypot(kx * tx / (1 + mu * kx / lim), ky * ty / (1 + mu * ky / lim)) - lim
-
-    lo, hi = 0.0, 1.0
-    while size(hi) > 0:
-        hi *= 4.0
-    for _ in range(100):
-        mid = 0.5 * (lo + hi)
-        if size(mid) > 0:
-            lo = mid
-        else:
-            hi = mid
-        if hi - lo <= 1e-15 * hi:
+    mu = (size0 / lim - 1.0) * lim / max(kx, ky)
+    for _ in range(60):
+        ax, ay = 1.0 + mu * kx / lim, 1.0 + mu * ky / lim
+        fx, fy = kx * tx / ax, ky * ty / ay
+        size = math.hypot(fx, fy)
+        if size - lim <= 1e-14 * lim:
             break
-    mu = hi
-    return tx / (1 + mu * kx / lim), ty / (1 + mu * ky / lim)
+        slope = -(fx * fx * kx / ax + fy * fy * ky / ay) / (lim * size)
+        mu -= (size - lim) / slope
+    return tx / (1.0 + mu * kx / lim), ty / (1.0 + mu * ky / lim)
 
 
 def rig_stiffness(folder) -> dict:
