@@ -203,8 +203,17 @@ def model_description(mesh: AircraftMesh) -> dict:
         "sidewall; *ELASTIC, TYPE=ENGINEERING CONSTANTS in per-element *ORIENTATION frames",
         "rim": "rigid body on the bead nodes (*RIGID BODY), rotation held",
         "contact": "CalculiX node-to-surface penalty contact (slave: tread and shoulder nodes "
-        f"within +-{p.fine_deg:g} deg of the bottom, master: road top face), linear "
+        f"{_slave_arc(mesh)}, master: road top face), linear "
         f"pressure-overclosure {ad.CONTACT_SLOPE:.3g} Pa/m, Coulomb friction {ad.FRICTION} "
         f"(stick slope {ad.STICK_SLOPE:.3g} Pa/m)",
         "nlgeom": True,
     }
+
+
+def _slave_arc(mesh) -> str:
+    """Where the contact slave nodes are: the fine arc, symmetric about the bottom or not (the
+    rolling mesh's arc is turned towards +x: ``info["fine_arc_deg"]``)."""
+    arc = getattr(mesh, "info", {}).get("fine_arc_deg")
+    if arc is not None:
+        return f"from {arc[0]:g} to {arc[1]:g} deg from the bottom (towards +x)"
+    return f"within +-{mesh.params.fine_deg:g} deg of the bottom"

@@ -44,8 +44,9 @@ POINTS = (
 SLIP_DEFINITION = (
     "kappa = R_e * dtheta/dX - 1: dtheta/dX is the rim's turn per axle travel over the second "
     "half of the roll (constant in the imposed-slip runs), R_e the free-rolling run's effective "
-    "rolling radius dX/dtheta over the same part (that run's rim turns nearly torque-free, see "
-    "its axle_torque_Nm); kappa < 0 braking (-1 = locked wheel), > 0 driving, 0 = free rolling"
+    "rolling radius dX/dtheta over the same part (that run's rim is driven through a soft spring, "
+    "not torque-free: see its axle_torque_Nm); kappa < 0 braking (-1 = locked wheel), > 0 "
+    "driving, 0 = free rolling"
 )
 
 
@@ -76,15 +77,22 @@ def _write_text(path: Path, text: str) -> None:
     os.replace(part, path)
 
 
-def projected_integral(points: np.ndarray, quads: np.ndarray, values: np.ndarray) -> float:
+def projected_integral(
+    points: np.ndarray, quads: np.ndarray, values: np.ndarray, weight: np.ndarray | None = None
+) -> float:
     """Integral of the bilinear nodal field over the faces projected on the road plane (2x2 Gauss).
 
     The vertical force of a pressure p acting normal to a deformed face is the
     integral of p over the face's projection on the road; this is the load that
     the road's reaction measures (and the one fepost's N_fe integrates).
+    ``weight``: a second nodal field w (e.g. the deformed x); the integral is then of the
+    product of the two bilinear fields, p(xi) w(xi), not of the bilinear interpolation of the
+    nodal products p w. The integrand (bilinear x bilinear x the projected Jacobian, linear in
+    each of xi, eta) is of degree 3 in each: 2x2 Gauss integrates it exactly.
     """
     g = np.array([-1.0, 1.0]) / np.sqrt(3.0)
     x, v, total = points[quads], values[quads], 0.0
+    w = None if weight is None else weight[quads]
     for a in g:
         for b in g:
             shape = 0.25 * np.array(
@@ -93,7 +101,8 @@ def projected_integral(points: np.ndarray, quads: np.ndarray, values: np.ndarray
             ta = np.einsum("k,fkj->fj", 0.25 * np.array([-(1 - b), 1 - b, 1 + b, -(1 + b)]), x)
             tb = np.einsum("k,fkj->fj", 0.25 * np.array([-(1 - a), -(1 + a), 1 + a, 1 - a]), x)
             jac = np.abs(ta[:, 0] * tb[:, 1] - ta[:, 1] * tb[:, 0])
-            total += float(np.sum(jac * (v @ shape)))
+            field = v @ shape if w is None else (v @ shape) * (w @ shape)
+            total += float(np.sum(jac * field))
     return total
 
 
@@ -102,7 +111,7 @@ def centre_of_pressure(mesh: AircraftMesh, state: RollState) -> tuple[float, flo
     pts, quads, cp, disp = mirror_surface(mesh, state)
     deformed = pts + disp
     n = projected_integral(deformed, quads, cp)
-    return n, projected_integral(deformed, quads, cp * deformed[:, 0]) / n
+    return n, projected_integral(deformed, quads, cp, deformed[:, 0]) / n
 
 
 def steady_turn_rate(result: RollResult) -> float:

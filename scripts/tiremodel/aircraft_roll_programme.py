@@ -83,7 +83,10 @@ class RunSpec:
             "turning about the axle"
         )
         if self.slip is None:
-            return head + "; free rolling (elastic drive, nearly torque-free)"
+            return head + (
+                "; free rolling approximated by an elastic drive (a soft torsion spring turned at a "
+                "guessed rate): not torque-free, the spring's torque is axle_torque_Nm"
+            )
         kind = "braking" if self.slip < 0 else "driving"
         return head + f"; {kind}, imposed longitudinal slip {self.slip:+g} (rim turn prescribed)"
 
