@@ -259,3 +259,24 @@ def test_critical_interval_by_value_against_fresh_linearisations():
     slope = (ends[0].critical_speed - ends[1].critical_speed) / (2 * h)
     assert (hi - lo) / 2 == pytest.approx(1.96 * abs(slope) * sd, rel=1e-3)
     assert (lo + hi) / 2 == pytest.approx(vc, rel=1e-12)
+
+
+def test_speed_terms_are_used_only_where_they_reproduce_the_jacobian(monkeypatch):
+    """J(V) = C0 + C1/V + C2 V holds for these equations (checked against the complex step at
+    other speeds); equations with another speed dependence (here a V² term) fall back on the
+    direct Jacobian."""
+    import fepost.shimmy.linear as linear
+
+    lin = Linearisation.of(GEAR, closed_forms_contact(**COEF))
+    assert lin.speed_terms is not None
+    for V in (0.7, 33.0, 211.0):
+        np.testing.assert_allclose(lin.jacobian(V), lin.direct_jacobian(V), rtol=ROUND_OFF, atol=ROUND_OFF)
+    plain = linear.rhs
+
+    def with_v2(x, V, gear, contact):
+        return plain(x, V, gear, contact) + np.array([0.0, 1e-3 * V * V * x[0], 0.0, 0.0])
+
+    monkeypatch.setattr(linear, "rhs", with_v2)
+    other = Linearisation.of(GEAR, closed_forms_contact(**COEF))
+    assert other.speed_terms is None
+    assert other.jacobian(100.0)[1, 0] == pytest.approx(lin.jacobian(100.0)[1, 0] + 10.0, rel=1e-12)
