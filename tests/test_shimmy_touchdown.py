@@ -99,3 +99,40 @@ def test_gear_without_the_touchdown_parameters_is_refused(tire):
         simulate_touchdown(g, tire, 70.0)
     with pytest.raises(ArgumentError, match="sink_rate must be positive"):
         simulate_touchdown(load_gear(GEAR), tire, 70.0, sink_rate=0.0)
+
+
+def test_command_writes_the_touchdown_rows(tmp_path, capsys):
+    """fepost shimmy ... --touchdown: the rows of ../shared/INTERFACE.md and their CSV files."""
+    import json
+
+    from fepost.cli import main
+
+    out = tmp_path / "out"
+    args = ["shimmy", "meshes/rig-aircraft/roll_static.vtu", "--gear", GEAR, "--out", str(out)]
+    args += ["--models", "closed_forms", "--speeds", "5", "--trails", "0", "--branch-speeds", "0"]
+    args += ["--no-simulation", "--no-intervals", "--no-progress"]
+    args += ["--touchdown", "60", "--touchdown-yaw", "0.5,1", "--touchdown-duration", "0.15"]
+    assert main(args) == 0
+    data = json.loads((out / "shimmy.json").read_text())
+    rows = data["touchdown"]
+    assert [r["initial_yaw"] for r in rows] == pytest.approx([math.radians(0.5), math.radians(1.0)])
+    for r in rows:
+        assert {"speed", "spin_up_time", "verdict", "amplitude", "csv"} <= set(r)
+        assert r["speed"] == 60.0 and 0.05 < r["spin_up_time"] < 0.2
+        assert (out / r["csv"]).read_text().startswith("t,psi,psi_dot,y,y_dot,omega_1,omega_2,load_share\n")
+    assert capsys.readouterr().out.count("touchdown 60 m/s") == 2
+
+
+def test_command_refuses_a_touchdown_the_gear_file_cannot_give(tmp_path, capsys):
+    from fepost.cli import main
+
+    out = tmp_path / "out"
+    args = ["shimmy", "meshes/static.vtu", "--gear", "examples/gear_a320_main.json", "--out", str(out)]
+    assert main([*args, "--touchdown", "70"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith(
+        "gear_a320_main.json: the touchdown needs wheel_spin_inertia > 0 in the gear file (docs/touchdown.md)"
+    )
+    assert not out.exists()
+    assert main([*args, "--touchdown", "70,abc"]) == 2
+    assert "--touchdown: must be a comma-separated list of numbers, got 'abc'" in capsys.readouterr().err

@@ -32,6 +32,7 @@ def _models(text: str) -> tuple[str, ...]:
 
 def add_parser(sub) -> None:
     from ._common import add_friction_option, add_input_options
+    from ._touchdown import add_touchdown_options
 
     p = sub.add_parser(
         "shimmy",
@@ -99,6 +100,7 @@ def add_parser(sub) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress lines on stderr")
     add_friction_option(p)
     add_input_options(p)
+    add_touchdown_options(p)
     p.set_defaults(func=run)
 
 
@@ -145,12 +147,14 @@ def run(args: argparse.Namespace) -> int:
     from ..shimmy.study import shimmy_study
     from ..shimmy.writer import write_shimmy
     from ._common import analysis_options
+    from ._touchdown import check_touchdown, run_touchdowns, touchdown_line
 
     if args.speed_max <= args.speed_min:
         raise ArgumentError(
             f"argument --speed-max: must be above --speed-min ({args.speed_min:g}), got {args.speed_max:g}"
         )
     gear = load_gear(args.gear)  # a bad gear file fails before the FE work
+    check_touchdown(args, gear)
     inputs = [args.static, args.rolling, args.gear]
     check_replaceable(args.out, inputs)
     result = analyse(args.static, args.rolling, friction=args.friction, options=analysis_options(args))
@@ -167,14 +171,18 @@ def run(args: argparse.Namespace) -> int:
         branch_speeds=args.branch_speeds,
         progress=None if args.no_progress else progress.study,
     )
+    touchdowns = run_touchdowns(args, gear, result)
     write_shimmy(
         study,
         args.out,
         force=args.force,
         protect=inputs,
         progress=None if args.no_progress else progress.writing,
+        touchdown=touchdowns,
     )
     for m in study.models:
         print(summary(m))
+    for run_, _ in touchdowns:
+        print(touchdown_line(run_))
     print(f"-> {args.out}/shimmy.json")
     return 0

@@ -22,7 +22,8 @@ run (``energy_residual``: the balance's error over the largest energy term).
 Reading the run (`read_touchdown`):
 
 * ``spin_up_time``: the first time the slowest wheel's rolling speed ω R_e is
-  within `SPUN_UP` of the road speed along the wheel, V cos(δ − crab);
+  within `SPUN_UP` of the road speed along the wheel, V cos(δ − crab) (None when
+  the run ends first: the oscillation is then read over the whole run);
 * the strut's oscillation after it: the half peak-to-peak amplitude of ψ in
   `WINDOWS` equal windows from the spin-up to the end. ``decays`` when the last
   window's is below `QUIET` rad or below half the first's and not rising;
@@ -56,6 +57,8 @@ SPUN_UP = 0.01
 WINDOWS, SETTLED, QUIET = 5, 0.05, 1e-5
 #: Default duration (s) and output sampling (Hz).
 DURATION, SAMPLING = 2.0, 1000.0
+#: Element grid (cells along x, y) of the command's touchdown runs (benchmarks/bench_touchdown.py).
+GRID = (12, 4)
 #: Gear parameters the touchdown needs.
 NEEDS = ("wheel_spin_inertia", "rolling_radius", "tire_stiffness_x", "tire_stiffness_y", "tire_deflection")
 
@@ -204,10 +207,8 @@ def read_touchdown(t, x, gear: Gear, speed: float, crab: float = 0.0):
     road = speed * np.cos(x[0] * math.cos(gear.rake) - crab)
     rolling = np.min(x[4 : 4 + w], axis=0) * gear.rolling_radius
     done = np.nonzero(rolling >= (1 - SPUN_UP) * road)[0]
-    if done.size == 0:
-        return None, "spinning_up", None, ()
-    i0 = int(done[0])
-    ts = float(t[i0])
+    i0 = int(done[0]) if done.size else 0
+    ts = float(t[i0]) if done.size else None
     psi = x[0, i0:]
     tt = t[i0:]
     if tt.size < 2 * WINDOWS:

@@ -29,9 +29,13 @@ CSV_FILES: list[Callable[[ShimmyResult, Path], None]] = [_simulation_csvs]
 JSON_KEYS: dict[str, Callable[[ShimmyResult], object]] = {}
 
 
-def write_shimmy(result: ShimmyResult, out, *, force: bool = False, protect=(), progress=None) -> Path:
+def write_shimmy(
+    result: ShimmyResult, out, *, force: bool = False, protect=(), progress=None, touchdown=()
+) -> Path:
     """Write ``result`` into the folder ``out``; returns its path. ``progress(k, n, step, s)``
-    is called once the figures are drawn (the writing's one long stage)."""
+    is called once the figures are drawn (the writing's one long stage). ``touchdown``:
+    [(`fepost.shimmy.touchdown.Touchdown`, csv name)], written as CSV files and the
+    ``touchdown`` rows of shimmy.json."""
     out = Path(out)
     with staged_folder(out, force=force, protect=protect) as tmp:
         for write in CSV_FILES:
@@ -41,6 +45,10 @@ def write_shimmy(result: ShimmyResult, out, *, force: bool = False, protect=(), 
             v = value(result)
             if v is not None:
                 data[key] = v
+        for run, csv in touchdown:
+            (tmp / csv).write_text(run.to_csv(), encoding="utf-8")
+        if touchdown:
+            data["touchdown"] = [run.row(csv) for run, csv in touchdown]
         t0 = time.perf_counter()
         data["figures"] = save_figures(result, tmp)
         if progress is not None:
