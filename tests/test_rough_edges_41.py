@@ -202,6 +202,35 @@ def test_outlines_are_drawn_above_the_pressure_in_one_colour_scale(disc):
     plt.close(fig)
 
 
+def test_load_trend_legends_lie_below_their_panels_and_k_x_says_its_maps(tmp_path):
+    import matplotlib.pyplot as plt
+
+    from fepost.figures.sweep import plot_load_trends
+    from fepost.report.rollinglabel import kind_of_rolling_maps
+    from fepost.sweep.trends import load_trends
+
+    loads = [5e4, 1e5, 2e5, 3e5]
+    rows = [
+        {"status": "ok", "N": n, "R": 0.1 * (n / 1e5) ** 0.4, "M0": 3e3 * (n / 1e5) ** 1.4,
+         "aR2": 0.02 * n / 1e5, "m_over_R2": 300 * 1e5 / n, "k_x": 0.24 if n == 2e5 else None}
+        for n in loads
+    ]  # fmt: skip
+    fig = plot_load_trends(rows, load_trends(rows), k_x_kind="sliding stand-in")
+    fig.canvas.draw()
+    panels = [ax for ax in fig.axes if ax.get_visible()]
+    assert any(ax.get_title() == "$k_x$ (sliding stand-in)" for ax in panels)
+    for ax in panels:
+        legend = ax.get_legend()
+        if legend is not None:
+            assert legend.get_window_extent().y1 < ax.get_window_extent().y0, ax.get_title()
+            assert all("-" not in t.get_text().split("$")[-1] for t in legend.get_texts())  # true minus
+    plt.close(fig)
+    stand_in, rolled = MESHES / "aircraft" / "rolling_100.vtu", MESHES / "rig-aircraft" / "roll_free.vtu"
+    assert kind_of_rolling_maps([str(stand_in), str(stand_in)]) == "sliding stand-in"
+    assert kind_of_rolling_maps([str(stand_in), str(rolled)]) == "rolling maps of several kinds"
+    assert kind_of_rolling_maps([None, ""]) is None
+
+
 # ---------------------------------------------------------------- numba's cache
 def test_numba_caches_outside_the_source_tree(monkeypatch, tmp_path):
     from fepost.friction import compiled

@@ -54,8 +54,12 @@ def _values(rows: Sequence[Mapping], key: str) -> np.ndarray:
     return np.array([np.nan if r.get(key) is None else float(r[key]) for r in rows])
 
 
-def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
-    """Panels of R, M0, aR², m/R² and k_x against N (log-log), with fits and 95 % bands."""
+def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw], *, k_x_kind: str | None = None):
+    """Panels of R, M0, aR², m/R² and k_x against N (log-log), with fits and 95 % bands.
+
+    ``k_x_kind``: what the rolling maps behind k_x are ("sliding stand-in", "rolled map,
+    free rolling", ...), said in the k_x panel's title. Each panel's legend sits below it,
+    clear of the points and bands."""
     import matplotlib.pyplot as plt
     from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
 
@@ -65,7 +69,7 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
     with mpl_style():
         ncol = min(TREND_COLUMNS, len(quantities))
         nrow = -(-len(quantities) // ncol)
-        fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.4 * nrow), squeeze=False)
+        fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 4.0 * nrow), squeeze=False)
         by_group = groups(rows)
         loads = _values([r for m in by_group.values() for r in m], "N")
         loads = loads[np.isfinite(loads) & (loads > 0)]
@@ -87,7 +91,9 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
                         "-",
                         color=colour,
                         lw=1.2,
-                        label=rf"$\propto N^{{{fit.exponent:.3f}}}$, 95 %: [{lo_a:.3f}, {hi_a:.3f}]",
+                        label=rf"$\propto N^{{{fit.exponent:.3f}}}$, 95 %: [{lo_a:.3f}, {hi_a:.3f}]".replace(
+                            "-", "−"
+                        ),
                     )
             finite = _values(rows, q)
             if np.all(finite[np.isfinite(finite)] > 0):
@@ -104,9 +110,13 @@ def plot_load_trends(rows: Sequence[Mapping], fits: Sequence[PowerLaw]):
             ax.set_ylabel(axis_label(q, unit))
             symbol = MATH_LABELS.get(q, label)
             title = symbol if hertz is None else rf"{symbol}   (Hertz: $\propto N^{{{hertz:.3g}}}$)"
+            if q == "k_x" and k_x_kind:
+                title = f"{symbol} ({k_x_kind})"
             ax.set_title(title, fontsize=10)
             if ax.get_legend_handles_labels()[0]:
-                ax.legend(loc="best", fontsize=LEGEND_FONTSIZE)
+                ax.legend(
+                    loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize=LEGEND_FONTSIZE, frameon=False
+                )
         for ax in list(axes.flat)[len(quantities) :]:
             ax.set_visible(False)
         fig.tight_layout()

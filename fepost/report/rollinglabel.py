@@ -91,6 +91,24 @@ def rolling_label(sidecar: Mapping[str, Any] | None) -> RollingLabel:
     return RollingLabel("unstated", "rolling map (kind not stated)", "rolling map")
 
 
+def kind_of_rolling_maps(paths) -> str | None:
+    """The short label (`RollingLabel.short`) the rolling maps ``paths`` share, "rolling maps
+    of several kinds" when they differ, None without any (a static-only sweep)."""
+    from ..errors import InputFileError
+    from ..reader.sidecar import read_sidecar
+
+    kinds = set()
+    for p in {str(p) for p in paths if p}:
+        try:
+            side = read_sidecar(Path(p))
+        except InputFileError:
+            side = None
+        kinds.add(rolling_label(side).short)
+    if not kinds:
+        return None
+    return kinds.pop() if len(kinds) == 1 else "rolling maps of several kinds"
+
+
 def own_mesh_static(rolling: str | Path, sidecar: Mapping[str, Any] | None) -> Path | None:
     """The static map solved on the rolled map's own mesh, or None.
 

@@ -100,7 +100,10 @@ def draw_figures(rows: Sequence[Mapping], fits: Sequence[PowerLaw], folder: Path
     figures = []
     loads = {r["N"] for r in rows if r.get("status") == "ok" and r.get("N") is not None}
     if len(loads) >= 2:
-        _save(plot_load_trends(rows, fits), folder, "load_trends")
+        from .rollinglabel import kind_of_rolling_maps
+
+        kind = kind_of_rolling_maps(r.get("rolling") for r in rows if r.get("k_x") is not None)
+        _save(plot_load_trends(rows, fits, k_x_kind=kind), folder, "load_trends")
         figures.append(
             {
                 "png": "load_trends.png",
