@@ -44,6 +44,8 @@ PERTURBATION, DURATION, SAMPLING = 1e-3, 10.0, 1000.0
 VERDICTS = ("decays", "grows", "limit_cycle")
 #: Duration (s) of each run of the limit-cycle sweep (`amplitude_sweep`).
 BRANCH_DURATION = 3.0
+#: Times a run of the limit-cycle sweep is continued while it has neither settled nor died away.
+BRANCH_EXTENSIONS = 3
 
 
 @dataclass(frozen=True)
@@ -150,8 +152,10 @@ def amplitude_sweep(
 
     The highest speed starts from the steady state plus the yaw ``perturbation``; each
     lower speed starts where the run above it ended (natural continuation: it starts
-    near that speed's cycle when there is one, so ``duration`` seconds suffice to
-    settle). Below the speed where the branch starts, the motion decays (amplitude
+    near that speed's cycle when there is one, so ``duration`` seconds mostly suffice
+    to settle; a run that has neither settled nor died away goes on for up to
+    `BRANCH_EXTENSIONS` more ``duration`` seconds, as near the onset, where the growth
+    rate is small). Below the speed where the branch starts, the motion decays (amplitude
     → 0 at a supercritical Hopf point); a branch that goes on below the linear
     critical speed is subcritical (a large enough disturbance shimmies below it).
     Points in increasing speed.
@@ -163,13 +167,18 @@ def amplitude_sweep(
     x0[0] += perturbation
     out = []
     for v in sorted((float(s) for s in speeds), reverse=True):
-        t_eval = np.linspace(0.0, duration, int(round(duration * 400.0)) + 1)
         f = scalar_rhs(gear, v, contact.scalar)
-        sol = solve_ivp(f, (0.0, duration), x0, method="DOP853", t_eval=t_eval, rtol=1e-7, atol=1e-10)
-        if sol.status != 0:
-            raise ArgumentError(f"the time integration at {v:g} m/s failed: {sol.message}")
-        dev = np.abs(sol.y[0] - eq[0])
-        verdict, _, final = verdict_of(sol.t, dev, max(float(dev[0]), perturbation))
+        start = x0
+        for _ in range(BRANCH_EXTENSIONS + 1):  # run on while neither settled nor died away
+            t_eval = np.linspace(0.0, duration, int(round(duration * 400.0)) + 1)
+            sol = solve_ivp(f, (0.0, duration), start, method="DOP853", t_eval=t_eval, rtol=1e-7, atol=1e-10)
+            if sol.status != 0:
+                raise ArgumentError(f"the time integration at {v:g} m/s failed: {sol.message}")
+            dev = np.abs(sol.y[0] - eq[0])
+            verdict, _, final = verdict_of(sol.t, dev, perturbation)
+            start = sol.y[:, -1]
+            if verdict == "limit_cycle" or final < DECAYED * perturbation:
+                break
         out.append(BranchPoint(v, verdict, final))
         if final > DECAYED * perturbation:
             x0 = sol.y[:, -1]
