@@ -5,7 +5,7 @@
 # also CalculiX and Chromium (TEST_PACKAGES).
 #
 # System packages (Debian names; `make system-packages` lists them):
-#   APT=yes (default)  install the missing ones with apt, listing first every package apt
+#   APT=yes (default; upgrade under CI=true)  install the missing ones with apt, listing first every package apt
 #                      would install (a simulated `apt-get -s install`); apt never upgrades an
 #                      installed package here: when it would (Mesa libraries, say), make stops,
 #                      names them and leaves the choice to you (APT=upgrade lets apt do it);
@@ -20,7 +20,9 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 PIP    := $(PY) -m pip --disable-pip-version-check
 OUT    ?= report
-APT      ?= yes
+# CI (CI=true, a machine made for the run) lets apt upgrade what it needs to; a person's
+# machine is never upgraded without APT=upgrade.
+APT      ?= $(if $(CI),upgrade,yes)
 CHROMIUM ?= yes
 # One stamp per set of extras: `make demo` then `make test` in one clone installs the
 # extras the tests need on top of the demo's install.
