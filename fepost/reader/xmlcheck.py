@@ -25,7 +25,6 @@ from .checks import (
     RELEASE_STEP,
     Counts,
     bad_file,
-    find_releasing,
     inside_folder,
     refuse_netcdf,
     regular_file,
@@ -46,6 +45,8 @@ _ROOT = {
 _PIECE_SUFFIX = {".pvtu": ".vtu", ".pvtp": ".vtp"}
 #: Most pieces a parallel file may list.
 MAX_PIECES = 4096
+#: The tag after which raw bytes may follow: the tag scan ends there.
+_APPENDED = b"<AppendedData"
 _TAG = re.compile(
     rb"<!--.*?-->|<\?.*?\?>|<!\[CDATA\[.*?\]\]>|<(/?)([A-Za-z_][\w:.-]*)((?:[^>\"']|\"[^\"]*\"|'[^']*')*)>",
     re.S,
@@ -96,16 +97,15 @@ class Xml(ArrayLengths):
         path, data = self.path, self.data
         refuse_netcdf(path, data)
         suffix = path.suffix.lower()
-        cut = find_releasing(data, b"<AppendedData")
-        limit = len(data) if cut < 0 else cut
-        first = data.find(b"<VTKFile", 0, limit)
-        prologue = data[: first if first >= 0 else min(limit, 1 << 16)]
+        # one walk over the file: the tag scan stops at <AppendedData (raw bytes may follow)
+        first = data.find(b"<VTKFile")
+        prologue = data[: first if first >= 0 else min(len(data), 1 << 16)]
         if re.search(rb"<!(DOCTYPE|ENTITY)", prologue, re.I):
             raise bad_file(
                 path, "refused: XML with DOCTYPE/ENTITY declarations (not a VTK file; entity expansion)"
             )
         self.encoding = _encoding(path, prologue)
-        root, pieces, refs = self._scan(limit)
+        root, pieces, refs, cut = self._scan(len(data))
         self.root, self.pieces = root, pieces  # the structure, for the direct decoder (`vtkdirect`)
         want = _ROOT.get(suffix)
         if root.get("type") != want:
@@ -135,21 +135,25 @@ class Xml(ArrayLengths):
         return counts
 
     def _tags(self, limit: int):
-        """The tags before ``limit``, found with bytes.find (array contents hold no '<')."""
+        """(position, match) of the tags before ``limit``, found with bytes.find (array contents
+        hold no '<'); the match is None for an unclosed AppendedData tag. The pages walked are
+        let go every `RELEASE_STEP` bytes, those of the last stretch kept: the decoder reads
+        them next."""
         data, pos = self.data, 0
         behind = 0  # the pages before this were let go
         while True:
             pos = data.find(b"<", pos, limit)
             if pos < 0:
-                release(data, behind, limit)
                 return
             if pos - behind > RELEASE_STEP:
                 release(data, behind, pos)
                 behind = pos
             m = _TAG.match(data, pos, limit)
-            if m is None:
+            if m is None and data[pos : pos + len(_APPENDED)] != _APPENDED:
                 raise bad_file(self.path, "a '<' that opens no XML tag")
-            yield m
+            yield pos, m
+            if m is None:
+                return
             pos = m.end()
 
     def _scan(self, limit: int):
@@ -159,7 +163,11 @@ class Xml(ArrayLengths):
         pieces: list[Piece] = []
         refs: list[str] = []
         section = ""
-        for m in self._tags(limit):
+        cut = -1
+        for pos, m in self._tags(limit):
+            if m is None or (m.group(2) == b"AppendedData" and not m.group(1)):
+                cut = pos  # raw bytes may follow (holding a '<'): the structure ends here
+                break
             closing, name, rest = m.group(1), m.group(2), m.group(3)
             if name is None:
                 continue  # comment, processing instruction, CDATA
@@ -195,9 +203,9 @@ class Xml(ArrayLengths):
                     raise bad_file(self.path, f"refused: XML nested more than {MAX_DEPTH} levels deep")
         if root is None:
             raise bad_file(self.path, "no VTKFile element: not a VTK XML file")
-        if stack and self.data.find(b"<AppendedData") < 0:
+        if stack and cut < 0:
             raise bad_file(self.path, f"XML element <{stack[-1].decode('latin-1')}> is not closed")
-        return root, pieces, refs
+        return root, pieces, refs, cut
 
     def _text(self, raw: bytes) -> str:
         """An attribute's value in the file's encoding (UTF-8 unless its XML declaration says
