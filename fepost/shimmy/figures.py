@@ -35,7 +35,7 @@ VERDICT_STYLE = {
     "grows": ("#ff7f0e", "^", "full"),  # triangle up
 }
 VERDICT_TEXT = {
-    "decays": "decays (still falling)",
+    "decays": "decays",
     "limit_cycle": "limit cycle (settled)",
     "grows": "still growing",
 }
@@ -203,10 +203,9 @@ def amplitude_figure(result: ShimmyResult, fig):
             ax.plot([p.speed], [1e3 * p.amplitude], marker, color=col, mfc=col if fill == "full" else "white")
         if m.stability.critical_speed is not None:
             ax.axvline(m.stability.critical_speed, color=col, ls=":", lw=1)
+    legend = {**VERDICT_TEXT, "decays": "died away or still falling"}
     for verdict, (_, marker, fill) in VERDICT_STYLE.items():
-        ax.plot(
-            [], [], marker, color="k", mfc="k" if fill == "full" else "white", label=VERDICT_TEXT[verdict]
-        )
+        ax.plot([], [], marker, color="k", mfc="k" if fill == "full" else "white", label=legend[verdict])
     ax.set_xlabel("forward speed V (m/s)")
     ax.set_ylabel("yaw amplitude at the end of the run (mrad)")
     ax.set_ylim(bottom=0.0)
