@@ -1,4 +1,4 @@
-"""Outside anchors of the dynamics (../shared/paper/dynamics-anchors.md), reproduced.
+"""Outside anchors of the dynamics with dry friction and of shimmy (docs/dynamics-anchors.md), reproduced.
 
 * `disc_epsilon`: a flat disc sliding and spinning on a plane under coupled Coulomb
   friction stops sliding and spinning together, with ε = v/(Rω) tending to the

@@ -20,7 +20,7 @@ k = ω/V only: `yaw_response` is the closed form, `simulate_yaw` the same string
 marched in time (the contact line shifted by one node per step, the exact
 transport, and v₁'s equation integrated by RK4), an independent computation.
 For σ = 3a the moment's amplitude dips near a path wavelength 2π/k of 11.65a
-(`dip_wavelength`; the anchor of ../shared/paper/dynamics-anchors.md, item 3).
+(`dip_wavelength`; an anchor of docs/dynamics-anchors.md).
 """
 
 from __future__ import annotations

@@ -82,7 +82,7 @@ class Touchdown:
     energy_terms: dict
 
     def row(self, csv: str) -> dict:
-        """The ``touchdown`` row of shimmy.json (../shared/INTERFACE.md), plus the run's inputs."""
+        """The ``touchdown`` row of shimmy.json (docs/touchdown.md), plus the run's inputs."""
         return {
             "speed": self.speed,
             "spin_up_time": self.spin_up_time,
