@@ -68,6 +68,20 @@ def moment_shift(side: dict) -> float:
     return (side["axle_torque_Nm"] - h * fx) / fz - side["static_centre_of_pressure_x_m"]
 
 
+def exact_centre(vtu: Path) -> float:
+    """x (m) of the centre of pressure of a rolled map: the exact integral of p(xi) x(xi) over its
+    deformed faces projected on the road, over that of p (``projected_integral`` with a weight)."""
+    import meshio
+
+    from .aircraft_roll_export import projected_integral
+
+    m = meshio.read(vtu)
+    quads = m.cells_dict["quad"]
+    x = m.points + m.point_data["displacement"]
+    cp = m.point_data["CPRESS"]
+    return projected_integral(x, quads, cp, x[:, 0]) / projected_integral(x, quads, cp)
+
+
 def rows(folder: Path) -> list[Row]:
     static = folder / "roll_static.vtu"
     runs = sorted(p for p in folder.glob("roll_*.json") if p.stem != "roll_static")
@@ -126,6 +140,13 @@ def main(argv: list[str] | None = None) -> int:
     for r in table:
         if r.x_c_steady:
             print(f"  {r.name}: " + ", ".join(f"{1e3 * v:+.2f}" for v in r.x_c_steady))
+    print()
+    print("centre shift from the maps themselves, exact face integral of p(xi) x(xi) (mm):")
+    x0 = exact_centre(folder / "roll_static.vtu")
+    for r in table:
+        if r.x_c_steady:
+            shift = exact_centre(folder / f"{r.name}.vtu") - x0
+            print(f"  {r.name}: {1e3 * shift:+.2f} (fepost {1e3 * r.x_c:+.2f})")
     return 0
 
 
