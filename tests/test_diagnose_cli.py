@@ -17,7 +17,7 @@ from fepost.synthetic import write_map
 CAUSES = {
     "none", "friction_level", "pressure_dependent_friction", "speed_dependent_friction",
     "elliptic_patch", "anisotropic_friction", "pressure_shift", "sensor_offset", "sensor_crosstalk",
-    "load_transfer",
+    "load_transfer", "pressure_shape",
 }  # fmt: skip
 
 
