@@ -250,7 +250,7 @@ def _curve(**kw) -> CurveData:
 
 def _legend(fig) -> dict[str, str]:
     """Legend texts of the test points and the band, by series."""
-    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]  # the figure's legend, below the axes
     return {
         "test": next(t for t in texts if "test points" in t),
         "band": next(t for t in texts if "prediction band" in t),
@@ -327,7 +327,7 @@ def test_report_provenance_and_grid_phrase(analytic_report):
         assert f"<code>{path.name}</code> (SHA-256 {sha}…)" in table
     assert str(static.parent) not in table
     assert html.count("the densest evaluated") == 1
-    assert "model errors: the largest errors over the error map&#39;s grid, the densest evaluated" in html
+    assert "; the largest errors over the error map&#39;s grid, the densest evaluated" in html
 
 
 def test_table1_json_dash_is_standard_output(small_map, tmp_path, capsys, monkeypatch):
