@@ -73,7 +73,11 @@ class BrushTire:
     ``kx``, ``ky``: element stiffnesses (N/m); ``ahead``: index of the element
     ahead in the same row (−1 at the leading edge); ``h``: the row spacing (m);
     ``R``: the patch radius (m) of spin speeds; ``f``, ``load``: friction level and
-    normal load (N); ``provenance``: where each parameter comes from.
+    normal load (N); ``provenance``: where each parameter comes from; ``blend``: 0 for
+    the sharp stick-slip switch, else the share of the friction limit below it over
+    which an element's slip rate is blended in from 0 (a smooth switch for the time
+    integration's steps; the dissipation |F_i| λ_i stays exact, so does the energy
+    balance).
     """
 
     x: np.ndarray
@@ -87,6 +91,7 @@ class BrushTire:
     f: float
     load: float
     provenance: dict = field(default_factory=dict)
+    blend: float = 0.0
 
     @property
     def n(self) -> int:
@@ -188,7 +193,11 @@ class BrushTire:
         nx, ny = fx / safe, fy / safe
         drive = nx * self.kx * dx + ny * self.ky * dy + self.beta(vr) * (fn - lim)
         stiff = np.where(fn > 0, nx * nx * self.kx + ny * ny * self.ky, 1.0)
-        lam = np.where((fn >= (1 - ON_LIMIT) * lim) & (drive > 0) & (fn > 0), drive / stiff, 0.0)
+        if self.blend > 0:
+            share = np.clip((fn / np.where(lim > 0, lim, 1.0) - 1.0) / self.blend + 1.0, 0.0, 1.0)
+            lam = np.where((drive > 0) & (fn > 0), share * drive / stiff, 0.0)
+        else:
+            lam = np.where((fn >= (1 - ON_LIMIT) * lim) & (drive > 0) & (fn > 0), drive / stiff, 0.0)
         return dx - lam * nx, dy - lam * ny, lam
 
     def beta(self, vr: float) -> float:
