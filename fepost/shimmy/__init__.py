@@ -14,7 +14,12 @@ gear (docs/shimmy.md), by job:
 * `.anchor`: a published simple nose-gear model (Somieski 1997) with its
   stretched-string tire, the outside check of the machinery;
 * `.study`: the whole study on FE maps (`shimmy_study`); `.result`,
-  `.figures`, `.writer`: its result, figures and output folder.
+  `.figures`, `.writer`: its result, figures and output folder;
+* `.brush`: the tire between sliding and gripping (tread elements over the FE
+  patch); `.gripping`: the gear on it; `.touchdown`: the spin-up at touchdown
+  (docs/touchdown.md);
+* `.tire_string`: the exact stretched-string tire's yaw response;
+  `.anchors_dynamics`: the outside anchors of the dynamics (docs/dynamics-anchors.md).
 """
 
 from .gear import Gear, GearFileError, load_gear
