@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._blas import one_blas_thread
 from ._chunks import map_chunks, slices
 
 #: Faces per chunk: the (9, chunk) corner matrix and its weighted copy, 576 kB together,
@@ -101,7 +102,9 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
     X = np.ascontiguousarray(x, dtype=float)
     Y = np.ascontiguousarray(y, dtype=float)
     V = np.ascontiguousarray(values, dtype=float)
-    parts = map_chunks(lambda sl: _chunk_sums(X, Y, V, tri, sl, location), slices(len(tri), CHUNK))
+    # one BLAS thread for the chunks' thin matrix products (more would only spin beside map_chunks')
+    with one_blas_thread():
+        parts = map_chunks(lambda sl: _chunk_sums(X, Y, V, tri, sl, location), slices(len(tri), CHUNK))
     # the chunks' totals in their order: the same sums on one thread or two
     gram = np.zeros((_ROWS, _ROWS))
     first = np.zeros(_ROWS)
