@@ -158,8 +158,8 @@ class GripModel:
         deflections (the rigid wheel's `fepost.shimmy.equations.equilibrium` with the brush's forces)."""
         from scipy.optimize import root
 
-        if self.spin or self.energy:
-            raise ArgumentError("the steady state is for the held slip (spin=False, energy=False)")
+        if self.spin or self.energy or self.crab:
+            raise ArgumentError("the steady state is for the held slip (spin=False, energy=False, crab=0)")
         g, tire = self.gear, self.tire
         vr = (1.0 - g.slip_ratio) * V
 
