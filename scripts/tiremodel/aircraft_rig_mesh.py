@@ -64,21 +64,23 @@ MESHES = {
         n_crown=2, n_shoulder=1, n_side=2, first_deg=6.0, growth=1.0, fine_deg=30.0, n_coarse=2
     ),
     # the whole tire (issue 39): 360 degrees, no cut faces, two elements through the rubber
-    # layer; the fine region as the sector's rig mesh, 12 geometrically growing layers per
-    # side from 33 degrees up to the top
+    # layer; 1.8 degree layers within +-33 degrees, 12 geometrically growing layers per side
+    # from there up to the top. (With the sector's counts, 4 + 2 + 3 and 2.2 degrees, the base
+    # stalled at 77 mm of deflection: a crown node row 71 mm off the centre line flipped in and
+    # out of contact, the residual 8 to 39 N, the increments cut below 1e-5 of the travel.)
     "whole": AircraftRigParams(
-        n_crown=4,
-        n_shoulder=2,
-        n_side=3,
+        n_crown=5,
+        n_shoulder=3,
+        n_side=4,
         n_rubber=2,
         incompatible_all=True,
-        first_deg=2.2,
+        first_deg=1.8,
         growth=1.0,
         fine_deg=33.0,
         n_coarse=12,
         sector_deg=180.0,
     ),
-    # its convergence partner: 1.5 x the counts along the section and around the fine region
+    # the finer partner (the programme's mesh): 6 + 3 + 4 elements per half section, 1.5 degrees
     "whole-fine": AircraftRigParams(
         n_crown=6,
         n_shoulder=3,
