@@ -150,3 +150,32 @@ def test_predict_command_with_defaults(maps, tmp_path, capsys):
     assert -float(rows[0]["Fx_exact"]) == pytest.approx(F * N, rel=TOL)
     assert -float(rows[1]["Mz_exact"]) == pytest.approx(F * lever, rel=TOL)
     assert -float(rows[1]["Mz_paper"]) == pytest.approx(F * lever, rel=TOL)
+
+
+@pytest.mark.parametrize("location", ["point", "cell"])
+def test_polar_moment_of_a_disc_is_its_closed_form(tmp_path, location):
+    """∬ σ r dA of σ = 1 + (r/a)² over a disc of radius a is 2π a³ (1/3 + 1/5) about its
+    centre; of σ = 1 about a point at distance d outside it, a² π d (1 + a²/(8 d²)) to
+    O(a⁴/d⁴). Nodal and face data alike, over more triangles than one chunk."""
+    import pyvista as pv
+
+    from fepost.patch import build_patch
+    from fepost.reader import read_contact
+
+    a = 0.05
+    disc = pv.Disc(inner=0.0, outer=a, r_res=40, c_res=720).triangulate()
+    xy = disc.points[:, :2] if location == "point" else disc.cell_centers().points[:, :2]
+    r2 = np.sum(xy**2, axis=1) / a**2
+    for name, values in (("rim", 1.0 + r2), ("flat", np.ones_like(r2))):
+        (disc.point_data if location == "point" else disc.cell_data)["CPRESS"] = values
+        path = tmp_path / f"{name}.vtu"
+        pv.UnstructuredGrid(disc).save(path)
+        patch = build_patch(read_contact(path))
+        assert patch.location == location and len(patch.triangles) > 32768
+        if name == "rim":
+            # the map's own centre of pressure is the disc's centre (symmetry)
+            assert polar_moment(patch) == pytest.approx(2 * np.pi * a**3 * (1 / 3 + 1 / 5), rel=2e-3)
+        else:
+            polygon = 0.5 * 720 * np.sin(2 * np.pi / 720) / np.pi  # the 720-gon's area over the disc's
+            far = a**2 * np.pi * 0.4 * (1 + a**2 / (8 * 0.4**2)) * polygon
+            assert polar_moment(patch, (0.4, 0.0)) == pytest.approx(far, rel=2e-5)
