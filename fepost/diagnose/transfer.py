@@ -23,6 +23,11 @@ model) starts from the local model about zero shift and corrects the shifts by
 Newton steps on exact evaluations until they move by less than
 `SHIFT_TOL` × R (`MAX_EXACT` evaluations at most; the map
 d ↦ h F(d)/N contracts for |h| f ≲ the patch radius, the parameter bounds).
+Where it does not (a map of a few small supports, whose force turns sharply as the
+centre of rotation passes a support), the shifts are kept finite and within the patch
+radius R (`_bounded`: a centre of pressure cannot leave the patch), so the model
+predicts poorly there and the fit moves away, instead of the iteration running to
+infinity.
 
 h_x, h_y are the effective heights; h = 0 is no effect (``friction_level``). The
 model combines with the sensor causes (offsets, crosstalk: applied after), not
@@ -43,6 +48,14 @@ SHIFT_TOL = 1e-7
 MAX_EXACT = 6
 #: Iterations of the fixed point inside a local model.
 LOCAL_ITERATIONS = 60
+
+
+def _bounded(d: np.ndarray, previous: np.ndarray, radius: float) -> np.ndarray:
+    """Shifts ``d`` (n, 2) with non-finite rows put back to ``previous`` and rows longer
+    than ``radius`` scaled back to it (module docstring)."""
+    d = np.where(np.all(np.isfinite(d), axis=1)[:, None], d, previous)
+    length = np.hypot(d[:, 0], d[:, 1])
+    return d * np.minimum(1.0, radius / np.maximum(length, 1e-300))[:, None]
 
 
 def _local(B0, G, H, d0):
@@ -98,7 +111,7 @@ def load_transfer_model(
 
     def solve_local(p, model, d):
         for _ in range(LOCAL_ITERATIONS):
-            new = target(p, model(d))
+            new = _bounded(target(p, model(d)), d, R)
             if np.max(np.abs(new - d)) < SHIFT_TOL * R:
                 return new
             d = new
@@ -120,7 +133,7 @@ def load_transfer_model(
             r = target(p, B) - d
             if np.max(np.abs(r)) < SHIFT_TOL * R:
                 break
-            d = d + np.linalg.solve(jac, r[..., None])[..., 0]
+            d = _bounded(d + np.linalg.solve(jac, r[..., None])[..., 0], d, R)
             B = pred.coulomb_moved(d[:, 0], d[:, 1])
         return d, B
 
