@@ -5,7 +5,7 @@ extension C₁, each other extension C₂ is a candidate second cause. The joint
 model C₁ + C₂ (`joint_candidate`: f shared, both
 parameter sets, the effects combined exactly) nests C₁, C₂, ``friction_level``
 and ``none``, and is **admissible** when against each of them its BIC is lower,
-its likelihood-ratio test has p < `PAIR_ALPHA` = 0.01/8 (Bonferroni over
+its likelihood-ratio test has p < `PAIR_ALPHA` = 0.01/9 (Bonferroni over
 the second causes tried: at most the eight other extensions that combine with
 it, ``load_transfer`` only with the sensor causes, and a friction level other
 than nominal), and its held-out log density is higher. The family-wise
@@ -58,8 +58,9 @@ from .fitting import Fit, fit
 from .models import Candidate, with_fixed
 from .selection import INDISTINGUISHABLE_DBIC, CrossValidation, crossvalidate, nesting_tests
 
-#: Level of each second-cause likelihood-ratio test (Bonferroni: 1 % over at most 8 second causes).
-PAIR_ALPHA = 0.01 / 8
+#: Level of each second-cause likelihood-ratio test (Bonferroni: 1 % over at most the other
+#: extensions and a friction level other than nominal, as many as the extensions).
+PAIR_ALPHA = 0.01 / len(EXTENSIONS)
 #: A joint model is fitted when its score (or Wald) statistic reaches this share of the
 #: likelihood ratio it needs to be admitted (module docstring).
 SCREEN_FRACTION = 0.5
