@@ -101,14 +101,15 @@ def _shape(xi, eta, quadratic):
 
 def integrate(points, p, corners, mids=None, normal_axis=2, centre=None, cut=16):
     """Integrals over the faces of the field p, projected on the plane normal to ``normal_axis``:
-    {N, area, Mx, My (first moments), spin (∬σ r dA about ``centre``, or about the centre of pressure)}.
+    {N, area, Mx, My (first moments), Mxx (∬σ x² dA), spin (∬σ r dA about ``centre``, or about
+    the centre of pressure)}.
 
     Each face is cut into ``cut`` × ``cut`` cells with a 4 × 4 Gauss rule each: the distance r has a
     kink at the centre, which a single Gauss rule per face would miss.
     """
     others = [a for a in range(3) if a != normal_axis]
     nodes = corners if mids is None else np.concatenate([corners, mids], axis=1)
-    tot = {"N": 0.0, "area": 0.0, "Mx": 0.0, "My": 0.0}
+    tot = {"N": 0.0, "area": 0.0, "Mx": 0.0, "My": 0.0, "Mxx": 0.0}
     samples = []
     edges = np.linspace(-1.0, 1.0, cut + 1)
     gx = (0.5 * (edges[:-1, None] + edges[1:, None]) + 0.5 * (edges[1] - edges[0]) * _G[0][None, :]).ravel()
@@ -126,6 +127,7 @@ def integrate(points, p, corners, mids=None, normal_axis=2, centre=None, cut=16)
             tot["area"] += float(det.sum())
             tot["Mx"] += float((s * xy[:, 0]) @ det)
             tot["My"] += float((s * xy[:, 1]) @ det)
+            tot["Mxx"] += float((s * xy[:, 0] ** 2) @ det)
             samples.append((xy, s * det))
     c = np.array([tot["Mx"], tot["My"]]) / tot["N"] if centre is None else np.asarray(centre)
     tot["spin"] = float(sum((np.hypot(*(xy - c).T) * sd).sum() for xy, sd in samples))

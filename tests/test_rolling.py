@@ -79,7 +79,13 @@ def test_tiny_rolling_deck_end_to_end(tmp_path):
     assert c["N_rolling"] == pytest.approx(side["cpress_integral_projected"], rel=1e-3)
     own = side["samples"][-1]["centre_of_pressure_shift_m"]
     assert c["x_c"] == pytest.approx(own, rel=0.15, abs=1e-4)
-    assert math.isfinite(c["k_x"])
+    # k_x = R x_c / <x^2> against the independent face integrals of both maps (not only finite)
+    static_m, rolled_m = (_road_moments(out / f"{name}.vtu") for name in ("roll_static", "roll_tiny"))
+    x0 = static_m["Mx"] / static_m["N"]
+    second = static_m["Mxx"] / static_m["N"] - x0**2
+    x_c = rolled_m["Mx"] / rolled_m["N"] - x0
+    # measured: 0.02177 against 0.02169
+    assert c["k_x"] == pytest.approx(c["R"] * x_c / second, rel=0.05)
 
 
 @pytest.mark.skipif(not RUNS, reason="meshes/rig-aircraft/ holds no rolling runs yet")
@@ -146,6 +152,28 @@ def test_free_rolling_kx_is_close_to_zero():
     assert side["axle_torque_Nm"] == pytest.approx(2 * setup.drive_stiffness * lag, rel=1e-3)
     # the map's own k_x is that line at the run's final force (fepost against the face integral)
     assert c.k_x == pytest.approx(per_metre * (intercept + slope * fx[-1]), rel=0.15)
+    # and k_x = R x_c / <x^2> (THEORY section 2) from an independent bilinear integration of both
+    # maps' faces on the road (tests/independent_fe.py; R = r_max is fepost's patch boundary):
+    # measured 0.03888 against fepost's 0.03896, x_c 1.927 against 1.931 mm
+    static, rolled = (_road_moments(ROLL / f"{name}.vtu") for name in (prog.STATIC_NAME, "roll_free"))
+    x0 = static["Mx"] / static["N"]
+    second = static["Mxx"] / static["N"] - x0**2
+    x_c = rolled["Mx"] / rolled["N"] - x0
+    assert c.x_c == pytest.approx(x_c, rel=0.01)
+    assert c.k_x == pytest.approx(c.R * x_c / second, rel=0.01)
+
+
+def _road_moments(path: Path) -> dict:
+    """N and the moments of the contact pressure over the faces touching the road (z = 0), deformed."""
+    import meshio
+    from independent_fe import integrate
+
+    mesh = meshio.read(path)
+    p = np.asarray(mesh.point_data["CPRESS"], float)
+    x = mesh.points + mesh.point_data["displacement"]
+    quads = mesh.cells_dict["quad"]
+    loaded = quads[np.any(p[quads] > 0, axis=1)]
+    return integrate(x, np.maximum(p, 0.0), loaded, normal_axis=2)
 
 
 # ------------------------------------------------- what CalculiX offers for a rate-dependent tread
