@@ -277,6 +277,7 @@ VALUES = ["", "-1", "0", "1e999", "nan", "abc", "9" * 5000, "-1e-300", "1,2,3,4"
 SKIP_OPTIONS = {("sweep", "--scheduler")}
 # a valid gear file, so that the shimmy command reaches the option under test
 GEAR_EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "gear_a320_main.json"
+TOUCHDOWN_GEAR = GEAR_EXAMPLE.with_name("gear_a320_main_touchdown.json")
 
 
 def _required(command: str, folder: Path) -> list[str]:
@@ -290,7 +291,10 @@ def _required(command: str, folder: Path) -> list[str]:
         "predict": [missing, "--kinematics", folder / "good.csv", "--out", folder / "pred.csv"],
         "sweep": [missing, "--out", folder / "out-sweep"],
         "rig": [missing, "--out", folder / "rig.csv"],
-        "shimmy": [missing, "--gear", GEAR_EXAMPLE, "--out", folder / "out-shimmy"],
+        # the touchdown's gear: its options' values are then judged, not the gear's lack of keys
+        "shimmy": [missing, "--gear", TOUCHDOWN_GEAR, "--out", folder / "out-shimmy"],
+        "pushes": [folder / "missing.txt", "--body", folder / "missing.json", "--out", folder / "p.csv"],
+        "map": [folder / "missing.json", "--out", folder / "m.vtu"],
     }.get(command, [])
 
 
@@ -309,10 +313,21 @@ def test_hostile_option_values(capsys, data, command, monkeypatch):
     folder, _, _ = data
     # a hostile --out value is a relative folder (``--out=abc``): keep what it writes in the scratch folder
     monkeypatch.chdir(folder)
-    if command not in ("coefficients", "table1", "report", "diagnose", "predict", "sweep", "rig", "shimmy"):
+    if command not in (
+        "coefficients",
+        "table1",
+        "report",
+        "diagnose",
+        "predict",
+        "sweep",
+        "rig",
+        "shimmy",
+        "pushes",
+        "map",
+    ):
         pytest.fail(f"new command {command!r}: add its required arguments to _required()")
     base = _required(command, folder)
-    missing = folder / "missing.vtu"
+    missing = folder / {"map": "missing.json", "pushes": "missing.json"}.get(command, "missing.vtu")
     tried = 0
     for opt in _value_options(command):
         for value in VALUES:
