@@ -9,9 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+# the example gear (examples/gear_a320_main.json) and closed forms of the rated-load tire
+from test_shimmy_linear import COEF, GEAR
+
 from fepost.cli import main
 from fepost.shimmy.contact import closed_forms_contact, model_contact
-from fepost.shimmy.gear import Gear
 from fepost.shimmy.linear import Linearisation, stability_map
 from fepost.shimmy.result import ModelStability
 from fepost.shimmy.simulate import simulate, verdict_of
@@ -19,21 +21,6 @@ from fepost.shimmy.simulate import simulate, verdict_of
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "gear_a320_main.json"
 STATIC = REPO / "meshes" / "aircraft" / "static_100.vtu"
-
-#: The example gear (examples/gear_a320_main.json) and closed forms of the rated-load tire.
-GEAR = Gear(
-    yaw_inertia=80.0,
-    torsional_stiffness=1.5e6,
-    torsional_damping=300.0,
-    trail=0.1,
-    lateral_mass=700.0,
-    lateral_stiffness=2.0e7,
-    lateral_damping=2000.0,
-    wheels=2,
-    half_track=0.46,
-    slip_ratio=0.03,
-)
-COEF = {"F0": 59578.6, "M0": 8254.3, "a": 0.652, "m": 10.39, "k_x": 0.2406, "R": 0.2538}
 
 
 @pytest.fixture(scope="module")
