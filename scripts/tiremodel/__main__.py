@@ -78,10 +78,10 @@ def _parser() -> argparse.ArgumentParser:
     )
     ra.add_argument(
         "--mesh",
-        choices=["rig", "fine", "whole", "whole-fine", "whole-test"],
+        choices=["rig", "fine", "whole", "whole-fine", "whole-tiny", "whole-test"],
         default="rig",
         help="rig, fine: the +-70 degree sector (meshes/rig-aircraft/); whole, whole-fine: the whole "
-        "360-degree tire (meshes/rig-tire360/); whole-test: its tiny version",
+        "360-degree tire (meshes/rig-tire360/); whole-tiny, whole-test: tiny versions",
     )
     ra.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
     ra.add_argument(

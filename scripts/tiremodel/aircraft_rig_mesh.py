@@ -93,6 +93,20 @@ MESHES = {
         n_coarse=12,
         sector_deg=180.0,
     ),
+    # the whole tire at a few hundred elements: the mu = 0 pure-spin check of the boundary
+    # conditions, solved in a few minutes (one element along the sidewall)
+    "whole-tiny": AircraftRigParams(
+        n_crown=2,
+        n_shoulder=1,
+        n_side=1,
+        n_rubber=2,
+        incompatible_all=True,
+        first_deg=8.0,
+        growth=1.0,
+        fine_deg=32.0,
+        n_coarse=4,
+        sector_deg=180.0,
+    ),
     # the whole tire at the test's size (deck checks and the tiny CalculiX case)
     "whole-test": AircraftRigParams(
         n_crown=2,

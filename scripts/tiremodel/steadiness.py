@@ -47,12 +47,13 @@ def tail_motion(history: dict, friction: float, share: float = SHARE) -> Motion:
     if tail.sum() < 2:
         raise ValueError(f"history: fewer than two increments in the last {share:g} of the path")
     fx, fy, fz = (np.asarray(history[k], dtype=float)[tail] for k in ("Fx", "Fy", "Fz"))
-    fn = friction * float(fz[-1])
+    # a frictionless run (friction 0) has no Coulomb scale: its forces are judged against N
+    fn = (friction if friction > 0.0 else 1.0) * float(fz[-1])
     return Motion(
         fx=float(np.ptp(fx)) / fn,
         fy=float(np.ptp(fy)) / fn,
         n=float(np.ptp(fz)) / float(fz[-1]),
-        f_abs=float(np.ptp(np.hypot(fx, fy) / (friction * fz))),
+        f_abs=float(np.ptp(np.hypot(fx, fy) / (fn / float(fz[-1]) * fz))),
         increments=int(tail.sum()),
     )
 
