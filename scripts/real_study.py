@@ -35,8 +35,9 @@ Reads the five hardboard logs of ``../shared/real/planar-sliding`` (Zhou et al.,
 
 Writes ``results.json``, ``tables.md`` and the figures into ``--out`` (default
 ``out/real``); ``--update`` copies them into ``docs/real/`` (the tables as ``tables.txt``).
-On the close-legs log ``fepost.diagnose`` stops in the ``load_transfer`` fit (NaN shifts);
-that log's diagnosis is then run without that cause and says so (``failed_with_every_cause``).
+Should ``fepost.diagnose`` stop on a log (its ``load_transfer`` fixed point once diverged on
+the close legs), that log's diagnosis is run without that cause and says so
+(``failed_with_every_cause``); on the five hardboard logs none stops.
 """
 
 from __future__ import annotations
