@@ -14,8 +14,9 @@ nested in it (``none`` and, for the extensions, ``friction_level``; see
 1. its BIC is lower;
 2. the likelihood-ratio statistic 2Δℓ exceeds the χ² quantile with Δk degrees
    of freedom at level `ALPHA` = 0.05/10 (Bonferroni over the ten
-   candidates other than ``none``: ``friction_level`` and the nine extensions, so that on data with no effect the chance of naming any cause
-   stays below 5 %; without the nesting test the richer of two nested models
+   candidates other than ``none``: ``friction_level`` and the nine extensions,
+   so that on data with no effect the chance of naming any cause stays below
+   5 %; without the nesting test the richer of two nested models
    wins on AIC about one time in six, P(χ²₁ > 2) = 0.157);
 3. its mean held-out log predictive density per observation under
    `FOLDS`-fold cross-validation (noise parameters re-estimated on each
