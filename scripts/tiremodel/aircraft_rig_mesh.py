@@ -50,6 +50,11 @@ class AircraftRigParams(AircraftParams):
         return [h0 * q**i for i in range(1, self.n_coarse + 1)]
 
 
+def _whole(**counts) -> AircraftRigParams:
+    """A whole-tire mesh: 360 degrees, two elements through the rubber, incompatible modes."""
+    return AircraftRigParams(n_rubber=2, incompatible_all=True, growth=1.0, sector_deg=180.0, **counts)
+
+
 MESHES = {
     # the programme: 4 + 2 + 3 elements per half section, 2 through the wall, 2.2 degree layers
     "rig": AircraftRigParams(
@@ -68,57 +73,41 @@ MESHES = {
     # from there up to the top. (With the sector's counts, 4 + 2 + 3 and 2.2 degrees, the base
     # stalled at 77 mm of deflection: a crown node row 71 mm off the centre line flipped in and
     # out of contact, the residual 8 to 39 N, the increments cut below 1e-5 of the travel.)
-    "whole": AircraftRigParams(
+    "whole": _whole(
         n_crown=5,
         n_shoulder=3,
         n_side=4,
-        n_rubber=2,
-        incompatible_all=True,
         first_deg=1.8,
-        growth=1.0,
         fine_deg=33.0,
         n_coarse=12,
-        sector_deg=180.0,
     ),
     # the finer partner (the programme's mesh): 6 + 3 + 4 elements per half section, 1.5 degrees
-    "whole-fine": AircraftRigParams(
+    "whole-fine": _whole(
         n_crown=6,
         n_shoulder=3,
         n_side=4,
-        n_rubber=2,
-        incompatible_all=True,
         first_deg=1.5,
-        growth=1.0,
         fine_deg=33.0,
         n_coarse=12,
-        sector_deg=180.0,
     ),
     # the whole tire at a few hundred elements: the mu = 0 pure-spin check of the boundary
     # conditions, solved in a few minutes (one element along the sidewall)
-    "whole-tiny": AircraftRigParams(
+    "whole-tiny": _whole(
         n_crown=2,
         n_shoulder=1,
         n_side=1,
-        n_rubber=2,
-        incompatible_all=True,
         first_deg=8.0,
-        growth=1.0,
         fine_deg=32.0,
         n_coarse=4,
-        sector_deg=180.0,
     ),
     # the whole tire at the test's size (deck checks and the tiny CalculiX case)
-    "whole-test": AircraftRigParams(
+    "whole-test": _whole(
         n_crown=2,
         n_shoulder=1,
         n_side=2,
-        n_rubber=2,
-        incompatible_all=True,
         first_deg=8.0,
-        growth=1.0,
         fine_deg=32.0,
         n_coarse=3,
-        sector_deg=180.0,
     ),
 }
 
