@@ -28,7 +28,6 @@ Every error is one line naming the file and the key.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -39,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from .errors import DataError, InputFileError, ScaleError
+from .jsonobject import read_json_object
 
 #: Log formats `load_body` knows (the ``log.format`` key).
 LOG_FORMATS = ("planar-push",)
@@ -296,26 +296,9 @@ def support_loads(body: Body) -> np.ndarray:
 
 def _read_object(p: Path) -> dict:
     try:
-        size = p.stat().st_size
-        if size > MAX_BYTES:
-            raise InputFileError(f"{p}: body JSON is {size} bytes (limit {MAX_BYTES})")
-        data = json.loads(p.read_bytes(), parse_constant=_no_constant)
-    except InputFileError:
-        raise
+        return read_json_object(p, "body JSON", MAX_BYTES)
     except FileNotFoundError:
         raise InputFileError(f"{p}: body file not found") from None
-    except (OSError, ValueError, RecursionError) as exc:
-        text = str(exc).strip().splitlines()
-        raise InputFileError(
-            f"{p}: unreadable body JSON ({text[0] if text else type(exc).__name__})"
-        ) from None
-    if not isinstance(data, dict):
-        raise InputFileError(f"{p}: body JSON must be an object, got {type(data).__name__}")
-    return data
-
-
-def _no_constant(name: str):
-    raise ValueError(f"{name} is not a number JSON allows")
 
 
 def _number(where: str, key: str, value) -> float:

@@ -12,20 +12,16 @@ fepost sees is always one number per key.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
 from ..errors import InputFileError
+from ..jsonobject import read_json_object
 
 #: Largest sidecar accepted, bytes.
 MAX_BYTES = 1 << 20
 #: Keys fepost reads as numbers.
 NUMBER_KEYS = ("reaction_z", "inflation_pressure", "deflection", "friction", "cpress_integral", "load")
-
-
-def _no_constants(name: str):
-    raise ValueError(f"non-finite number {name}")
 
 
 def read_sidecar(path: Path) -> dict | None:
@@ -40,19 +36,9 @@ def read_sidecar(path: Path) -> dict | None:
     if side == path or not side.is_file():
         return None
     try:
-        size = side.stat().st_size
-        if size > MAX_BYTES:
-            raise InputFileError(f"{side}: sidecar JSON is {size} bytes (limit {MAX_BYTES})")
-        data = json.loads(side.read_bytes(), parse_constant=_no_constants)
-    except InputFileError:
-        raise
-    except (OSError, ValueError, RecursionError) as exc:
-        text = str(exc).strip().splitlines()
-        raise InputFileError(
-            f"{side}: unreadable sidecar JSON ({text[0] if text else type(exc).__name__})"
-        ) from None
-    if not isinstance(data, dict):
-        raise InputFileError(f"{side}: sidecar JSON must be an object, got {type(data).__name__}")
+        data = read_json_object(side, "sidecar JSON", MAX_BYTES)
+    except FileNotFoundError:  # removed since the check above
+        return None
     for key in NUMBER_KEYS:
         v = data.get(key)
         if v is None:
