@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_body import LEGS
 
 from fepost.body import load_body
 from fepost.errors import DataError, InputFileError
@@ -33,19 +34,14 @@ def _quat(yaw: float) -> list[float]:
 
 
 def _body(tmp_path: Path, origin=(0.5, -0.3, 0.0)) -> Path:
-    data = {
-        "mass": 1.5,
-        "gravity": 9.81,
-        "centre_of_mass": [0.05, 0.05],
-        "reference_point": [0.05, 0.05],
-        "supports": [[0.01, 0.01], [0.13, 0.01], [0.01, 0.13]],
-        "support_radius": 0.002,
+    """test_body's three-leg body, logged with the rig's sensor matrix and ``origin``."""
+    data = {k: v for k, v in LEGS.items() if k != "board"} | {
         "log": {
             "format": "planar-push",
             "sensor_to_world": SENSOR,
             "body_origin_in_mocap": list(origin),
             "length_unit": 0.001,
-        },
+        }
     }
     p = tmp_path / "body.json"
     p.write_text(json.dumps(data))

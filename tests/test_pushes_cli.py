@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_pushes import excerpt
 
 from fepost.body import load_body
 from fepost.cli import main
@@ -22,22 +23,10 @@ pytestmark = pytest.mark.skipif(
 )
 
 
-def _excerpt(log: Path, count: int, out: Path) -> Path:
-    """The first ``count`` pushes of ``log``, the header saying ``count``."""
-    lines = log.read_text().splitlines()
-    i = 1
-    for _ in range(count):
-        i += 2
-        i += int(lines[i]) + 1
-        i += int(lines[i]) + 1
-    out.write_text("\n".join([str(count), *lines[1:i]]) + "\n")
-    return out
-
-
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     folder = tmp_path_factory.mktemp("pushes_cli")
-    log = _excerpt(REAL / f"hardboard_{LAYOUT}.txt", 5, folder / "excerpt.txt")
+    log = excerpt(REAL / f"hardboard_{LAYOUT}.txt", 5, folder / "excerpt.txt")
     out = folder / "pushes.csv"
     return log, out, folder
 
