@@ -33,6 +33,18 @@ SIZE = 0.15
 COARSE = {"EDGE_SIZE": 0.005, "FAR_SIZE": 0.015, "LAYERS": 2}
 
 
+def _block(board: dict) -> dict:
+    """The flat-based block of these tests on ``board``."""
+    return {
+        "mass": MASS,
+        "gravity": G,
+        "centre_of_mass": [0.05, 0.05],
+        "reference_point": [0.05, 0.05],
+        "base": [[0.0, 0.0], [SIZE, 0.0], [0.0, SIZE]],
+        "board": board,
+    }
+
+
 @pytest.fixture(scope="module")
 def fe_map(tmp_path_factory):
     if not HAVE_CCX:
@@ -41,18 +53,7 @@ def fe_map(tmp_path_factory):
 
     d = tmp_path_factory.mktemp("bodymap_fe")
     body = d / "block.json"
-    body.write_text(
-        json.dumps(
-            {
-                "mass": MASS,
-                "gravity": G,
-                "centre_of_mass": [0.05, 0.05],
-                "reference_point": [0.05, 0.05],
-                "base": [[0.0, 0.0], [SIZE, 0.0], [0.0, SIZE]],
-                "board": {"thickness": 0.01},
-            }
-        )
-    )
+    body.write_text(json.dumps(_block({"thickness": 0.01})))
     with pytest.MonkeyPatch.context() as mp:
         for name, value in COARSE.items():
             mp.setattr(board, name, value)
@@ -133,18 +134,7 @@ def test_fe_refuses_point_supports(tmp_path, capsys):
 )
 def test_bad_board_keys(tmp_path, capsys, board, message):
     body = tmp_path / "block.json"
-    body.write_text(
-        json.dumps(
-            {
-                "mass": MASS,
-                "gravity": G,
-                "centre_of_mass": [0.05, 0.05],
-                "reference_point": [0.05, 0.05],
-                "base": [[0.0, 0.0], [SIZE, 0.0], [0.0, SIZE]],
-                "board": board,
-            }
-        )
-    )
+    body.write_text(json.dumps(_block(board)))
     assert main(["map", str(body), "--out", str(tmp_path / "m.vtu"), "--fe"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and message in err, err
