@@ -4,7 +4,7 @@
     python scripts/real_study.py --update        # also rewrites docs/real/ (tracked)
 
 Reads the five hardboard logs of ``../shared/real/planar-sliding`` (Zhou et al., ICRA
-2016; the plywood logs are held out and never read) and, per layout:
+2016; no other log is read) and, per layout:
 
 1. ``fepost pushes`` (the pushes CSV) and ``fepost map`` (the support's pressure map;
    for the flat base also ``--fe``, the base on an elastic board solved by CalculiX);

@@ -15,7 +15,7 @@ if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
 SHARED = REPO.parent / "shared" / "real" / "planar-sliding"
-#: The hardboard layouts (folder names of the upstream logs); the plywood logs are held out.
+#: The hardboard layouts (folder names of the upstream logs): the only logs the study reads.
 LAYOUTS = (
     "10_130_10_10_10_130",
     "10_90_10_10_30_130",
