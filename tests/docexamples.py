@@ -293,8 +293,7 @@ def numbers_agree(a: str, b: str, rtol: float) -> bool:
     if rtol <= 0:
         return False
     x, y = float(a), float(b)
-    allowed = rtol * max(abs(x), abs(y)) + max(_half_unit(a), _half_unit(b))
-    return abs(x - y) <= allowed * (1.0 + 1e-12)
+    return abs(x - y) <= rtol * max(abs(x), abs(y)) + max(_half_unit(a), _half_unit(b))
 
 
 def line_agrees(expected: str, full: str, rtol: float) -> bool:
