@@ -24,6 +24,7 @@ from .causes import Predictor, build_candidates
 from .fitting import Fit, fit
 from .lackfit import LOF_LEVEL, lack_of_fit
 from .measured import CHANNELS, MeasuredData
+from .models import Candidate
 from .pipeline import screen
 from .simulation import Simulation
 
@@ -33,7 +34,7 @@ class FittedCause:
     """One cause's candidate fitted to ``data`` on the rows the screen kept."""
 
     data: MeasuredData
-    candidate: object
+    candidate: Candidate
     fit: Fit
     Y: np.ndarray
     rows: np.ndarray
@@ -41,7 +42,7 @@ class FittedCause:
     def prediction(self, values: np.ndarray | None = None) -> np.ndarray:
         """The fitted model's dimensionless channels (n, 3) at ``values`` (default the fit's)."""
         model = self.fit.model if self.fit.model is not None else self.candidate
-        return model.predict(self.fit.values if values is None else values)  # type: ignore[attr-defined]
+        return model.predict(self.fit.values if values is None else values)
 
     def verdict(self) -> dict:
         """`lack_of_fit` of this fit, as ``diagnose`` runs it on its chosen model."""
@@ -88,7 +89,7 @@ def false_alarms(fitted: FittedCause, draws: int, *, seed: int = 0) -> FalseAlar
     for _ in range(draws):
         Y = fitted.Y.copy()
         Y[fitted.rows] = clean[fitted.rows] + sigma * rng.standard_normal(sigma.shape)
-        again = fit(fitted.candidate, Y, fitted.rows, start=fitted.fit.values, noise=fitted.fit.noise)  # type: ignore[arg-type]
+        again = fit(fitted.candidate, Y, fitted.rows, start=fitted.fit.values, noise=fitted.fit.noise)
         lof = FittedCause(fitted.data, fitted.candidate, again, Y, fitted.rows).verdict()
         detected += bool(lof["detected"])
         for ch, v in lof["channels"].items():
