@@ -11,6 +11,8 @@ import argparse
 import math
 import sys
 
+from ._validate import number_in
+
 
 def _numbers(lo: float, hi: float, unit: str):
     def parse(text: str) -> tuple[float, ...]:
@@ -66,8 +68,8 @@ def add_touchdown_options(p: argparse.ArgumentParser) -> None:
     )
     g.add_argument(
         "--touchdown-duration",
-        type=_numbers(0.05, 60.0, "s"),
-        default=(2.0,),
+        type=number_in(0.05, 60.0),
+        default=2.0,
         metavar="T",
         help="simulated seconds per touchdown (default 2)",
     )
@@ -79,14 +81,6 @@ def check_touchdown(args: argparse.Namespace, gear) -> None:
 
     if getattr(args, "touchdown", None):
         check_gear(gear, str(args.gear))
-        if len(args.touchdown_duration) != 1:
-            raise_usage("--touchdown-duration", "takes one value")
-
-
-def raise_usage(option: str, problem: str) -> None:
-    from ..errors import ArgumentError
-
-    raise ArgumentError(f"argument {option}: {problem}")
 
 
 def run_touchdowns(args: argparse.Namespace, gear, analysis) -> list:
@@ -122,7 +116,7 @@ def run_touchdowns(args: argparse.Namespace, gear, analysis) -> list:
             sink_rate=s,
             yaw=math.radians(y),
             crab=math.radians(c),
-            duration=args.touchdown_duration[0],
+            duration=args.touchdown_duration,
         )
         out.append((run, f"touchdown_{k:02d}.csv"))
         if not args.no_progress:
