@@ -132,7 +132,7 @@ class Body:
         """The base polygon's area (m²); raises `DataError` for a body on point supports."""
         if self.base is None:
             raise DataError(f"{self.path}: the body stands on point supports, it has no 'base'")
-        return abs(_signed_area(np.array(self.base)))
+        return abs(signed_area(np.array(self.base)))
 
     def to_dict(self) -> dict:
         """The body as plain JSON values (the contract's keys)."""
@@ -273,7 +273,7 @@ def support_loads(body: Body) -> np.ndarray:
             f"{body.path}: key 'supports': statics gives the loads of exactly 3 supports, got {len(pts)}"
         )
     size = float(np.max(np.ptp(pts, axis=0)))
-    area2 = _signed_area(pts) * 2.0
+    area2 = signed_area(pts) * 2.0
     if size == 0.0 or abs(area2) <= GEOMETRY_RTOL * size * size:
         raise DataError(
             f"{body.path}: key 'supports': the three supports are collinear, statics cannot share the load"
@@ -368,14 +368,15 @@ def _check_radius(where: str, supports, radius) -> None:
         )
 
 
-def _signed_area(pts: np.ndarray) -> float:
+def signed_area(pts: np.ndarray) -> float:
+    """The shoelace area (m²) of the polygon ``pts`` (n, 2): positive counter-clockwise."""
     x, y = pts[:, 0], pts[:, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
 def _check_base(where: str, poly: np.ndarray, com: _Point) -> None:
     size = float(np.max(np.ptp(poly, axis=0)))
-    if size == 0.0 or abs(_signed_area(poly)) <= GEOMETRY_RTOL * size * size:
+    if size == 0.0 or abs(signed_area(poly)) <= GEOMETRY_RTOL * size * size:
         raise DataError(f"{where}: key 'base': the polygon has no area")
     n = len(poly)
     for i in range(n):

@@ -392,7 +392,7 @@ def board_map(
         reaction_source="CalculiX: total vertical reaction of the table under the board",
         board={**board.__dict__, "penalty_slope": penalty, "margin": MARGIN_THICKNESSES * t},
         mesh={"edge_size": edge, "far_size": far, "layers": layers, "nodes": int(len(solid.nodes))},
-        uniform_pressure=body.weight / _polygon_area(poly),
+        uniform_pressure=body.weight / body.base_area(),
         cpress_scale=reaction / raw_load,
     )
     return BodyMap("board", xy, tri, p, load, (float(first[0] / load), float(first[1] / load)), info)
@@ -417,8 +417,3 @@ def _map_faces(fld) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     remap = np.full(len(fld.points), -1, np.int64)
     remap[used] = np.arange(used.size)
     return np.asarray(fld.points)[used, :2], remap[tri], p[used]
-
-
-def _polygon_area(poly: np.ndarray) -> float:
-    x, y = poly[:, 0], poly[:, 1]
-    return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y)))

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..body import signed_area
 from ..errors import DataError
 
 #: Disc mesh: rings and sectors (the pressure of a small support is smooth; the load is
@@ -78,7 +79,7 @@ def disc_mesh(
 def _ear_clip(poly: np.ndarray, where: str) -> np.ndarray:
     """Triangles (k, 3) of vertex indices covering a simple polygon, counter-clockwise."""
     idx = list(range(len(poly)))
-    if _signed_area(poly) < 0:
+    if signed_area(poly) < 0:
         idx.reverse()
     out = []
     guard = 0
@@ -137,11 +138,6 @@ def polygon_mesh(polygon, size: float, *, where: str = "base") -> tuple[np.ndarr
     key = np.round(xy / (1e-9 * scale)).astype(np.int64)
     _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
     return xy[first], inverse.reshape(-1)[tri]
-
-
-def _signed_area(poly: np.ndarray) -> float:
-    x, y = poly[:, 0], poly[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
 def _cross(o, a, b) -> float:
