@@ -94,7 +94,7 @@ class _Lines:
         push = f"push {self.push}, " if self.push else ""
         return f"{self.path}: {push}line {self.number}"
 
-    def next(self, what: str) -> list[str] | None:
+    def next(self) -> list[str] | None:
         """The next non-blank line's words, or None at the end of the file."""
         for number, text in self._lines:
             self.number = number
@@ -104,7 +104,7 @@ class _Lines:
         return None
 
     def need(self, what: str) -> list[str]:
-        words = self.next(what)
+        words = self.next()
         if words is None:
             push = f"in push {self.push} " if self.push else ""
             raise DataError(
@@ -223,14 +223,14 @@ def read_log(path) -> Iterator[RawPush]:
     with handle:
         lines = _Lines(name, handle)
         try:
-            first = lines.next("the number of pushes")
+            first = lines.next()
             if first is None:
                 raise DataError(f"{name}: the push log is empty")
             n = lines.count("the number of pushes", MAX_PUSHES, first)
             for k in range(1, n + 1):
                 yield _push(lines, name, k)
             lines.push = 0
-            if lines.next("the end of the file") is not None:
+            if lines.next() is not None:
                 raise DataError(
                     f"{lines.where()}: data after the last of the {n} pushes the first line announces"
                 )
