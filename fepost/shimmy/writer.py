@@ -2,31 +2,17 @@
 
 Everything is written into a temporary folder beside ``out`` and moved into place
 only when all of it succeeded (`fepost.output.staged_folder`); an existing
-non-empty ``out`` is replaced only with ``force``. `CSV_FILES` lists what writes
-the CSV files of a result (one function per kind of record; a new kind of record
-adds its own), `JSON_KEYS` what adds keys to shimmy.json beyond `ShimmyResult.to_dict`.
+non-empty ``out`` is replaced only with ``force``.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 from ..output import staged_folder, to_json
 from .figures import save_figures
 from .result import ShimmyResult
-
-
-def _simulation_csvs(result: ShimmyResult, folder: Path) -> None:
-    for sim in result.simulations:
-        (folder / sim.csv).write_text(sim.history.to_csv(), encoding="utf-8")
-
-
-#: Writers of a result's CSV files: ``write(result, folder)``.
-CSV_FILES: list[Callable[[ShimmyResult, Path], None]] = [_simulation_csvs]
-#: Extra keys of shimmy.json: ``key -> (result -> value or None)`` (None: key left out).
-JSON_KEYS: dict[str, Callable[[ShimmyResult], object]] = {}
 
 
 def write_shimmy(
@@ -38,13 +24,9 @@ def write_shimmy(
     ``touchdown`` rows of shimmy.json."""
     out = Path(out)
     with staged_folder(out, force=force, protect=protect) as tmp:
-        for write in CSV_FILES:
-            write(result, tmp)
+        for sim in result.simulations:
+            (tmp / sim.csv).write_text(sim.history.to_csv(), encoding="utf-8")
         data = result.to_dict()
-        for key, value in JSON_KEYS.items():
-            v = value(result)
-            if v is not None:
-                data[key] = v
         for run, csv in touchdown:
             (tmp / csv).write_text(run.to_csv(), encoding="utf-8")
         if touchdown:
