@@ -291,20 +291,11 @@ class ParameterMap:
     critical_speeds: tuple[float | None, ...]
     unstable_ranges: tuple[tuple[tuple[float, float | None], ...], ...]
 
-    @property
-    def trails(self) -> np.ndarray:
-        """The values (the name of a speed × trail map's values)."""
-        return self.values
-
     def rows(self) -> list[dict]:
         return [
             {self.parameter: float(t), "critical_speed": v, "unstable_ranges": [list(r) for r in rng]}
             for t, v, rng in zip(self.values, self.critical_speeds, self.unstable_ranges, strict=True)
         ]
-
-
-#: The speed × trail map is a `ParameterMap` of the trail.
-TrailMap = ParameterMap
 
 
 def parameter_map(lin: Linearisation, contact: Contact, parameter: str, values, speeds) -> ParameterMap:
