@@ -76,6 +76,8 @@ def simulate_yaw(wavelength: float, a: float, sigma: float, *, nodes: int = 400,
     line's road-fixed points move exactly one node per step. The amplitude is read over
     the last wavelength, after ``periods`` − 1 of settling (σ decays within one or two).
     """
+    from scipy.integrate import trapezoid
+
     if nodes < 8 or periods < 2:
         raise ArgumentError("nodes must be at least 8 and periods at least 2")
     x = np.linspace(a, -a, nodes)  # leading edge first
@@ -103,15 +105,10 @@ def simulate_yaw(wavelength: float, a: float, sigma: float, *, nodes: int = 400,
                 v1 += s * (k1 + 2 * k2 + 2 * k3 + k4) / 6
             ys[1:] = ys[:-1].copy()
         ys[0] = v1 + a * np.sin(k * t)
-        v = ys - x * np.sin(k * t)
-        fy = sigma * v1 + _trapz(v, x) + sigma * v[-1]
-        mz = sigma * (a + sigma) * (v1 - v[-1]) + _trapz(x * v, x)
+        v = ys - x * np.sin(k * t)  # x decreasing: ∫ from −a to a is −trapezoid(., x)
+        fy = sigma * v1 - trapezoid(v, x) + sigma * v[-1]
+        mz = sigma * (a + sigma) * (v1 - v[-1]) - trapezoid(x * v, x)
         if step >= last:
             out_f.append(fy)
             out_m.append(mz)
     return 0.5 * (max(out_f) - min(out_f)), 0.5 * (max(out_m) - min(out_m))
-
-
-def _trapz(f, x) -> float:
-    """∫ f dx over the nodes x (decreasing), trapezoidal."""
-    return float(np.sum(0.5 * (f[1:] + f[:-1]) * (x[:-1] - x[1:])))
