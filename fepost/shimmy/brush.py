@@ -180,10 +180,7 @@ class BrushTire:
         """
         wx = vx - wz * self.y
         wy = vy + wz * self.x
-        has = self.ahead >= 0
-        idx = np.where(has, self.ahead, 0)
-        ax = np.where(has, ex[idx], 0.0)
-        ay = np.where(has, ey[idx], 0.0)
+        ax, ay = self.ahead_deflections(ex, ey)
         dx = -wx + vr * (ax - ex) / self.h - growth * ex
         dy = -wy + vr * (ay - ey) / self.h - growth * ey
         fx, fy = self.kx * ex, self.ky * ey
@@ -199,6 +196,13 @@ class BrushTire:
         else:
             lam = np.where((fn >= (1 - ON_LIMIT) * lim) & (drive > 0) & (fn > 0), drive / stiff, 0.0)
         return dx - lam * nx, dy - lam * ny, lam
+
+    def ahead_deflections(self, ex, ey) -> tuple[np.ndarray, np.ndarray]:
+        """The deflections of the element ahead of each (0 at the leading edge: the tread enters
+        undeflected)."""
+        has = self.ahead >= 0
+        idx = np.where(has, self.ahead, 0)
+        return np.where(has, ex[idx], 0.0), np.where(has, ey[idx], 0.0)
 
     def beta(self, vr: float) -> float:
         """Rate (1/s) at which a sliding element's force returns to the friction limit when past it

@@ -127,15 +127,11 @@ class GripModel:
             out[1] = (-g.torsional_stiffness * psi - g.torsional_damping * dpsi + moment) / g.yaw_inertia
             out[2] = dy
             out[3] = (-g.lateral_stiffness * y - g.lateral_damping * dy + lateral) / g.lateral_mass
-            i = 4
-            if self.spin:
-                for j in range(self.wheels):
-                    out[4 + j] = -re * parts[j][2] / iw
-                i += self.wheels
-            n = tire.n
-            for j in range(self.wheels):
-                out[i + 2 * j * n : i + (2 * j + 1) * n] = parts[j][0]
-                out[i + (2 * j + 1) * n : i + (2 * j + 2) * n] = parts[j][1]
+            _, out_spins, out_elems, _ = self.blocks(out)
+            for j, ((out_x, out_y), (dex, dey, fx)) in enumerate(zip(out_elems, parts, strict=True)):
+                out_x[:], out_y[:] = dex, dey
+                if self.spin:
+                    out_spins[j] = -re * fx / iw
             if self.energy:
                 damp = g.torsional_damping * dpsi * dpsi + g.lateral_damping * dy * dy
                 out[-5:] = (forward, damp, sliding, released, entering)
@@ -209,13 +205,9 @@ class GripModel:
     def _on_limit(self, X) -> np.ndarray:
         """Mask of the states that are sliding elements' deflections (|F_i| at f n_i to 1e-9)."""
         mask = np.zeros(X.size, bool)
-        _, _, elems, _ = self.blocks(X)
-        start = 4 + (self.wheels if self.spin else 0)
-        n, t = self.tire.n, self.tire
-        for j, (ex, ey) in enumerate(elems):
-            on = np.hypot(t.kx * ex, t.ky * ey) >= (1 - ON_LIMIT) * t.limit
-            mask[start + 2 * j * n : start + (2 * j + 1) * n] = on
-            mask[start + (2 * j + 1) * n : start + (2 * j + 2) * n] = on
+        t = self.tire
+        for (ex, ey), (mask_x, mask_y) in zip(self.blocks(X)[2], self.blocks(mask)[2], strict=True):
+            mask_x[:] = mask_y[:] = np.hypot(t.kx * ex, t.ky * ey) >= (1 - ON_LIMIT) * t.limit
         return mask
 
     def eigenvalues(self, V: float) -> np.ndarray:
@@ -229,8 +221,5 @@ class GripModel:
 
 def _released(tire: BrushTire, ex, ey, vr: float) -> float:
     """Power of the transport term (W): Σ F_i · V_r (e_ahead − e_i)/h (the tread leaving the patch)."""
-    has = tire.ahead >= 0
-    idx = np.where(has, tire.ahead, 0)
-    ax = np.where(has, ex[idx], 0.0)
-    ay = np.where(has, ey[idx], 0.0)
+    ax, ay = tire.ahead_deflections(ex, ey)
     return float(vr / tire.h * np.sum(tire.kx * ex * (ax - ex) + tire.ky * ey * (ay - ey)))
