@@ -72,10 +72,11 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{'run':<28} {'Fx/fN':>8} {'Fy/fN':>8} {'N/N':>8} {'|F|/fN':>8}  steady (all < {TOL:g})")
     bad = 0
     for p in paths:
-        if "history" not in json.loads(p.read_text()):
+        side = json.loads(p.read_text())
+        if "history" not in side:
             print(f"{p!s:<28} not a slide/spin run (no history): skipped")
             continue
-        m = run_motion(p)
+        m = tail_motion(side["history"], float(side["friction"]))
         bad += not m.steady()
         print(f"{p!s:<28} {m.fx:8.4f} {m.fy:8.4f} {m.n:8.4f} {m.f_abs:8.4f}  {'yes' if m.steady() else 'NO'}")
     return 1 if bad else 0
