@@ -70,16 +70,30 @@ _CHUNK = 1 << 15
 
 
 def polar_moment(patch: Patch, centre: tuple[float, float] = (0.0, 0.0)) -> float:
-    """∬ σ r dA (N·m) over the patch's triangles, r the distance from ``centre``, by a
-    degree-4 rule on each triangle (nodal data linear, face data constant on it).
+    """∬ σ r dA (N·m) over the patch's triangles, r the distance from ``centre``
+    (`triangle_polar_moment` of its faces).
 
-    It runs on every analysis at the default grid, so it works in chunks of `_CHUNK`
-    triangles, gathering each chunk's corners and values once (a gather per rule point, and
-    small matrix products, cost 0.8-1.2 s of CPU on a 2.2 M-triangle map; this 0.25 s)."""
-    xy = np.ascontiguousarray(patch.xy - np.asarray(centre, float))
-    tri = patch.triangles
-    v = np.asarray(patch.values, float)
-    pointwise = patch.location == "point"
+    It runs on every analysis at the default grid."""
+    return triangle_polar_moment(patch.xy, patch.triangles, patch.values, patch.location, centre)
+
+
+def triangle_polar_moment(
+    xy: np.ndarray,
+    tri: np.ndarray,
+    values: np.ndarray,
+    location: str,
+    centre: tuple[float, float] = (0.0, 0.0),
+) -> float:
+    """∬ σ r dA (N·m) over the triangles ``tri`` of the nodes ``xy``, r the distance from
+    ``centre``, by a degree-4 rule on each triangle (``values`` at the nodes, linear on a
+    triangle, for ``location`` ``"point"``; one per triangle otherwise).
+
+    It works in chunks of `_CHUNK` triangles, gathering each chunk's corners and values once
+    (a gather per rule point, and small matrix products, cost 0.8-1.2 s of CPU on a
+    2.2 M-triangle map; this 0.25 s)."""
+    xy = np.ascontiguousarray(xy - np.asarray(centre, float))
+    v = np.asarray(values, float)
+    pointwise = location == "point"
     total = 0.0
     for start in range(0, len(tri), _CHUNK):
         t = tri[start : start + _CHUNK]
@@ -167,7 +181,7 @@ def refined_grid(segments: list[tuple[float, float]], level: int) -> PolarGrid:
     )
 
 
-def carried(patch: Patch, pmap: PolarMap, mom: Moments, moment: float) -> float:
+def carried(patch: Patch, mom: Moments, moment: float) -> float:
     """The larger of |N / N_fe − 1| and |∬ σ r dA (grid) / ``moment`` − 1|."""
     load = abs(mom.N / patch.N_fe - 1.0) if patch.N_fe else 0.0
     spin = abs(mom.spin / moment - 1.0) if moment else 0.0
@@ -180,7 +194,7 @@ def refined_map(patch: Patch, pmap: PolarMap, mom: Moments) -> tuple[PolarMap, M
     carries both within `REFINE_TOL` (the most accurate one tried when none does)."""
     centre, radius = pmap.centre, pmap.radius
     moment = polar_moment(patch, centre)
-    err = carried(patch, pmap, mom, moment)
+    err = carried(patch, mom, moment)
     if err <= TRIGGER_TOL:
         return pmap, mom
     segments = loaded_segments(patch, centre, radius)
@@ -191,7 +205,7 @@ def refined_map(patch: Patch, pmap: PolarMap, mom: Moments) -> tuple[PolarMap, M
             break
         m = resample(patch, grid, radius=radius, centre=centre)
         mo = moments(m)
-        e = carried(patch, m, mo, moment)
+        e = carried(patch, mo, moment)
         if e < best[0]:
             best = (e, m, mo)
         if e <= REFINE_TOL:

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..locate import interpolate
 from ..polar import PolarGrid
+from ..refine import triangle_polar_moment
 from .maps import BodyMap
 
 #: Grids tried, coarsest first (nr, nphi): the library default, then finer.
@@ -52,26 +53,10 @@ def grid_load(bmap: BodyMap, nr: int, nphi: int, rule: str = "gauss") -> tuple[f
     return float(np.sum(sigma * dA) / bmap.load), float(np.sum(sigma * r * dA) / map_moment(bmap))
 
 
-#: Barycentric points and weights of a degree-4 rule on a triangle (Dunavant, 6 points).
-_B = np.array([[0.108103018168070, 0.445948490915965], [0.816847572980459, 0.091576213509771]])
-_WB = np.array([0.223381589678011, 0.109951743655322])
-
-
 def map_moment(bmap: BodyMap) -> float:
-    """∬ σ r dA over the map's triangles about its centre of pressure (N·m), by a degree-4 rule
-    on each triangle halved three times (r is smooth on every triangle but the one holding
-    the centre, whose kink costs O(h³) there)."""
-    xy = bmap.xy - np.asarray(bmap.centre_of_pressure)
-    tri, p = bmap.triangles, bmap.pressure
-    a, b, c = xy[tri[:, 0]], xy[tri[:, 1]], xy[tri[:, 2]]
-    pa, pb, pc = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
-    area = 0.5 * np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
-    total = 0.0
-    for (u, v), w in zip(_B, _WB, strict=True):
-        for l1, l2, l3 in ((u, v, v), (v, u, v), (v, v, u)):
-            pt = l1 * a + l2 * b + l3 * c
-            total += float(np.sum(w * area * (l1 * pa + l2 * pb + l3 * pc) * np.hypot(pt[:, 0], pt[:, 1])))
-    return total
+    """∬ σ r dA over the map's triangles about its centre of pressure (N·m), by the degree-4
+    rule of `fepost.refine.triangle_polar_moment`."""
+    return triangle_polar_moment(bmap.xy, bmap.triangles, bmap.pressure, "point", bmap.centre_of_pressure)
 
 
 def recommended_grid(bmap: BodyMap) -> dict:
