@@ -38,7 +38,7 @@ import numpy as np
 from scipy import optimize
 
 from ..errors import ArgumentError, FitError
-from .polynomial import HomogeneousPolynomial, monomial_gradients, monomial_hessians, monomials
+from .polynomial import HomogeneousPolynomial, exponents, monomial_gradients, monomial_hessians, monomials
 
 #: Weight η of the twist-direction term against the wrench term (Zhou et al. weigh them alike).
 DIRECTION_WEIGHT = 1.0
@@ -188,7 +188,7 @@ def fit_limit_surface(
         raise ArgumentError("wrench and twist must be finite")
     if not (np.isfinite(rho) and rho > 0):
         raise ArgumentError(f"rho must be a positive length in m, got {rho!r}")
-    n_min = 15 if degree == 4 else 6
+    n_min = len(exponents(degree))  # as many pushes as coefficients
     if W.shape[0] < n_min:
         raise ArgumentError(
             f"a degree-{degree} limit surface needs at least {n_min} pushes, got {W.shape[0]}"
@@ -214,7 +214,7 @@ def _solve(w, t, degree, eta) -> tuple[np.ndarray, dict, float]:
     U = sphere(CHECK_POINTS)
     lin = [
         np.einsum("na,nak->nk", t, monomial_gradients(w, degree)),  # normals along the twists
-        monomials(U, degree) - 0.0,  # H ≥ floor on the sphere (the floor is the bound below)
+        monomials(U, degree),  # H ≥ floor on the sphere (the floor is the bound below)
     ]
     floors = [np.zeros(len(w)), np.full(len(U), POSITIVE_FLOOR)]
     start_u = sphere(64)
