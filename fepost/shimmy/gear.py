@@ -85,18 +85,7 @@ ALL_PARAMETERS = {**PARAMETERS, **ADDED}
 #: Optional keys besides the parameters.
 OPTIONAL = ("name", "sources", "notes")
 #: Parameters a gear file may leave out (defaults in `Gear`).
-DEFAULTED = (
-    "wheels",
-    "half_track",
-    "slip_ratio",
-    "wheel_spin_inertia",
-    "rolling_radius",
-    "bending_slope",
-    "rake",
-    "tire_stiffness_x",
-    "tire_stiffness_y",
-    "tire_deflection",
-)
+DEFAULTED = ("wheels", "half_track", "slip_ratio", *ADDED)
 #: Plausible range of an inertia (kg m²) or modal mass (kg) of a landing gear, SI.
 INERTIA_RANGE = (1e-4, 1e7)
 #: Highest plausible frequency (Hz) of the gear's torsional or lateral mode.
