@@ -48,7 +48,7 @@ import numpy as np
 from .._arrays import frozen
 from ..body import Body, support_loads
 from ..errors import ArgumentError
-from .mesh import disc_mesh, linear_load, polygon_mesh
+from .mesh import disc_mesh, linear_load, polygon_mesh, triangle_areas
 
 #: Disc pressure profiles of point supports (module docstring).
 PROFILES = ("hertz", "uniform")
@@ -105,10 +105,7 @@ class BodyMap:
     def mean_pressure(self) -> float:
         """load / loaded area, Pa (the area of the triangles with any node loaded)."""
         loaded = np.any(self.pressure[self.triangles] > 0, axis=1)
-        a, b, c = (self.xy[self.triangles[loaded, k]] for k in range(3))
-        area = 0.5 * np.abs(
-            (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-        )
+        area = np.abs(triangle_areas(self.xy, self.triangles[loaded]))
         return self.load / float(area.sum())
 
 
