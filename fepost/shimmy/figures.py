@@ -10,6 +10,8 @@ apart, and the stability maps shade the unstable region with the boundary drawn.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -238,22 +240,20 @@ def parameter_figure(result: ShimmyResult, fig, parameter: str = "trail"):
     return fig
 
 
-FIGURES = {
+#: The parameter each stability map's figure shows.
+MAP_FIGURES = {
+    "stability_plane": "trail",
+    "stability_damping": "torsional_damping",
+    "stability_stiffness": "torsional_stiffness",
+}
+FIGURES: dict[str, Callable[..., object]] = {
     "stability_map": stability_figure,
     "eigenvalue_paths": eigenvalue_figure,
     "damping_frequency": damping_figure,
     "mode_shapes": mode_figure,
     "time_histories": time_history_figure,
     "limit_cycle_amplitude": amplitude_figure,
-    "stability_plane": lambda r, f: parameter_figure(r, f, "trail"),
-    "stability_damping": lambda r, f: parameter_figure(r, f, "torsional_damping"),
-    "stability_stiffness": lambda r, f: parameter_figure(r, f, "torsional_stiffness"),
-}
-#: The parameter each stability map's figure shows.
-MAP_FIGURES = {
-    "stability_plane": "trail",
-    "stability_damping": "torsional_damping",
-    "stability_stiffness": "torsional_stiffness",
+    **{name: partial(parameter_figure, parameter=p) for name, p in MAP_FIGURES.items()},
 }
 
 
@@ -283,7 +283,7 @@ def save_figures(result: ShimmyResult, folder: Path) -> list[str]:
             if not _has_content(result, name):
                 continue
             fig = plt.figure()
-            if name in ("damping_frequency",):
+            if name == "damping_frequency":
                 fig.set_size_inches(7.0, 6.0)
             if name in MAP_FIGURES or name == "mode_shapes":
                 fig.set_size_inches(9.0, 3.8)
