@@ -91,19 +91,23 @@ def rolling_label(sidecar: Mapping[str, Any] | None) -> RollingLabel:
     return RollingLabel("unstated", "rolling map (kind not stated)", "rolling map")
 
 
-def kind_of_rolling_maps(paths) -> str | None:
-    """The short label (`RollingLabel.short`) the rolling maps ``paths`` share, "rolling maps
-    of several kinds" when they differ, None without any (a static-only sweep)."""
+def rolling_kind(path: str | Path) -> str:
+    """The short label (`RollingLabel.short`) of the rolling map ``path``, from its sidecar
+    (an unreadable sidecar: the kind is not stated)."""
     from ..errors import InputFileError
     from ..reader.sidecar import read_sidecar
 
-    kinds = set()
-    for p in {str(p) for p in paths if p}:
-        try:
-            side = read_sidecar(Path(p))
-        except InputFileError:
-            side = None
-        kinds.add(rolling_label(side).short)
+    try:
+        side = read_sidecar(Path(path))
+    except InputFileError:
+        side = None
+    return rolling_label(side).short
+
+
+def kind_of_rolling_maps(paths) -> str | None:
+    """The short label (`RollingLabel.short`) the rolling maps ``paths`` share, "rolling maps
+    of several kinds" when they differ, None without any (a static-only sweep)."""
+    kinds = {rolling_kind(p) for p in {str(p) for p in paths if p}}
     if not kinds:
         return None
     return kinds.pop() if len(kinds) == 1 else "rolling maps of several kinds"

@@ -81,20 +81,9 @@ def _resolved(path) -> str:
 def _rolling_kinds(pairings) -> dict[str, str]:
     """The short label (`fepost.report.rollinglabel.RollingLabel.short`) of each rolling map
     the sweep pairs, by its resolved path."""
-    from ..errors import InputFileError
-    from ..reader.sidecar import read_sidecar
-    from .rollinglabel import rolling_label
+    from .rollinglabel import rolling_kind
 
-    out = {}
-    for pr in pairings:
-        if pr.rolling is None:
-            continue
-        try:
-            side = read_sidecar(Path(pr.rolling))
-        except InputFileError:
-            side = None
-        out[_resolved(pr.rolling)] = rolling_label(side).short
-    return out
+    return {_resolved(pr.rolling): rolling_kind(pr.rolling) for pr in pairings if pr.rolling is not None}
 
 
 def _signed(v: float, fmt: str) -> str:
