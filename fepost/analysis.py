@@ -26,7 +26,7 @@ from .field import ContactField
 from .moments import Moments, moments
 from .options import DEFAULT_FRICTION, AnalysisOptions, check_friction
 from .patch import Patch, build_patch
-from .polar import PolarGrid, PolarMap
+from .polar import DEFAULT_NPHI, DEFAULT_NR, PolarGrid, PolarMap
 from .reader import isolate, start_reading
 from .reader.units import describe
 from .refine import refined_map
@@ -232,8 +232,6 @@ def _default_grid(options: AnalysisOptions) -> bool:
     """Whether the analysis runs on the library's default polar grid, which `fepost.refine`
     refines where a map's pressure is when it misses the map's load or polar moment (a grid
     the caller chose is kept, with the warning of `_check_resampling`)."""
-    from .polar import DEFAULT_NPHI, DEFAULT_NR
-
     return (options.nr, options.nphi, options.rule) == (DEFAULT_NR, DEFAULT_NPHI, "gauss")
 
 

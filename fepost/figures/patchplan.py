@@ -61,6 +61,7 @@ def plot_patch_plan(patch: Patch, ax=None, *, clim: tuple[float, float] | None =
         xy = np.asarray(patch.xy)
         kpa = np.asarray(patch.values) / 1e3
         shading = "gouraud" if patch.location == "point" else "flat"
+        vmin, vmax = clim or pressure_colour_range(patch)
         tpc = ax.tripcolor(
             xy[:, 0],
             xy[:, 1],
@@ -70,8 +71,8 @@ def plot_patch_plan(patch: Patch, ax=None, *, clim: tuple[float, float] | None =
             cmap=theme.CMAP,
             gid="pressure",
             rasterized=True,
-            vmin=(clim or pressure_colour_range(patch))[0],
-            vmax=(clim or pressure_colour_range(patch))[1],
+            vmin=vmin,
+            vmax=vmax,
         )
         fig.colorbar(tpc, ax=ax, label=f"contact pressure {symbol} (kPa)", shrink=0.8)
         edge = contact_edge(patch)
