@@ -363,7 +363,9 @@ def board_map(
     from ..reader import read_contact
 
     if body.base is None:
-        raise ArgumentError(f"{body.path}: --fe models a flat base on a board; this body has point supports")
+        raise ArgumentError(
+            f"{body.path}: --fe models a flat base on an elastic board; this body has point supports"
+        )
     board = Board.of(body)
     t = board.thickness
     edge = EDGE_SIZE if edge is None else edge

@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
     from ..bodymap import body_map, write_map
     from ..bodymap.grid import recommended_grid
     from ..bodymap.write import check_map_path, sidecar_path
-    from ..errors import ArgumentError, OutputError
+    from ..errors import OutputError
     from ..output import check_replaceable
 
     out = check_map_path(args.out)  # before any work
@@ -67,11 +67,7 @@ def run(args: argparse.Namespace) -> int:
     check_replaceable(side, [args.body])
     body = load_body(args.body)
     if args.fe:
-        if body.base is None:
-            raise ArgumentError(
-                f"{args.body}: --fe models a flat base on an elastic board; this body has point supports"
-            )
-        from ..bodymap.board import board_map
+        from ..bodymap.board import board_map  # refuses a body on point supports
 
         bmap = board_map(body)
     else:
@@ -81,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     write_map(bmap, out)
     cx, cy = bmap.centre_of_pressure
     print(
-        f"{bmap.info['contact']} -> {out} (+ sidecar {out.with_suffix('.json').name}): N = {bmap.load:.6g} N "
+        f"{bmap.info['contact']} -> {out} (+ sidecar {side.name}): N = {bmap.load:.6g} N "
         f"(m g = {body.weight:.6g} N), centre of pressure ({cx:.4g}, {cy:.4g}) m from reference_point, "
         f"peak/mean pressure {bmap.peak() / bmap.mean_pressure():.3g}"
     )
