@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ArgumentError
+from .brush import sliding_point_forces
 
 #: The published terminal ratios ε (homogeneous disc, ring).
 PUBLISHED_EPSILON = {"homogeneous": 0.653, "ring": 1.0}
@@ -35,12 +36,7 @@ def ring_forces(vx, vy, wz, *, R: float = 1.0, f: float = 0.3, N: float = 1.0, n
     """Exact Coulomb resultants of a ring of radius R (all pressure on the rim), by the midpoint rule."""
     phi = (np.arange(nodes) + 0.5) * 2 * np.pi / nodes
     x, y = R * np.cos(phi), R * np.sin(phi)
-    vx, vy, wz = np.broadcast_arrays(*(np.asarray(q, float)[..., None] for q in (vx, vy, wz)))
-    wx, wy = vx - wz * y, vy + wz * x
-    wn = np.hypot(wx, wy)
-    wn = np.where(wn > 0, wn, 1.0)
-    fx, fy = -f * N / nodes * wx / wn, -f * N / nodes * wy / wn
-    return fx.sum(-1), fy.sum(-1), (x * fy - y * fx).sum(-1)
+    return sliding_point_forces(x, y, np.full(nodes, f * N / nodes), vx, vy, wz)
 
 
 def closed_form_disc(profile: str, *, R: float = 1.0, f: float = 0.3, N: float = 1.0):

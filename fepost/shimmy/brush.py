@@ -250,14 +250,7 @@ class BrushTire:
 
     def sliding_forces(self, vx, vy, wz):
         """(Fx, Fy, Mz) with every element sliding: Σ −f n_i ŵ_i (arrays of kinematic points)."""
-        vx, vy, wz = np.broadcast_arrays(*(np.asarray(q, float)[..., None] for q in (vx, vy, wz)))
-        wx = vx - wz * self.y
-        wy = vy + wz * self.x
-        wn = np.hypot(wx, wy)
-        safe = np.where(wn > 0, wn, 1.0)
-        fx = -self.limit * wx / safe
-        fy = -self.limit * wy / safe
-        return fx.sum(-1), fy.sum(-1), (self.x * fy - self.y * fx).sum(-1)
+        return sliding_point_forces(self.x, self.y, self.limit, vx, vy, wz)
 
     def sliding_contact(self):
         """`sliding_forces` as a `fepost.shimmy.contact.Contact` (the brush's full-sliding limit)."""
@@ -273,6 +266,20 @@ class BrushTire:
         f0 = -float(self.sliding_forces(1.0, 0.0, 0.0)[0])
         m0 = -float(self.sliding_forces(0.0, 0.0, 1.0)[2])
         return Contact("brush_sliding", forces, self.R, f0, m0, info={"elements": self.n}, scalar=one)
+
+
+def sliding_point_forces(x, y, limit, vx, vy, wz):
+    """(Fx, Fy, Mz) of point contacts at (``x``, ``y``) (m), each sliding at its friction limit
+    ``limit`` (N) against its motion over the road, for the patch origin's slip (vx, vy, wz)
+    (arrays of kinematic points): Σ −limit_i ŵ_i, the moment about the origin."""
+    vx, vy, wz = np.broadcast_arrays(*(np.asarray(q, float)[..., None] for q in (vx, vy, wz)))
+    wx = vx - wz * y
+    wy = vy + wz * x
+    wn = np.hypot(wx, wy)
+    safe = np.where(wn > 0, wn, 1.0)
+    fx = -limit * wx / safe
+    fy = -limit * wy / safe
+    return fx.sum(-1), fy.sum(-1), (x * fy - y * fx).sum(-1)
 
 
 def _return(tx: float, ty: float, kx: float, ky: float, lim: float) -> tuple[float, float]:
