@@ -64,7 +64,7 @@ import numpy as np
 from ..body import Body
 from ..errors import ArgumentError, DataError, InputFileError
 from .maps import BodyMap, common_info
-from .mesh import linear_load
+from .mesh import linear_load, triangle_areas
 
 #: The hardboard defaults (module docstring).
 HARDBOARD = {"youngs_modulus": 4.0e9, "poisson_ratio": 0.3, "thickness": 0.0032}
@@ -184,8 +184,7 @@ def _oriented(xy: np.ndarray, parts: dict) -> Mesh2D:
     quad_in: list = []
     tri_in: list = []
     for (inside, k), conn in parts.items():
-        a, b, c = xy[conn[:, 0]], xy[conn[:, 1]], xy[conn[:, 2]]
-        flip = ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])) < 0
+        flip = triangle_areas(xy, conn) < 0  # the first three corners' turn
         conn = np.where(flip[:, None], conn[:, ::-1], conn)
         (quads if k == 4 else tris).append(conn)
         (quad_in if k == 4 else tri_in).append(np.full(len(conn), inside))
