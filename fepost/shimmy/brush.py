@@ -256,16 +256,15 @@ class BrushTire:
         """`sliding_forces` as a `fepost.shimmy.contact.Contact` (the brush's full-sliding limit)."""
         from .contact import Contact
 
-        def forces(vx, vy, wz):
-            return self.sliding_forces(vx, vy, wz)
-
         def one(vx, vy, wz):
             fx, fy, mz = self.sliding_forces(vx, vy, wz)
             return float(fx), float(fy), float(mz)
 
         f0 = -float(self.sliding_forces(1.0, 0.0, 0.0)[0])
         m0 = -float(self.sliding_forces(0.0, 0.0, 1.0)[2])
-        return Contact("brush_sliding", forces, self.R, f0, m0, info={"elements": self.n}, scalar=one)
+        return Contact(
+            "brush_sliding", self.sliding_forces, self.R, f0, m0, info={"elements": self.n}, scalar=one
+        )
 
 
 def sliding_point_forces(x, y, limit, vx, vy, wz):
