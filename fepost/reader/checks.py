@@ -54,16 +54,19 @@ def bad_file(path: Path, what: str) -> InputFileError:
     return InputFileError(f"{path}: corrupt or truncated {path.suffix} file ({what})")
 
 
-def inside_folder(path: Path, ref: str, what: str) -> Path:
+def inside_folder(path: Path, ref: str, what: str, *, folder: Path | None = None) -> Path:
     """The file ``ref`` names relative to ``path``'s folder; refused when it lies outside that folder.
 
     A parallel or multi-block file, or an XDMF file's heavy data, may only point at files
     in its own folder or below it: an absolute path, ``..`` or a symbolic link that leaves
     the folder is refused (a file handed to fepost must not make it read elsewhere).
+    ``folder``: that folder when it is not ``path``'s as named (an XDMF file's heavy data
+    lie next to its real path).
     """
-    folder = path.parent.resolve()
+    base = path.parent if folder is None else folder
+    folder = base.resolve()
     try:
-        target = (path.parent / ref).resolve()
+        target = (base / ref).resolve()
     except (OSError, RuntimeError, ValueError):
         raise bad_file(path, f"refused: {what} {ref!r} cannot be resolved") from None
     if not target.is_relative_to(folder):

@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputFileError
-from .checks import MAX_COUNT, MAX_DEPTH, bad_file, regular_file
+from .checks import MAX_COUNT, MAX_DEPTH, bad_file, inside_folder, regular_file
 
 #: The 8 bytes an HDF5 file starts with (at offset 0, 512, 1024, 2048, ... after a user block).
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
@@ -116,12 +116,7 @@ class _Heavy:
     def size(self, ref: str, dataset: str) -> int:
         import h5py
 
-        try:
-            target = (self.folder / ref).resolve()
-        except (OSError, RuntimeError, ValueError):
-            raise bad_file(self.path, f"refused: heavy-data file {ref!r} cannot be resolved") from None
-        if not target.is_relative_to(self.folder):
-            raise bad_file(self.path, f"refused: heavy-data file {ref!r} lies outside the file's folder")
+        target = inside_folder(self.path, ref, "heavy-data file", folder=self.folder)
         # the keys meshio walks: one leading '/' dropped, the rest split at every '/'
         keys = (dataset[1:] if dataset.startswith("/") else dataset).split("/")
         if not all(keys):
