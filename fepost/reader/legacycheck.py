@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from ..errors import InputFileError
-from .checks import MAX_COUNT, Counts, bad_file
+from .checks import MAX_COUNT, Counts, bad_file, refuse_netcdf
 
 _LEGACY_SIZES = {
     "bit": 0,
@@ -45,6 +45,7 @@ class Legacy:
         return bad_file(self.path, what)
 
     def check(self) -> Counts:
+        refuse_netcdf(self.path, self.data)
         lines, pos = [], 0
         for _ in range(4):  # the four header lines, found without copying the body
             eol = self.data.find(b"\n", pos)

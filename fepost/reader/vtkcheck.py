@@ -43,7 +43,7 @@ import mmap
 from pathlib import Path
 
 from ..errors import InputFileError
-from .checks import MAX_COUNT, MAX_DEPTH, MAX_VTM_DEPTH, Counts, bad_file, refuse_netcdf
+from .checks import MAX_COUNT, MAX_DEPTH, MAX_VTM_DEPTH, Counts, bad_file
 from .legacycheck import Legacy
 from .xmlcheck import Xml
 
@@ -55,7 +55,6 @@ def check_file(path: Path) -> Counts:
     suffix = path.suffix.lower()
     try:
         with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
-            refuse_netcdf(path, data)
             if suffix == ".vtk":
                 return Legacy(path, data).check()
             return Xml(path, data, 0).check()
