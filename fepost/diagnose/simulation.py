@@ -33,7 +33,7 @@ from ..coefficients import Coefficients, coefficients_from_moments
 from ..errors import ArgumentError
 from ..friction.quadrature import PressureQuadrature, edge_grid
 from ..friction_coefficient import DEFAULT_FRICTION, check_friction
-from ..moments import moments
+from ..moments import Moments, moments
 from ..polar import PolarGrid, PolarMap
 
 #: Default fit grid (radial × angular nodes of the sine-substituted polar rule).
@@ -48,11 +48,11 @@ FIT_NPHI = 48
 FIT_GRID_TOL = 0.05
 
 
-def on_fit_grid(pmap: PolarMap, grid: PolarGrid) -> PolarMap:
+def on_fit_grid(pmap: PolarMap, grid: PolarGrid, *, own: Moments | None = None) -> PolarMap:
     """``pmap`` regridded on the fit ``grid``, or ``pmap`` itself where the fit grid misses its
-    load or polar moment by more than `FIT_GRID_TOL`."""
+    load or polar moment by more than `FIT_GRID_TOL` (``own``: ``pmap``'s moments, when known)."""
     fit = regrid(pmap, grid)
-    a, b = moments(pmap), moments(fit)
+    a, b = own if own is not None else moments(pmap), moments(fit)
     if not (a.N > 0 and a.spin > 0):
         return fit
     return pmap if max(abs(b.N / a.N - 1.0), abs(b.spin / a.spin - 1.0)) > FIT_GRID_TOL else fit
@@ -154,12 +154,12 @@ def simulation_from_maps(
     if int(nphi) % 2:
         raise ArgumentError(f"nphi must be even, got {nphi!r}")
     grid = edge_grid(nr, nphi)
-    coef = coefficients_from_moments(
-        moments(static), None if rolling is None else moments(rolling), friction=friction
-    )
+    s_mom = moments(static)
+    r_mom = None if rolling is None else moments(rolling)
+    coef = coefficients_from_moments(s_mom, r_mom, friction=friction)
     return Simulation(
-        static=on_fit_grid(static, grid),
-        rolling=None if rolling is None else on_fit_grid(rolling, grid),
+        static=on_fit_grid(static, grid, own=s_mom),
+        rolling=None if rolling is None else on_fit_grid(rolling, grid, own=r_mom),
         friction=float(friction),
         coefficients=coef,
         source=source or static.source,
