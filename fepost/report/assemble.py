@@ -77,7 +77,7 @@ def _sidecar_pressure(analysis: Analysis) -> tuple[float, str] | None:
             raise ArgumentError(
                 f"{field_.source}: sidecar {key} must be a positive pressure in Pa, got {value!r}"
             )
-        units = getattr(field_, "units", None)
+        units = field_.units
         if len(path) > 1 and units is not None and not units.is_si:
             p *= units.pressure
         return p, key
