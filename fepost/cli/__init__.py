@@ -324,10 +324,9 @@ def _parse(parser: argparse.ArgumentParser, argv: list[str]) -> argparse.Namespa
     args, extra = parser.parse_known_args(argv)
     if extra:
         sub = _subparser(parser, getattr(args, "command", None)) or parser
-        options = [o for a in sub._actions for o in a.option_strings]
         unknown = next((a for a in extra if a.startswith("-")), extra[0])
         name = unknown.split("=", 1)[0]
-        hint = _suggest(name, options) if name.startswith("-") else ""
+        hint = _suggest(name, _options_of(sub)) if name.startswith("-") else ""
         raise UsageError(f"unrecognized argument {unknown!r}{hint} (see '{sub.prog} --help')")
     return args
 
