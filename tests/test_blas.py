@@ -32,3 +32,34 @@ def test_libraries_inspected_once(monkeypatch):
         with _blas.one_blas_thread():
             pass
     assert calls == []
+
+
+_CLI_PROBE = """
+import fepost.cli as cli
+def probe():
+    import numpy  # noqa: F401  (loads BLAS after the entry point has set its thread count)
+    from threadpoolctl import threadpool_info
+    print(sorted({i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"}))
+    return 0
+cli.main = probe
+cli.console_main()
+"""
+
+
+@pytest.mark.parametrize(("given", "expected"), [(None, "[1]"), ("2", "[2]")])
+def test_the_command_runs_blas_on_one_thread_unless_told(given, expected):
+    """The ``fepost`` entry point sets OpenBLAS to one thread before numpy loads it; a count
+    the user's environment gives is kept."""
+    import os
+    import subprocess
+    import sys
+
+    if not _blas_threads():
+        pytest.skip("no BLAS library reported by threadpoolctl")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    out = subprocess.run(
+        [sys.executable, "-c", _CLI_PROBE], env=env, capture_output=True, text=True, check=True
+    )
+    assert out.stdout.strip() == expected

@@ -401,8 +401,21 @@ def main(argv: Sequence[str] | None = None) -> int:
             return BROKEN_PIPE
 
 
+#: Environment variable OpenBLAS (numpy's and scipy's BLAS) reads its thread count from, once,
+#: when it loads.
+BLAS_THREADS_ENV = "OPENBLAS_NUM_THREADS"
+
+
 def console_main() -> None:
-    """Entry point of the ``fepost`` script."""
+    """Entry point of the ``fepost`` script.
+
+    BLAS runs on one thread unless the user's environment says otherwise (`BLAS_THREADS_ENV`,
+    set here before any command imports numpy). fepost's products are thin (n x 3, a polar
+    grid against a few columns): more BLAS threads never finish sooner, and after each call
+    they spin, taking the cores from fepost's own threads and the reading child. On the
+    1.08 M-node surface map they took about 0.15 s of the process's CPU time
+    (benchmarks/bench_read.py)."""
+    os.environ.setdefault(BLAS_THREADS_ENV, "1")
     status = main()
     try:
         sys.stdout.flush()
