@@ -19,6 +19,11 @@ def summary_stream(*outputs: str | None) -> TextIO:
     return sys.stderr if any(o == "-" for o in outputs) else sys.stdout
 
 
+def progress_line(k: int, n: int, step: str, seconds: float) -> None:
+    """A long command's stage done, one line on standard error: ``[k/n] step ... done in 1.2 s``."""
+    print(f"[{k}/{n}] {step} ... done in {seconds:.1f} s", file=sys.stderr, flush=True)
+
+
 def output_name(path: str) -> str:
     """``path`` as a summary names it: ``standard output`` for ``-``."""
     return "standard output" if path == "-" else path

@@ -8,10 +8,9 @@ sample meshes, the current folder, the home folder or the root
 from __future__ import annotations
 
 import argparse
-import sys
 
 from . import _validate as v
-from ._common import add_friction_option, add_input_options, analysis_options
+from ._common import add_friction_option, add_input_options, analysis_options, progress_line
 
 
 def add_parser(sub) -> None:
@@ -65,10 +64,6 @@ def add_parser(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _progress(k: int, n: int, step: str, seconds: float) -> None:
-    print(f"[{k}/{n}] {step} ... done in {seconds:.1f} s", file=sys.stderr, flush=True)
-
-
 def run(args: argparse.Namespace) -> int:
     from ..output import check_replaceable
     from ..report import build_report
@@ -88,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
         friction=args.friction,
         seed=args.seed,
         options=analysis_options(args),
-        progress=_progress,
+        progress=progress_line,
         gear=args.gear,
     )
     total = sum(t for _, t in result.timings)

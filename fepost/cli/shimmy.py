@@ -11,9 +11,9 @@ stay light: the work is imported inside `run`.
 from __future__ import annotations
 
 import argparse
-import sys
 
 from . import _validate as v
+from ._common import progress_line
 
 #: The friction models the command knows, in the order of shimmy.json.
 MODELS = ("closed_forms", "generalised", "exact")
@@ -119,7 +119,7 @@ class _Progress:
         self._line(self.total, step, seconds)
 
     def _line(self, k: int, step: str, seconds: float) -> None:
-        print(f"[{k}/{self.total}] {step} ... done in {seconds:.1f} s", file=sys.stderr, flush=True)
+        progress_line(k, self.total, step, seconds)
 
 
 def summary(m) -> str:
