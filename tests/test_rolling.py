@@ -119,9 +119,12 @@ def test_rolled_maps_pair_with_the_static_map():
         own = side["samples"][-1]["centre_of_pressure_shift_m"]
         # fepost's polar resampling of the 20 mm faces against their exact integral
         assert c.x_c == pytest.approx(own, rel=0.05, abs=3e-4)
-        # the solver's own reactions: the axle torque balances h Fx + x_p Fz about the axle;
-        # nodal contact forces against their bilinear interpolation over 20 mm faces: 1 mm
-        assert moment_shift(side) == pytest.approx(own, abs=1e-3)
+        # the solver's own reactions: the axle torque balances h Fx + x_p Fz about the axle, a
+        # balance of nodal forces. Its centre is compared with that of the lumped nodal forces
+        # p_i * integral(N_i dA) (the old sidecars' rule, kept in centre_of_pressure_note):
+        # within 0.61 mm; the bilinear field's exact centre is up to 1.05 mm off (full sliding)
+        lumped = side["centre_of_pressure_note"]["end_of_roll_shift_old_rule_m"]
+        assert moment_shift(side) == pytest.approx(lumped, abs=1e-3)
 
 
 @pytest.mark.skipif(
