@@ -227,6 +227,34 @@ def test_sigterm_during_report_leaves_nothing(small_map, tmp_path, delay):
     assert not out.exists() and temporaries(tmp_path) == []
 
 
+class _Writes:
+    """A stream that records each write call."""
+
+    def __init__(self) -> None:
+        self.calls: list[str] = []
+
+    def write(self, text: str) -> int:
+        self.calls.append(text)
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+
+def test_progress_and_stop_lines_are_written_whole(monkeypatch):
+    """A progress line and the stop message each go out in one write, newline included: the
+    handler of a signal that arrives between two writes raises there, and the stop message
+    then lands on the progress line's end (as the SIGTERM test above once saw)."""
+    import fepost.cli as cli
+    from fepost.cli._common import progress_line
+
+    stream = _Writes()
+    monkeypatch.setattr(sys, "stderr", stream)
+    progress_line(1, 12, "read", 0.25)
+    cli._say("fepost: terminated by SIGTERM")
+    assert stream.calls == ["[1/12] read ... done in 0.2 s\n", "fepost: terminated by SIGTERM\n"]
+
+
 _HALF_BUILT = """
 import os, signal, sys, time
 import fepost.cli as cli

@@ -247,7 +247,7 @@ def _silence_stdout() -> None:
 
 def _say(line: str) -> None:
     try:
-        print(line, file=sys.stderr)
+        sys.stderr.write(line + "\n")  # one write: a signal handled between two cannot split the line
     except (OSError, ValueError):
         pass
 

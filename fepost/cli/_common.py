@@ -20,8 +20,12 @@ def summary_stream(*outputs: str | None) -> TextIO:
 
 
 def progress_line(k: int, n: int, step: str, seconds: float) -> None:
-    """A long command's stage done, one line on standard error: ``[k/n] step ... done in 1.2 s``."""
-    print(f"[{k}/{n}] {step} ... done in {seconds:.1f} s", file=sys.stderr, flush=True)
+    """A long command's stage done, one line on standard error: ``[k/n] step ... done in 1.2 s``.
+
+    The line and its newline go in one write: ``print`` writes them apart, and a signal
+    handled in between (``fepost: terminated by SIGTERM``) would land on the same line."""
+    sys.stderr.write(f"[{k}/{n}] {step} ... done in {seconds:.1f} s\n")
+    sys.stderr.flush()
 
 
 def output_name(path: str) -> str:
