@@ -190,7 +190,8 @@ def common_keys(mesh: AircraftMesh, result: RollResult, state: RollState, figure
         "model": {
             **model_description(mesh),
             "rim": "rigid body on the bead nodes (*RIGID BODY, reference node on the axle); its "
-            "turn about the axle is prescribed (imposed slip) or free (free rolling)",
+            "turn about the axle is prescribed (imposed slip) or driven through a soft torsion spring "
+            "(the free-rolling run)",
         },
         "units": "SI (m, Pa, N, N m, rad)",
     }

@@ -2,8 +2,9 @@
 
 Runs (all at the rated-load rim travel, axle travel 0.75 m = 1.6 patch lengths):
 
-- ``roll_free``: free rolling, the rim driven through a soft torsion spring (nearly torque-free); its
-  steady turn per travel gives the effective rolling radius R_e;
+- ``roll_free``: free rolling, the rim driven through a soft torsion spring (not torque-free:
+  the spring's torque is in the sidecar); its steady turn per travel gives the effective
+  rolling radius R_e;
 - ``roll_brake<k>`` / ``roll_drive<k>``: imposed slip kappa = -k/100 / +k/100,
   the rim turned by theta = (1 + kappa) X / R_e while the axle travels X.
 
