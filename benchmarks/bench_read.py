@@ -244,8 +244,15 @@ def _tree_rss(pid: int) -> int:
     return total
 
 
-def run(argv: list[str], pythonpath: str | None = None, cwd: Path | None = None) -> tuple[float, float]:
-    """Wall time (s) of a whole process and its sampled peak tree RSS (MB)."""
+def run(
+    argv: list[str], pythonpath: str | None = None, cwd: Path | None = None
+) -> tuple[float, float, float]:
+    """Wall time (s) of a whole process, its sampled peak tree RSS (MB) and the CPU time (s, user
+    + system) of it and the children it waited for (the reading child): on a machine shared with
+    other work the CPU time moves much less than the wall time."""
+    import resource
+
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
     env = dict(os.environ)
     if pythonpath:
         env["PYTHONPATH"] = pythonpath
@@ -269,7 +276,9 @@ def run(argv: list[str], pythonpath: str | None = None, cwd: Path | None = None)
     th.join()
     if proc.returncode:
         raise SystemExit(f"{' '.join(argv)} failed ({proc.returncode}): {err.decode()[-500:]}")
-    return dt, peak[0] / 2**20
+    now = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = now.ru_utime + now.ru_stime - used.ru_utime - used.ru_stime
+    return dt, peak[0] / 2**20, cpu
 
 
 BREAKDOWN = r"""
@@ -374,7 +383,7 @@ def main() -> None:
         bare = [sys.executable, "-c", f"import pyvista; pyvista.read({str(path)!r})"]
         ours = [sys.executable, "-m", "fepost", "coefficients", str(path), *OPTIONS.get(key, [])]
         before = load()
-        tb, to, mb, mo, tbase = [], [], [], [], []
+        tb, to, mb, mo, tbase, cb, co = [], [], [], [], [], [], []
         here = str(Path(__file__).resolve().parents[1])
         sides = [("bare", bare, None), ("ours", ours, here)]
         if args.baseline:
@@ -382,16 +391,18 @@ def main() -> None:
         for k in range(args.pairs):
             # the order rotates every round: bare, ours(, base); ours(, base), bare; ...
             for label, argv, pythonpath in sides[k % len(sides) :] + sides[: k % len(sides)]:
-                dt, peak = run(argv, pythonpath, args.dir)
+                dt, peak, cpu = run(argv, pythonpath, args.dir)
                 if label == "bare":
                     tb.append(dt)
                     mb.append(peak)
+                    cb.append(cpu)
                 elif label == "ours":
                     to.append(dt)
                     mo.append(peak)
+                    co.append(cpu)
                 else:
                     tbase.append(dt)
-        rows.append((key, tb, to, mb, mo, before, load()))
+        rows.append((key, tb, to, mb, mo, before, load(), cb, co))
         r = rows[-1]
         print(
             f"{key}: bare {statistics.median(tb):.2f} s, fepost {statistics.median(to):.2f} s, "
@@ -409,17 +420,20 @@ def main() -> None:
     print()
     print(
         f"{'file':<13} {'bare read s':>12} {'fepost s':>9} {'ratio':>6} {'pair ratios':>24} "
-        f"{'bare MB':>8} {'fepost MB':>9} {'mem ratio':>9}  load before -> after"
+        f"{'bare MB':>8} {'fepost MB':>9} {'mem ratio':>9} {'bare CPU':>8} {'fepost CPU':>10}"
+        "  load before -> after"
     )
-    for key, tb, to, mb, mo, before, after in rows:
+    for key, tb, to, mb, mo, before, after, cb, co in rows:
         pr = sorted(o / b for o, b in zip(to, tb, strict=True))
         print(
             f"{key:<13} {statistics.median(tb):12.2f} {statistics.median(to):9.2f} "
             f"{statistics.median(to) / statistics.median(tb):6.2f} {pr[0]:>11.2f} .. {pr[-1]:<10.2f} "
-            f"{max(mb):8.0f} {max(mo):9.0f} {max(mo) / max(mb):9.2f}  {before} -> {after}"
+            f"{max(mb):8.0f} {max(mo):9.0f} {max(mo) / max(mb):9.2f} {statistics.median(cb):8.2f} "
+            f"{statistics.median(co):10.2f}  {before} -> {after}"
         )
     print(
-        f"medians of {args.pairs} alternating pairs; targets: surface <= 0.5, solver <= 0.17; "
+        f"medians of {args.pairs} alternating pairs (CPU: user + system s of the process tree); "
+        "targets: surface <= 0.5, solver <= 0.17; "
         "exodus, exodus-ground <= 0.5; memory <= 1.0"
     )
 
