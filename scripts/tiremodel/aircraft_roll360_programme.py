@@ -1,0 +1,296 @@
+"""The whole tire's rolling programme: free rolling with the rim free to turn, then imposed slips.
+
+Runs (half model of the whole 360-degree tire, ``aircraft_roll360_deck``; rim travel 124.1 mm,
+the whole rig tire's rated-load travel: 21.8 mm inflated clearance + 102.3 mm deflection):
+
+- ``roll_free``: the rim free to turn about the axle (no torque on it, no driver): free rolling
+  as it is; its steady turn per travel over the last fifth of the roll gives R_e;
+- ``roll_brake<k>`` / ``roll_drive<k>``: imposed slip kappa = -k/1000 / +k/1000 against that
+  R_e, the rim turned by (1 + kappa) X / R_e; the small slips first (the slip curve's initial
+  slope and a second, torque-zero estimate of free rolling), then the large ones.
+
+Why the free rim and not a driver: the sector's free run was driven through a torsion spring
+whose driver turned 2.4 % fast (1.87 kN m on the rim). With the turn held during inflation and
+loading and released for the roll (a second step), the free rim's roll converged on the tiny
+deck at the rotation node's residual torque of a few N m.
+
+The runs are Dask tasks (``fepost.sweep.engine.Cluster``, one worker), each solved in
+``work/<run>/`` on one thread (``nice -n 5``). Resume rule: a run whose ``<run>.json`` holds the
+sha256 of the deck it would now write (its .vtu and .dat.txt beside it) is skipped; any other
+state is redone, reusing a finished CalculiX solve of the same deck in the work folder.
+
+``python -m scripts.tiremodel.aircraft_roll360_programme --work DIR [--out DIR] [--mesh fine|mid|tiny]
+[--travel M] [--only RUN ...] [--scheduler ADDRESS]`` runs it; ``--table`` prints the finished
+runs (slip, Fx/N, torque, steadiness, balance) and the brush estimate of the initial slope.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import aircraft_deck as ad
+from . import aircraft_roll360_deck as r3
+from .aircraft_roll_programme import finished
+
+#: braking (< 0) and driving slips, in run order: small ones first
+SLIPS = (-0.01, 0.01, -0.03, 0.03, -0.10, 0.10)
+FREE = "roll_free"
+STATIC = "roll_static"
+OUT = Path(__file__).resolve().parents[2] / "meshes" / "rig-tire360" / "roll"
+
+
+@dataclass(frozen=True)
+class Setup:
+    """What every run of a programme shares."""
+
+    mesh_kind: str = "fine"
+    rim_travel: float = 0.1241  # m: meshes/rig-tire360/static.json's rim_travel_z (0.124068)
+    travel: float = 1.6  # m of axle travel
+    print_every: float = 0.05  # analysis time (the roll takes 2): 40 mm of travel at 1.6 m
+    frames: int = 4
+    tolerances: tuple[float, float] = r3.TOLERANCES
+
+    def plan(self, rotation: float | None) -> r3.Plan:
+        return r3.Plan(self.rim_travel, self.travel, rotation, self.print_every, self.frames, self.tolerances)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    name: str
+    slip: float | None  # None: the free rim
+
+    def plan(self, radius: float | None, setup: Setup) -> r3.Plan:
+        if self.slip is None:
+            return setup.plan(None)
+        if radius is None:
+            raise ValueError(f"{self.name}: needs the free-rolling run's effective radius")
+        return setup.plan(r3.turn_for(setup.travel, radius, self.slip))
+
+    def labels(self, setup: Setup, radius: float | None) -> dict:
+        head = (
+            f"quasi-static rolling of the whole aircraft tire (half model, symmetry plane y = 0, "
+            f"mesh '{setup.mesh_kind}'): inflation, {1e3 * setup.rim_travel:.1f} mm rim travel, then "
+            f"{setup.travel:g} m of axle travel"
+        )
+        if self.slip is None:
+            return {
+                "description": head + "; free rolling: the rim free to turn (no torque on it)",
+                "imposed": "axle travel only; the rim's turn is free (held during inflation and load)",
+                "effective_rolling_radius_m": radius,
+                "effective_rolling_radius_source": "this run: dX/dtheta over the last fifth of its roll",
+            }
+        kind = "braking" if self.slip < 0 else "driving"
+        return {
+            "description": head + f"; {kind} at the imposed longitudinal slip {self.slip:+g}",
+            "imposed": f"rim turn (1 {self.slip:+g}) X / R_e, linear in the axle travel X",
+            "imposed_slip": self.slip,
+            "effective_rolling_radius_m": radius,
+            "effective_rolling_radius_source": f"{FREE}.json (the free rim's dX/dtheta)",
+        }
+
+
+def run_name(slip: float | None) -> str:
+    if slip is None:
+        return FREE
+    return f"roll_{'brake' if slip < 0 else 'drive'}{round(abs(slip) * 1000):03d}"
+
+
+def programme(slips: tuple[float, ...] = SLIPS) -> list[RunSpec]:
+    return [RunSpec(FREE, None), *(RunSpec(run_name(s), s) for s in slips)]
+
+
+def effective_radius(out: Path) -> float | None:
+    """R_e of the finished free run (its sidecar), None before it exists."""
+    try:
+        return float(json.loads((out / f"{FREE}.json").read_text())["effective_rolling_radius_m"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def _log(msg: str) -> None:
+    print(f"{time.strftime('%H:%M:%S')} roll360: {msg}", file=sys.stderr, flush=True)
+
+
+@dataclass(frozen=True)
+class Task:
+    """Everything a worker needs for one run (picklable; the mesh from the client: gmsh)."""
+
+    spec: RunSpec
+    plan: r3.Plan
+    setup: Setup
+    mesh: r3.Roll360Mesh
+    out: Path
+    work: Path
+    radius: float | None
+
+
+def solve_and_export(task: Task) -> dict:
+    """Solve (or reuse) one run and write its files; the summary the client logs."""
+    from .aircraft_roll360_run import solve, steady_turn_rate, write_run, write_static
+    from .solve import find_ccx
+
+    result = solve(find_ccx(), task.mesh, task.spec.name, task.plan, task.work / task.spec.name)
+    task.out.mkdir(parents=True, exist_ok=True)
+    radius = task.radius
+    if task.spec.slip is None:
+        radius = 1.0 / steady_turn_rate(result.history)
+        write_static(task.mesh, result, task.out, STATIC)
+    side = write_run(task.mesh, result, task.out, task.spec.name, task.spec.labels(task.setup, radius))
+    return {
+        "slip": side["longitudinal_slip"],
+        "Fx/N": side["longitudinal_force_ratio"],
+        "torque_Nm": side["axle_torque_tail_mean_Nm"],
+        "steady": side["steadiness"]["steady"],
+        "cpu_s": side["cpu_s"],
+    }
+
+
+def _tasks(specs, out: Path, work: Path, setup: Setup, mesh, deck_sha) -> tuple[list[Task], list[str]]:
+    from .aircraft_roll360_run import deck_text
+    from .aircraft_roll_run import sha256_text
+
+    radius = effective_radius(out)
+    todo, skipped = [], []
+    for spec in specs:
+        if spec.slip is not None and radius is None:
+            continue
+        plan = spec.plan(radius, setup)
+        sha = (
+            deck_sha(spec, plan)
+            if deck_sha
+            else sha256_text(deck_text(mesh, plan, work / f".{spec.name}.tmp")[0])
+        )
+        if finished(out, spec.name, sha):
+            skipped.append(spec.name)
+        else:
+            todo.append(Task(spec, plan, setup, mesh, out, work, None if spec.slip is None else radius))
+    return todo, skipped
+
+
+def run_programme(
+    out: Path,
+    work: Path,
+    specs: list[RunSpec] | None = None,
+    setup: Setup = Setup(),
+    scheduler: str | None = None,
+    task_fn: Callable[[Task], dict] = solve_and_export,
+    deck_sha: Callable[[RunSpec, r3.Plan], str] | None = None,
+    processes: bool = True,
+    mesh=None,
+) -> list[str]:
+    """Run the programme (the free run first: the slips need its R_e); the runs done now.
+
+    ``task_fn``, ``deck_sha`` and ``mesh`` replace the solve, the deck's hash and the mesh (tests).
+    """
+    from fepost.sweep.engine import Cluster
+
+    specs = programme() if specs is None else specs
+    mesh = r3.build_mesh(setup.mesh_kind) if mesh is None else mesh
+    work.mkdir(parents=True, exist_ok=True)
+    done_now: list[str] = []
+    with Cluster(workers=None if scheduler else 1, scheduler=scheduler, processes=processes) as cluster:
+        for phase in ("free", "slip"):
+            chosen = [s for s in specs if (s.slip is None) == (phase == "free")]
+            todo, skipped = _tasks(chosen, out, work, setup, mesh, deck_sha)
+            for name in skipped:
+                _log(f"{name}: finished earlier with the same deck, skipped")
+            if not todo:
+                continue
+            futures = [
+                cluster.client.submit(task_fn, t, key=f"roll360-{t.spec.name}", pure=False, priority=-i)
+                for i, t in enumerate(todo)
+            ]
+            _log(f"{phase}: {len(todo)} run(s) submitted: {', '.join(t.spec.name for t in todo)}")
+            failed = []
+            for k, (fut, res) in enumerate(cluster.as_completed(futures), start=1):
+                name = fut.key.removeprefix("roll360-")
+                if isinstance(res, BaseException):
+                    failed.append(name)
+                    _log(
+                        f"[{k}/{len(todo)}] {name}: FAILED: {str(res).splitlines()[0] if str(res) else res!r}"
+                    )
+                    continue
+                done_now.append(name)
+                _log(f"[{k}/{len(todo)}] {name}: saved ({json.dumps(res)})")
+            if phase == "free" and failed:
+                raise RuntimeError("the free-rolling run failed: the slip runs need its effective radius")
+    return done_now
+
+
+def brush_slope(side: dict) -> float:
+    """C_kappa / N of the brush model, 2 c_px a^2 / N, from the run's static patch: c_px = G_t w / h
+    (tread rubber shear modulus G_t, patch width w, tread depth h = 20 mm), a = half the patch length."""
+    patch = side["static_patch"]
+    g = ad.RUBBER["TREAD"]["shear_modulus"]
+    c_px = g * patch["width"] / 0.020
+    return 2.0 * c_px * (patch["length"] / 2.0) ** 2 / side["static_load"]
+
+
+def table(out: Path) -> list[str]:
+    """One line per finished run: slip, Fx/N, axle torque, steadiness, balance; the brush slope."""
+    lines = [
+        f"{'run':<16} {'kappa':>8} {'Fx/N':>8} {'T kN m':>8} {'dFx/fN':>7} {'dFz/N':>7} {'dT/fNR':>7} "
+        f"{'bal x/N':>8} {'bal z/N':>8} {'CPU s/m':>8}"
+    ]
+    slope = None
+    for p in sorted(out.glob("roll_*.json")):
+        side = json.loads(p.read_text())
+        if side.get("kind") != "rolling run":
+            continue
+        st, bal = side["steadiness"], side["balance"]["residual_over_N"]
+        kappa = side["longitudinal_slip"]
+        lines.append(
+            f"{side['case']:<16} {kappa if kappa is not None else math.nan:8.4f} "
+            f"{side['tail_means']['Fx'] / side['tail_means']['Fz']:8.4f} "
+            f"{side['axle_torque_tail_mean_Nm'] / 1e3:8.3f} {st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
+            f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {side['cpu_s_per_m'] or math.nan:8.0f}"
+        )
+        slope = brush_slope(side)
+    if slope is not None:
+        lines.append(f"brush estimate of the initial slope C_kappa/N = 2 c_px a^2 / N: {slope:.2f}")
+    return lines
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m scripts.tiremodel.aircraft_roll360_programme")
+    ap.add_argument("--work", type=Path, help="work folder (CalculiX runs)")
+    ap.add_argument("--out", type=Path, default=OUT)
+    ap.add_argument("--mesh", default="fine", choices=sorted(r3.MESHES))
+    ap.add_argument("--travel", type=float, default=Setup.travel)
+    ap.add_argument("--only", nargs="+", metavar="RUN")
+    ap.add_argument("--scheduler")
+    ap.add_argument("--table", action="store_true", help="print the finished runs' table and stop")
+    a = ap.parse_args(argv)
+    if a.table:
+        print("\n".join(table(a.out)))
+        return 0
+    if a.work is None:
+        print(f"{ap.prog}: --work DIR is needed to run the programme", file=sys.stderr)
+        return 2
+    specs = programme()
+    if a.only:
+        unknown = sorted(set(a.only) - {s.name for s in specs})
+        if unknown:
+            print(f"{ap.prog}: unknown run(s) {', '.join(unknown)}", file=sys.stderr)
+            return 2
+        specs = [s for s in specs if s.name in a.only]
+    if not 0.01 <= a.travel <= 1.7:
+        print(
+            f"{ap.prog}: --travel {a.travel} outside [0.01, 1.7] m (the contact slaves' arc)", file=sys.stderr
+        )
+        return 2
+    setup = Setup(mesh_kind=a.mesh, travel=a.travel)
+    done = run_programme(a.out, a.work, specs, setup, a.scheduler)
+    _log(f"done now: {', '.join(done) or 'nothing'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

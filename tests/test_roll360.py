@@ -1,0 +1,173 @@
+"""Steady rolling of the whole aircraft tire (issue 39, part 3): deck, solve, sidecar, driver.
+
+- a tiny whole-tire deck (half model, 10 degree layers) rolled 20 mm by CalculiX with the rim
+  free to turn: no torque, rim and road in balance, the sidecar's integrals and labels;
+- the deck: the whole rig tire's contact lines, the turn held while loading and released
+  (or imposed) in the roll;
+- the driver's resume rule with a fake solver (no CalculiX);
+- the steadiness and turn-rate readers on a made-up history.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from scripts.tiremodel import aircraft_roll360_programme as prog
+from scripts.tiremodel.aircraft_roll360_run import History, steadiness, steady_turn_rate
+
+HAVE_GMSH = importlib.util.find_spec("gmsh") is not None
+needs_gmsh = pytest.mark.skipif(not HAVE_GMSH, reason="gmsh is not installed (the 'model' extra)")
+needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed")
+
+
+@pytest.fixture(scope="module")
+def tiny_mesh():
+    from scripts.tiremodel.aircraft_roll360_deck import build_mesh
+
+    return build_mesh("tiny")
+
+
+def _tiny_plan(rotation=None):
+    from scripts.tiremodel.aircraft_roll360_deck import Plan
+
+    # a light load (60 mm rim travel) and 20 mm of roll: the coarse deck's quickest solve
+    return Plan(0.06, 0.02, rotation, print_every=0.25, frames=1, first_roll_inc=0.002)
+
+
+@pytest.mark.slow
+@pytest.mark.ccx
+@needs_gmsh
+@needs_ccx
+def test_tiny_free_roll_end_to_end(tiny_mesh, tmp_path):
+    """The free rim rolls without torque; rim and road balance; the sidecar says what the run is."""
+    from scripts.tiremodel.aircraft_roll360_run import solve, write_run, write_static
+
+    spec = prog.RunSpec(prog.FREE, None)
+    result = solve(shutil.which("ccx"), tiny_mesh, "tiny", _tiny_plan(), tmp_path / "work")
+    h = result.history
+    radius = 1.0 / steady_turn_rate(h)
+    static = write_static(tiny_mesh, result, tmp_path, prog.STATIC)
+    side = write_run(
+        tiny_mesh, result, tmp_path, prog.FREE, spec.labels(prog.Setup(mesh_kind="tiny"), radius)
+    )
+    n = side["reaction"]["force"][2]
+    # no torque on a free rim: the rotation node's reaction is the solver's residual only
+    # (measured 2.9 N m against f N R = 10.6 kN m: 2.8e-4)
+    assert abs(side["axle_torque_Nm"]) < 1e-3 * 0.3 * n * side["loaded_radius_m"]
+    # the rim turned: R_e between the loaded radius and the unloaded one (0.584 m)
+    assert side["loaded_radius_m"] < radius < 0.584
+    assert side["longitudinal_slip"] == pytest.approx(0.0, abs=1e-12)
+    # rim against road: road + rim - bead pressure load = 0 within 0.5 % of N (measured 4e-4, 2e-5)
+    for s in (side, static):
+        bal = s["balance"]["residual_over_N"]
+        assert abs(bal[0]) < 5e-3 and abs(bal[2]) < 5e-3
+        # and the bead's pressure load is what separates the rim's reaction from the road's
+        assert abs(s["balance"]["rim_force"][2] + s["balance"]["road_force"][2]) > 0.05 * n
+    # the contact pressure carries the road reaction (the coarse deck: within 3 %)
+    assert side["cpress_integral_projected"] == pytest.approx(n, rel=0.03)
+    assert "free to turn" in side["description"] and side["imposed"].startswith("axle travel only")
+    assert side["steadiness"]["printed_times"] >= 2 and side["cpu_s"] > 0.0
+    for ext in (".vtu", ".dat.txt", ".json"):
+        assert (tmp_path / f"{prog.FREE}{ext}").is_file()
+    assert json.loads((tmp_path / f"{prog.FREE}.json").read_text())["deck_sha256"] == result.deck_sha256
+
+
+@needs_gmsh
+def test_deck_uses_the_whole_rig_tire_contact_and_releases_the_turn(tiny_mesh, tmp_path):
+    from scripts.tiremodel import aircraft_rig_deck as ard
+    from scripts.tiremodel.aircraft_roll360_deck import road_block, write_deck
+
+    free, imposed = _tiny_plan(), _tiny_plan(0.0357)
+    write_deck(tmp_path / "free.inp", tiny_mesh, free)
+    write_deck(tmp_path / "imp.inp", tiny_mesh, imposed)
+    text_free, text_imp = ((tmp_path / f).read_text() for f in ("free.inp", "imp.inp"))
+    pair = ard.WHOLE.model_lines(tiny_mesh, "x", road_block(free))
+    k = pair.index("*SURFACE INTERACTION, NAME=SI")
+    assert "\n".join(pair[k : k + 7]) in text_free
+    # two steps: the turn held (ROTN 2) while loading; the roll re-states every condition
+    assert text_free.count("*STEP, NLGEOM") == 2 and "*BOUNDARY, OP=NEW" in text_free
+    roll_free, roll_imp = (t.split("*BOUNDARY, OP=NEW")[1] for t in (text_free, text_imp))
+    assert "ROTN, 2, 2," not in roll_free
+    assert "ROTN, 2, 2, 3.570000000e-02" in roll_imp
+    assert "SYMN, 2, 2" in roll_free and "ROADN, 1, 1, -2.000000000e-02" in roll_free
+
+
+def _fake_task(task: prog.Task) -> dict:
+    side = {"deck_sha256": _fake_sha(task.spec, task.plan), "effective_rolling_radius_m": 0.55}
+    for ext in (".vtu", ".dat.txt"):
+        (task.out / f"{task.spec.name}{ext}").write_text("x")
+    (task.out / f"{task.spec.name}.json").write_text(json.dumps(side))
+    CALLS.append(task.spec.name)
+    return {"case": task.spec.name}
+
+
+def _fake_sha(spec: prog.RunSpec, plan) -> str:
+    return f"{spec.name}:{plan.rotation}"
+
+
+CALLS: list[str] = []
+
+
+def test_resume_runs_free_first_and_skips_finished_runs(tmp_path):
+    specs = prog.programme((-0.01, 0.01))
+    out, work = tmp_path / "out", tmp_path / "work"
+    out.mkdir()
+    free, brake, drive = specs
+    setup = prog.Setup(mesh_kind="tiny")
+    # the braking run finished earlier with the deck it gets now; the driving run half-written
+    _fake_task(prog.Task(brake, brake.plan(0.55, setup), setup, None, out, work, 0.55))
+    (out / f"{drive.name}.vtu").write_text("partial")
+    CALLS.clear()
+    done = prog.run_programme(
+        out, work, specs, setup, task_fn=_fake_task, deck_sha=_fake_sha, processes=False, mesh=object()
+    )
+    assert CALLS == [free.name, drive.name] and sorted(done) == sorted(CALLS)
+    CALLS.clear()
+    assert (
+        prog.run_programme(
+            out, work, specs, setup, task_fn=_fake_task, deck_sha=_fake_sha, processes=False, mesh=object()
+        )
+        == []
+    )
+    assert CALLS == []
+
+
+def test_slip_plans_turn_against_the_free_radius():
+    setup = prog.Setup(mesh_kind="tiny", travel=1.0)
+    spec = prog.RunSpec(prog.run_name(-0.03), -0.03)
+    assert spec.name == "roll_brake030"
+    assert spec.plan(0.5, setup).rotation == pytest.approx(0.97 / 0.5)
+    assert prog.RunSpec(prog.FREE, None).plan(None, setup).rotation is None
+    with pytest.raises(ValueError, match="effective radius"):
+        spec.plan(None, setup)
+
+
+def test_steadiness_and_turn_rate_of_a_made_up_history():
+    x = np.linspace(0.0, 1.0, 41)
+    fz = np.full(x.size, 2.0e5)
+    fx = 1.0e3 * (1.0 - np.exp(-x / 0.2))  # a relaxation length of 0.2 m
+    h = History(
+        time=1.2 + 2.0 * x,
+        axle_travel=x,
+        rotation=x / 0.56,
+        road=np.column_stack([fx, 0 * x, fz]),
+        rim=np.column_stack([-fx, 0 * x, -fz]),
+        torque=0.5 * fx,
+        road_z=np.full(x.size, 0.12),
+    )
+    assert steady_turn_rate(h) == pytest.approx(1 / 0.56)
+    st = steadiness(h, 0.46)
+    # Fx moves by 1e3 (e^-4 - e^-5) = 11.6 N over the last fifth, against f N = 6e4 N
+    assert st["Fx_over_fN"] == pytest.approx(1e3 * (np.exp(-4) - np.exp(-5)) / 6e4, rel=1e-9)
+    assert st["Fz_over_N"] == 0.0 and st["printed_times"] == 9 and st["steady"]
+    fz2 = fz.copy()
+    fz2[-1] *= 1.01  # N moving 1 % in the tail is not steady
+    h2 = History(
+        h.time, h.axle_travel, h.rotation, np.column_stack([fx, 0 * x, fz2]), h.rim, h.torque, h.road_z
+    )
+    assert not steadiness(h2, 0.46)["steady"]
