@@ -1,7 +1,8 @@
 """The whole 360-degree aircraft tire on the slide/spin rig (issue 39) and the generators' outputs.
 
 - its mesh (gmsh; skipped without it): closed round the circumference, no cut
-  faces, two elements through the rubber, C3D8I everywhere;
+  faces, two elements through the rubber, C3D8I except the rubber band under the patch's
+  lateral edges;
 - its decks: no cut-face equations, a frictionless variant for the mu = 0 check,
   the sector's decks as before;
 - where the generators write: ``out/tiremodel/...`` unless ``--out`` or ``--update``;
@@ -68,9 +69,8 @@ def test_whole_mesh_is_closed_round_the_circumference(whole):
 
 @needs_gmsh
 def test_whole_mesh_has_two_elements_through_the_rubber(whole):
-    """On the radial line under the crown centre: the outer point, two rubber layers, the carcass."""
-    from scripts.tiremodel import aircraft_deck as ad
-
+    """On the radial line under the crown centre: the outer point, two rubber layers, the carcass;
+    C3D8I everywhere but in the fine region's rubber beyond ``PLAIN_EDGE_Y`` from the mid-plane."""
     x, y = whole.nodes[:, 0], whole.nodes[:, 1]
     below = (np.abs(x) < 1e-9) & (np.abs(y) < 1e-9) & (whole.nodes[:, 2] < whole.params.axle_z)
     depth = np.sort(whole.nodes[below, 2])
@@ -78,7 +78,10 @@ def test_whole_mesh_has_two_elements_through_the_rubber(whole):
     assert depth.size == 4
     np.testing.assert_allclose(np.diff(depth)[:2].sum(), p.rubber_thickness[0][0], rtol=1e-6)
     np.testing.assert_allclose(depth[-1] - depth[0], p.total_thickness[0][0], rtol=1e-6)
-    assert ad.incompatible_mask(whole).all()  # no plain C3D8 (they lock in bending)
+    off_centre = np.abs(whole.nodes[whole.hexes, 1].mean(axis=1))
+    band = whole.fine & (whole.layer == 0) & (off_centre > ard.PLAIN_EDGE_Y)
+    assert band.any() and (off_centre[~whole.fine | (whole.layer > 0)] > ard.PLAIN_EDGE_Y).any()
+    np.testing.assert_array_equal(ard.incompatible_mask(whole), ~band)
 
 
 @needs_gmsh
@@ -93,16 +96,29 @@ def test_whole_decks(whole, tmp_path):
         text = inp.read_text()
         assert "*EQUATION" not in text and "CUTREF" not in text
         assert text.count("*FRICTION") == cards
-        # every tire element C3D8I: the C3D8 card (kept for the sweep's decks) lists none
-        lines = text.splitlines()
-        assert lines[lines.index("*ELEMENT, TYPE=C3D8, ELSET=TIRE") + 1].startswith("*")
+        # C3D8I but in the band under the patch's lateral edges (``incompatible_mask``)
+        assert _element_count(text, "C3D8") == int((~ard.incompatible_mask(whole)).sum()) > 0
+        assert _element_count(text, "C3D8I") == int(ard.incompatible_mask(whole).sum()) > 0
         slide = tmp_path / f"slide{friction}.inp"
         rd.write_slide_deck(slide, whole, rd.kinematics(0.0, 90.0, 1, tire), 0.12, (0.0, 0.0), 0.25, tire)
         text = slide.read_text()
-        assert "CUTREF" not in text and "0.02, 0.5" in text  # the sector's relaxed criteria
+        # CalculiX's default criteria, up to 50 iterations an increment
+        assert "CUTREF" not in text and "0.005, 0.01\n" in text and "0.02, 0.5" not in text
+        assert "12, 24, 24, 50, 30, 4, 0, 20" in text
     assert ard.tire_for("rig") is ard.AIRCRAFT and ard.tire_for("whole") is ard.WHOLE
+    # the whole tire's road holds its patch (0.23 m ahead of the centre) over a 0.45 m slide
+    assert np.abs(ard.tire_for("whole", 0.0).road().nodes[:, :2]).max(axis=0) == pytest.approx([0.8, 0.8])
+    assert np.abs(ard.AIRCRAFT.road().nodes[:, :2]).max(axis=0) == pytest.approx([0.6, 0.6])
     with pytest.raises(ValueError, match="friction"):
         ard.tire_for("whole", -0.1)
+
+
+def _element_count(text: str, etype: str) -> int:
+    """Number of tire elements of ``etype`` in a deck's ``*ELEMENT, TYPE=etype, ELSET=TIRE`` card."""
+    lines = text.splitlines()
+    start = lines.index(f"*ELEMENT, TYPE={etype}, ELSET=TIRE") + 1
+    stop = next(i for i in range(start, len(lines)) if lines[i].startswith("*"))
+    return stop - start
 
 
 @pytest.mark.parametrize(

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import rig_deck as rd
-from .aircraft_rig_deck import AIRCRAFT, tire_for
+from .aircraft_rig_deck import AIRCRAFT, incompatible_mask, tire_for
 from .aircraft_rig_mesh import build_rig_mesh
 from .rig_programme import run_name
 
@@ -212,7 +212,7 @@ def model_info(mesh, setup: Setup, rim_travel: float, clearance: float, solver: 
     from .aircraft_export import model_description
 
     hexes = mesh.hexes.shape[0]
-    incompatible = int(ad.incompatible_mask(mesh).sum())
+    incompatible = int(incompatible_mask(mesh).sum())
     info = {
         "solver": solver,
         "mesh": {
