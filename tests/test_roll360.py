@@ -35,8 +35,9 @@ def tiny_mesh():
 def _tiny_plan(rotation=None):
     from scripts.tiremodel.aircraft_roll360_deck import Plan
 
-    # a light load (60 mm rim travel) and 20 mm of roll: the coarse deck's quickest solve
-    return Plan(0.06, 0.02, rotation, print_every=0.25, frames=1, first_roll_inc=0.002)
+    # the rated-load rim travel and 20 mm of roll (13 s of CPU). The coarse deck's 100 mm faces
+    # make its roll fragile: at a light load (60 mm, six contact nodes) it stalled 13 mm into it
+    return Plan(0.1241, 0.02, rotation, print_every=0.25, frames=1)
 
 
 @pytest.mark.slow
@@ -57,19 +58,20 @@ def test_tiny_free_roll_end_to_end(tiny_mesh, tmp_path):
     )
     n = side["reaction"]["force"][2]
     # no torque on a free rim: the rotation node's reaction is the solver's residual only
-    # (measured 2.9 N m against f N R = 10.6 kN m: 2.8e-4)
+    # (measured 0.59 N m against f N R = 34.5 kN m: 1.7e-5)
     assert abs(side["axle_torque_Nm"]) < 1e-3 * 0.3 * n * side["loaded_radius_m"]
     # the rim turned: R_e between the loaded radius and the unloaded one (0.584 m)
     assert side["loaded_radius_m"] < radius < 0.584
     assert side["longitudinal_slip"] == pytest.approx(0.0, abs=1e-12)
-    # rim against road: road + rim - bead pressure load = 0 within 0.5 % of N (measured 4e-4, 2e-5)
+    # rim against road: road + rim - bead pressure load = 0 within 0.5 % of N (measured 3e-5 of N
+    # along x, 4e-7 along z at the end of the roll; 3e-6 along z in the static state)
     for s in (side, static):
         bal = s["balance"]["residual_over_N"]
         assert abs(bal[0]) < 5e-3 and abs(bal[2]) < 5e-3
         # and the bead's pressure load is what separates the rim's reaction from the road's
         assert abs(s["balance"]["rim_force"][2] + s["balance"]["road_force"][2]) > 0.05 * n
-    # the contact pressure carries the road reaction (the coarse deck: within 3 %)
-    assert side["cpress_integral_projected"] == pytest.approx(n, rel=0.03)
+    # the contact pressure carries the road reaction (the coarse deck's 100 mm faces: 2.95 % short)
+    assert side["cpress_integral_projected"] == pytest.approx(n, rel=0.035)
     assert "free to turn" in side["description"] and side["imposed"].startswith("axle travel only")
     assert side["steadiness"]["printed_times"] >= 2 and side["cpu_s"] > 0.0
     for ext in (".vtu", ".dat.txt", ".json"):
@@ -171,3 +173,26 @@ def test_steadiness_and_turn_rate_of_a_made_up_history():
         h.time, h.axle_travel, h.rotation, np.column_stack([fx, 0 * x, fz2]), h.rim, h.torque, h.road_z
     )
     assert not steadiness(h2, 0.46)["steady"]
+
+
+RUNS = sorted(p for p in prog.OUT.glob("roll_*.json") if p.stem != prog.STATIC)
+
+
+@pytest.mark.skipif(not RUNS, reason="meshes/rig-tire360/roll/ holds no rolling runs yet")
+@pytest.mark.parametrize("path", RUNS, ids=lambda p: p.stem)
+def test_committed_runs_balance_and_say_what_they_are(path):
+    side = json.loads(path.read_text())
+    assert side["kind"] == "rolling run" and side["deck_sha256"]
+    for ext in (".vtu", ".dat.txt"):
+        assert path.with_suffix("").with_suffix(ext).is_file()
+    # rim against road within 0.5 % of N (bead pressure load included)
+    assert max(abs(v) for v in side["balance"]["residual_over_N"]) < 5e-3
+    n = side["reaction"]["force"][2]
+    if side["case"] == prog.FREE:
+        # the free rim: no torque but the solver's residual; its slip is 0 by definition
+        assert "free to turn" in side["description"]
+        assert abs(side["axle_torque_tail_mean_Nm"]) < 1e-3 * 0.3 * n * side["loaded_radius_m"]
+    else:
+        assert side["imposed_slip"] == pytest.approx(side["longitudinal_slip"], abs=2e-3)
+    # the last frame's centre comes from the exact projected integral; the load integral is N's
+    assert side["cpress_integral_projected"] == pytest.approx(n, rel=0.03)

@@ -35,6 +35,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from . import aircraft_deck as ad
 from . import aircraft_roll360_deck as r3
 from .aircraft_roll_programme import finished
@@ -233,28 +235,54 @@ def brush_slope(side: dict) -> float:
     return 2.0 * c_px * (patch["length"] / 2.0) ** 2 / side["static_load"]
 
 
-def table(out: Path) -> list[str]:
-    """One line per finished run: slip, Fx/N, axle torque, steadiness, balance; the brush slope."""
+def fepost_kx(out: Path, name: str) -> float:
+    """k_x that ``fepost coefficients`` gives the run's map against ``roll_static``."""
+    import tempfile
+
+    from fepost.cli import main as fepost
+
+    with tempfile.TemporaryDirectory(prefix="roll360-kx-") as tmp:
+        js = Path(tmp) / "coef.json"
+        static, rolled = out / f"{STATIC}.vtu", out / f"{name}.vtu"
+        if fepost(["coefficients", str(static), "--rolling", str(rolled), "--json", str(js)]) != 0:
+            raise RuntimeError(f"fepost coefficients failed on {rolled}")
+        coef = json.loads(js.read_text())
+    return float(coef.get("coefficients", coef)["k_x"])
+
+
+def table(out: Path, kx: bool = True) -> list[str]:
+    """One line per finished run: slip, Fx/N, axle torque, steadiness, balance, fepost's k_x; the
+    slip curve's initial slope from the two smallest slips against the brush estimate."""
     lines = [
-        f"{'run':<16} {'kappa':>8} {'Fx/N':>8} {'T kN m':>8} {'dFx/fN':>7} {'dFz/N':>7} {'dT/fNR':>7} "
-        f"{'bal x/N':>8} {'bal z/N':>8} {'CPU s/m':>8}"
+        f"{'run':<15} {'kappa':>7} {'Fx/N':>7} {'T kN m':>7} {'dFx/fN':>7} {'dFz/N':>7} {'dT/fNR':>7} "
+        f"{'bal x/N':>8} {'bal z/N':>8} {'k_x':>7} {'CPU s/m':>7}"
     ]
-    slope = None
+    slope, points = None, []
     for p in sorted(out.glob("roll_*.json")):
         side = json.loads(p.read_text())
         if side.get("kind") != "rolling run":
             continue
         st, bal = side["steadiness"], side["balance"]["residual_over_N"]
         kappa = side["longitudinal_slip"]
+        ratio = side["tail_means"]["Fx"] / side["tail_means"]["Fz"]
+        k = fepost_kx(out, side["case"]) if kx else math.nan
+        cpu = side["cpu_s_per_m"] or math.nan
         lines.append(
-            f"{side['case']:<16} {kappa if kappa is not None else math.nan:8.4f} "
-            f"{side['tail_means']['Fx'] / side['tail_means']['Fz']:8.4f} "
-            f"{side['axle_torque_tail_mean_Nm'] / 1e3:8.3f} {st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
-            f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {side['cpu_s_per_m'] or math.nan:8.0f}"
+            f"{side['case']:<15} {kappa if kappa is not None else math.nan:7.4f} {ratio:7.4f} "
+            f"{side['axle_torque_tail_mean_Nm'] / 1e3:7.3f} {st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
+            f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {k:7.4f} {cpu:7.0f}"
         )
         slope = brush_slope(side)
+        if kappa is not None:
+            points.append((abs(kappa), kappa, ratio))
     if slope is not None:
         lines.append(f"brush estimate of the initial slope C_kappa/N = 2 c_px a^2 / N: {slope:.2f}")
+    near = sorted(points)[:3]
+    if len(near) >= 2 and np.ptp([q[1] for q in near]) > 0:
+        fit = np.polyfit([q[1] for q in near], [q[2] for q in near], 1)
+        lines.append(
+            f"slip curve: C_kappa/N = {fit[0]:.2f} (a least-squares line, the {len(near)} smallest slips)"
+        )
     return lines
 
 
@@ -267,9 +295,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", nargs="+", metavar="RUN")
     ap.add_argument("--scheduler")
     ap.add_argument("--table", action="store_true", help="print the finished runs' table and stop")
+    ap.add_argument("--no-kx", action="store_true", help="the table without fepost's k_x")
     a = ap.parse_args(argv)
     if a.table:
-        print("\n".join(table(a.out)))
+        print("\n".join(table(a.out, kx=not a.no_kx)))
         return 0
     if a.work is None:
         print(f"{ap.prog}: --work DIR is needed to run the programme", file=sys.stderr)

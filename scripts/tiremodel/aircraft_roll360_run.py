@@ -335,7 +335,12 @@ def write_run(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str, labels
         "runtime_s": round(result.runtime_s, 1),
         "cpu_s": result.cpu_s,
         "cpu_s_per_m": None if result.cpu_s is None else result.cpu_s / result.plan.travel_x,
-        "solver_tolerances": list(result.plan.tolerances),
+        "solver_tolerances": {
+            "roll": list(result.plan.tolerances),
+            "inflation_and_load": list(result.plan.load_tolerances),
+            "note": "CalculiX *CONTROLS, PARAMETERS=FIELD: R_n (force residual over the average "
+            "nodal force), C_n (displacement correction over the increment)",
+        },
         "deck_sha256": result.deck_sha256,
         "mesh": {k: v for k, v in mesh.info.items() if isinstance(v, (int, float, str, bool, list))},
         "model": {
