@@ -1,12 +1,13 @@
 """Steady rolling of the whole aircraft tire: its mesh and its CalculiX deck (issue 39).
 
-The model. The whole rig tire's materials, elements (C3D8I everywhere, two
-elements through the rubber) and contact law (``aircraft_rig_deck.WHOLE``'s
-model lines, imported, not copied: whatever normal-contact law the whole rig
-tire uses, rolling uses too), revolved over the full 360 degrees with uniform
-circumferential layers all round: a roll of X metres turns the rim by about
-X / R_e (1.5 m: 150 degrees), so material from almost the whole circumference
-passes through the patch and every layer is a contact slave. Straight rolling
+The model. The whole rig tire's materials, elements (two through the rubber;
+C3D8I, plain C3D8 in the rubber under the patch's lateral edges) and contact
+(``aircraft_rig_deck.WHOLE``'s model lines, imported, not copied: whatever
+element split and contact law the whole rig tire uses, rolling uses too),
+revolved over the full 360 degrees with uniform circumferential layers all
+round: a roll of X metres turns the rim by about X / R_e (1.6 m: 164 degrees),
+so material from almost the whole circumference passes through the patch and
+every layer but the top one is a contact slave. Straight rolling
 is symmetric about the mid-plane y = 0, so the model is the half y >= 0 with
 a symmetry plane (u_y = 0 there): half the cost of the full section. Forces
 are reported for the whole tire (twice the half model's).
@@ -213,6 +214,10 @@ def write_deck(path, mesh: Roll360Mesh, plan: Plan) -> dict:
         "output_times": times,
         "print_times": roll_times(plan),
         "contact_law": law,
+        "elements": {
+            "C3D8I": int(ard.incompatible_mask(mesh).sum()),
+            "C3D8": int((~ard.incompatible_mask(mesh)).sum()),
+        },
     }
 
 

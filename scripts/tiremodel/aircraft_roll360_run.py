@@ -348,7 +348,8 @@ def write_run(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str, labels
             "rim": "rigid body on the bead nodes, its reference node on the axle",
             "contact": "the whole rig tire's contact pair (aircraft_rig_deck.WHOLE's model lines): "
             f"node-to-surface penalty, {result.deck_info['contact_law']}, Coulomb friction {ad.FRICTION}",
-            "elements": "C3D8I everywhere, two elements through the rubber",
+            "elements": "two elements through the rubber; C3D8I, plain C3D8 in the rubber under the "
+            f"patch's lateral edges (aircraft_rig_deck.incompatible_mask): {result.deck_info['elements']}",
         },
         "units": "SI (m, Pa, N, N m, rad)",
     }
