@@ -77,6 +77,10 @@ def test_tiny_free_roll_end_to_end(tiny_mesh, tmp_path):
     for ext in (".vtu", ".dat.txt", ".json"):
         assert (tmp_path / f"{prog.FREE}{ext}").is_file()
     assert json.loads((tmp_path / f"{prog.FREE}.json").read_text())["deck_sha256"] == result.deck_sha256
+    # the progress listing reads the same records from the work folder
+    lines = prog.progress(tmp_path)
+    assert lines[0].startswith("tiny:") and len(lines) == 1 + h.time.size
+    assert float(lines[-1].split()[3]) == pytest.approx(n, abs=0.1)
 
 
 @needs_gmsh

@@ -286,6 +286,26 @@ def table(out: Path, kx: bool = True) -> list[str]:
     return lines
 
 
+def progress(work: Path) -> list[str]:
+    """The printed records so far of every run in the work folder (a run still solving included)."""
+    from .aircraft_roll360_run import read_history
+    from .solve import ModelError
+
+    lines = []
+    for dat in sorted(work.glob("*/*.dat")):
+        try:
+            h = read_history(dat)
+        except (ModelError, OSError, ValueError) as exc:
+            lines.append(f"{dat.stem}: {exc}")
+            continue
+        lines.append(f"{dat.stem}: travel m, turn rad, Fx N, Fz N, axle torque N m (whole tire)")
+        lines += [
+            f"  {x:7.4f} {th:8.5f} {f[0]:10.1f} {f[2]:10.1f} {t:9.2f}"
+            for x, th, f, t in zip(h.axle_travel, h.rotation, h.road, h.torque, strict=True)
+        ]
+    return lines
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m scripts.tiremodel.aircraft_roll360_programme")
     ap.add_argument("--work", type=Path, help="work folder (CalculiX runs)")
@@ -296,6 +316,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scheduler")
     ap.add_argument("--table", action="store_true", help="print the finished runs' table and stop")
     ap.add_argument("--no-kx", action="store_true", help="the table without fepost's k_x")
+    ap.add_argument(
+        "--progress", action="store_true", help="print the runs' records so far (--work) and stop"
+    )
     a = ap.parse_args(argv)
     if a.table:
         print("\n".join(table(a.out, kx=not a.no_kx)))
@@ -303,6 +326,9 @@ def main(argv: list[str] | None = None) -> int:
     if a.work is None:
         print(f"{ap.prog}: --work DIR is needed to run the programme", file=sys.stderr)
         return 2
+    if a.progress:
+        print("\n".join(progress(a.work)))
+        return 0
     specs = programme()
     if a.only:
         unknown = sorted(set(a.only) - {s.name for s in specs})
