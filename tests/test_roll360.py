@@ -104,7 +104,13 @@ def test_deck_uses_the_whole_rig_tire_contact_and_releases_the_turn(tiny_mesh, t
 
 
 def _fake_task(task: prog.Task) -> dict:
-    side = {"deck_sha256": _fake_sha(task.spec, task.plan), "effective_rolling_radius_m": 0.55}
+    from scripts.tiremodel.aircraft_roll360_run import EXPORT_VERSION
+
+    side = {
+        "deck_sha256": _fake_sha(task.spec, task.plan),
+        "effective_rolling_radius_m": 0.55,
+        "export_version": EXPORT_VERSION,
+    }
     for ext in (".vtu", ".dat.txt"):
         (task.out / f"{task.spec.name}{ext}").write_text("x")
     (task.out / f"{task.spec.name}.json").write_text(json.dumps(side))
@@ -141,6 +147,12 @@ def test_resume_runs_free_first_and_skips_finished_runs(tmp_path):
         == []
     )
     assert CALLS == []
+    # a sidecar of an older export is written again
+    side = json.loads((out / f"{drive.name}.json").read_text())
+    (out / f"{drive.name}.json").write_text(json.dumps({**side, "export_version": 1}))
+    assert prog.run_programme(
+        out, work, specs, setup, task_fn=_fake_task, deck_sha=_fake_sha, processes=False, mesh=object()
+    ) == [drive.name]
 
 
 def test_slip_plans_turn_against_the_free_radius():

@@ -16,8 +16,9 @@ deck at the rotation node's residual torque of a few N m.
 
 The runs are Dask tasks (``fepost.sweep.engine.Cluster``, one worker), each solved in
 ``work/<run>/`` on one thread (``nice -n 5``). Resume rule: a run whose ``<run>.json`` holds the
-sha256 of the deck it would now write (its .vtu and .dat.txt beside it) is skipped; any other
-state is redone, reusing a finished CalculiX solve of the same deck in the work folder.
+sha256 of the deck it would now write and the current export version (its .vtu and .dat.txt
+beside it) is skipped; any other state is redone, reusing a finished CalculiX solve of the same
+deck in the work folder (an older export is thus written again without a new solve).
 
 ``python -m scripts.tiremodel.aircraft_roll360_programme --work DIR [--out DIR] [--mesh fine|mid|tiny]
 [--travel M] [--only RUN ...] [--scheduler ADDRESS]`` runs it; ``--table`` prints the finished
@@ -39,7 +40,6 @@ import numpy as np
 
 from . import aircraft_deck as ad
 from . import aircraft_roll360_deck as r3
-from .aircraft_roll_programme import finished
 
 #: braking (< 0) and driving slips, in run order: small ones first
 SLIPS = (-0.01, 0.01, -0.03, 0.03, -0.10, 0.10)
@@ -106,6 +106,20 @@ def run_name(slip: float | None) -> str:
 
 def programme(slips: tuple[float, ...] = SLIPS) -> list[RunSpec]:
     return [RunSpec(FREE, None), *(RunSpec(run_name(s), s) for s in slips)]
+
+
+def finished(out: Path, name: str, deck_sha256: str) -> bool:
+    """A run is finished when its sidecar holds this deck's sha256 and the current export version
+    and its .vtu and .dat.txt exist (an older export is redone from its finished solve)."""
+    from .aircraft_roll360_run import EXPORT_VERSION
+
+    try:
+        side = json.loads((out / f"{name}.json").read_text())
+    except (OSError, ValueError):
+        return False
+    files = all((out / f"{name}{ext}").is_file() for ext in (".vtu", ".dat.txt"))
+    current = side.get("export_version") == EXPORT_VERSION
+    return files and current and side.get("deck_sha256") == deck_sha256
 
 
 def effective_radius(out: Path) -> float | None:

@@ -40,6 +40,8 @@ from .rig_export import bead_pressure_load
 from .solve import ModelError, run_ccx
 from .steadiness import SHARE, TOL
 
+#: the sidecar's layout: a sidecar of another version is written again from its finished solve
+EXPORT_VERSION = 2
 TIMEOUT = 12 * 3600.0  # s, wall time allowed to one CalculiX run (the fine mesh's roll is hours)
 
 
@@ -261,6 +263,7 @@ def write_static(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str) -> 
     side = {
         "case": name,
         "kind": "static map",
+        "export_version": EXPORT_VERSION,
         "description": f"the whole tire (half model, mirrored) at the end of its vertical travel in run "
         f"'{result.name}', before rolling: the static partner of the roll_*.vtu maps",
         "reaction_z": float(state.road_force[2]),
@@ -291,6 +294,7 @@ def write_run(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str, labels
     side = {
         "case": name,
         "kind": "rolling run",
+        "export_version": EXPORT_VERSION,
         **labels,
         "rim_rotation_deg": math.degrees(state.rotation),
         "axle_travel_m": state.axle_travel,
