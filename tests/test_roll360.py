@@ -74,6 +74,7 @@ def test_tiny_free_roll_end_to_end(tiny_mesh, tmp_path):
     assert side["cpress_integral_projected"] == pytest.approx(n, rel=0.035)
     assert "free to turn" in side["description"] and side["imposed"].startswith("axle travel only")
     assert side["steadiness"]["printed_times"] >= 2 and side["cpu_s"] > 0.0
+    assert 0.0 < prog.brush_slope(side) < 50.0
     for ext in (".vtu", ".dat.txt", ".json"):
         assert (tmp_path / f"{prog.FREE}{ext}").is_file()
     assert json.loads((tmp_path / f"{prog.FREE}.json").read_text())["deck_sha256"] == result.deck_sha256
@@ -212,3 +213,10 @@ def test_committed_runs_balance_and_say_what_they_are(path):
         assert side["imposed_slip"] == pytest.approx(side["longitudinal_slip"], abs=2e-3)
     # the last frame's centre comes from the exact projected integral; the load integral is N's
     assert side["cpress_integral_projected"] == pytest.approx(n, rel=0.03)
+
+
+def test_brush_slope_of_a_rectangular_patch():
+    """Strips of one length 2a over a width w: C_kappa = (G/h) 2 a^2 w; over N."""
+    strips = {"length": [0.4] * 5, "width": [0.06] * 5}
+    slope = prog.brush_slope({"static_patch_strips": strips, "static_load": 2.0e5})
+    assert slope == pytest.approx(1.5e6 / 0.02 * 2 * 0.2**2 * 0.3 / 2.0e5, rel=1e-12)

@@ -45,6 +45,7 @@ from . import aircraft_roll360_deck as r3
 SLIPS = (-0.01, 0.01, -0.03, 0.03, -0.10, 0.10)
 FREE = "roll_free"
 STATIC = "roll_static"
+TREAD_DEPTH = 0.020  # m, the crown rubber (aircraft_geometry: rubber_thickness on the crown)
 OUT = Path(__file__).resolve().parents[2] / "meshes" / "rig-tire360" / "roll"
 
 
@@ -241,12 +242,14 @@ def run_programme(
 
 
 def brush_slope(side: dict) -> float:
-    """C_kappa / N of the brush model, 2 c_px a^2 / N, from the run's static patch: c_px = G_t w / h
-    (tread rubber shear modulus G_t, patch width w, tread depth h = 20 mm), a = half the patch length."""
-    patch = side["static_patch"]
+    """C_kappa / N of the brush model from the run's static patch, strip by strip: a lateral strip
+    of width dy and length 2 a carries bristles of stiffness G_t / h per unit area (tread rubber
+    shear modulus G_t, tread depth h = 20 mm), and under a small slip kappa its force is
+    (G_t / h) 2 a^2 kappa dy; summed over the strips, over N."""
+    strips = side["static_patch_strips"]
     g = ad.RUBBER["TREAD"]["shear_modulus"]
-    c_px = g * patch["width"] / 0.020
-    return 2.0 * c_px * (patch["length"] / 2.0) ** 2 / side["static_load"]
+    a = np.asarray(strips["length"]) / 2.0
+    return float(g / TREAD_DEPTH * np.sum(2.0 * a**2 * np.asarray(strips["width"])) / side["static_load"])
 
 
 def fepost_kx(out: Path, name: str) -> float:
@@ -290,7 +293,7 @@ def table(out: Path, kx: bool = True) -> list[str]:
         if kappa is not None:
             points.append((abs(kappa), kappa, ratio))
     if slope is not None:
-        lines.append(f"brush estimate of the initial slope C_kappa/N = 2 c_px a^2 / N: {slope:.2f}")
+        lines.append(f"brush estimate of the initial slope C_kappa/N (strip by strip): {slope:.2f}")
     near = sorted(points)[:3]
     if len(near) >= 2 and np.ptp([q[1] for q in near]) > 0:
         fit = np.polyfit([q[1] for q in near], [q[2] for q in near], 1)

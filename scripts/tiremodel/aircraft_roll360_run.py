@@ -41,7 +41,7 @@ from .solve import ModelError, run_ccx
 from .steadiness import SHARE, TOL
 
 #: the sidecar's layout: a sidecar of another version is written again from its finished solve
-EXPORT_VERSION = 2
+EXPORT_VERSION = 3
 TIMEOUT = 12 * 3600.0  # s, wall time allowed to one CalculiX run (the fine mesh's roll is hours)
 
 
@@ -256,6 +256,25 @@ def samples(mesh: r3.Roll360Mesh, result: Result) -> list[dict]:
     return out
 
 
+def patch_strips(pts: np.ndarray, disp: np.ndarray, cp: np.ndarray) -> dict:
+    """The loaded length of each lateral strip of the patch: for each node column (reference y)
+    with loaded nodes, the x extent of its loaded nodes on the deformed surface, and the strip
+    width (half-way to the next columns, the outer columns to the patch edge at their own y)."""
+    loaded = cp > 0.0
+    ys = np.round(pts[loaded, 1], 9)
+    cols = np.unique(ys)
+    x = (pts + disp)[loaded, 0]
+    length = np.array([np.ptp(x[ys == y]) for y in cols])
+    edges = np.concatenate([[cols[0]], 0.5 * (cols[1:] + cols[:-1]), [cols[-1]]])
+    return {
+        "y": cols.tolist(),
+        "length": length.tolist(),
+        "width": np.diff(edges).tolist(),
+        "note": "m: per node column of the static patch, the loaded x extent (deformed) and the strip "
+        "width it stands for (half-way to the neighbouring columns)",
+    }
+
+
 def write_static(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str) -> dict:
     """The loaded, not yet rolled state (the end of the first step): the rolled maps' static partner."""
     state = next(s for s in result.states if s.name == "static")
@@ -335,6 +354,7 @@ def write_run(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str, labels
         "patch": figures["patch"],
         "static_load": float(static.road_force[2]),
         "static_patch": patch_metrics(pts + disp, quads, cp),
+        "static_patch_strips": patch_strips(pts, disp, cp),
         "loaded_radius_m": loaded,
         "runtime_s": round(result.runtime_s, 1),
         "cpu_s": result.cpu_s,
