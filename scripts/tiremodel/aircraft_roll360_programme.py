@@ -1,7 +1,7 @@
 """The whole tire's rolling programme: free rolling with the rim free to turn, then imposed slips.
 
-Runs (half model of the whole 360-degree tire, ``aircraft_roll360_deck``; rim travel 124.1 mm,
-the whole rig tire's rated-load travel: 21.8 mm inflated clearance + 102.3 mm deflection):
+Runs (half model of the whole 360-degree tire, ``aircraft_roll360_deck``; rim travel 120.7 mm:
+the mesh's 18.4 mm inflated clearance + the static sweep's rated-load deflection of 102.3 mm):
 
 - ``roll_free``: the rim free to turn about the axle (no torque on it, no driver): free rolling
   as it is; its steady turn per travel over the last fifth of the roll gives R_e;
@@ -54,7 +54,10 @@ class Setup:
     """What every run of a programme shares."""
 
     mesh_kind: str = "fine"
-    rim_travel: float = 0.1241  # m: meshes/rig-tire360/static.json's rim_travel_z (0.124068)
+    # m: this mesh's inflated clearance (18.41 mm at the end of the inflation of roll_free) plus the
+    # static sweep's rated-load deflection 102.3 mm. (At 124.1 mm, the whole rig tire's travel for
+    # its own 21.77 mm clearance, the deflection was 105.7 mm and the load 208.4 kN.)
+    rim_travel: float = 0.12071
     travel: float = 1.6  # m of axle travel
     print_every: float = 0.05  # analysis time (the roll takes 2): 40 mm of travel at 1.6 m
     frames: int = 4
