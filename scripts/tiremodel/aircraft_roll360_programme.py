@@ -40,6 +40,7 @@ import numpy as np
 
 from . import aircraft_deck as ad
 from . import aircraft_roll360_deck as r3
+from .aircraft_roll_programme import run_phases, runs_to_do
 
 #: braking (< 0) and driving slips, in run order: small ones first
 SLIPS = (-0.01, 0.01, -0.03, 0.03, -0.10, 0.10)
@@ -174,24 +175,16 @@ def solve_and_export(task: Task) -> dict:
 
 def _tasks(specs, out: Path, work: Path, setup: Setup, mesh, deck_sha) -> tuple[list[Task], list[str]]:
     from .aircraft_roll360_run import deck_text
-    from .aircraft_roll_run import sha256_text
 
-    radius = effective_radius(out)
-    todo, skipped = [], []
-    for spec in specs:
-        if spec.slip is not None and radius is None:
-            continue
-        plan = spec.plan(radius, setup)
-        sha = (
-            deck_sha(spec, plan)
-            if deck_sha
-            else sha256_text(deck_text(mesh, plan, work / f".{spec.name}.tmp")[0])
-        )
-        if finished(out, spec.name, sha):
-            skipped.append(spec.name)
-        else:
-            todo.append(Task(spec, plan, setup, mesh, out, work, None if spec.slip is None else radius))
-    return todo, skipped
+    return runs_to_do(
+        specs,
+        (out, work, setup, mesh),
+        deck_sha,
+        deck_text=deck_text,
+        task_cls=Task,
+        radius=effective_radius(out),
+        finished_fn=finished,
+    )
 
 
 def run_programme(
@@ -209,39 +202,18 @@ def run_programme(
 
     ``task_fn``, ``deck_sha`` and ``mesh`` replace the solve, the deck's hash and the mesh (tests).
     """
-    from fepost.sweep.engine import Cluster
-
     specs = programme() if specs is None else specs
     mesh = r3.build_mesh(setup.mesh_kind) if mesh is None else mesh
     work.mkdir(parents=True, exist_ok=True)
-    done_now: list[str] = []
-    with Cluster(workers=None if scheduler else 1, scheduler=scheduler, processes=processes) as cluster:
-        for phase in ("free", "slip"):
-            chosen = [s for s in specs if (s.slip is None) == (phase == "free")]
-            todo, skipped = _tasks(chosen, out, work, setup, mesh, deck_sha)
-            for name in skipped:
-                _log(f"{name}: finished earlier with the same deck, skipped")
-            if not todo:
-                continue
-            futures = [
-                cluster.client.submit(task_fn, t, key=f"roll360-{t.spec.name}", pure=False, priority=-i)
-                for i, t in enumerate(todo)
-            ]
-            _log(f"{phase}: {len(todo)} run(s) submitted: {', '.join(t.spec.name for t in todo)}")
-            failed = []
-            for k, (fut, res) in enumerate(cluster.as_completed(futures), start=1):
-                name = fut.key.removeprefix("roll360-")
-                if isinstance(res, BaseException):
-                    failed.append(name)
-                    _log(
-                        f"[{k}/{len(todo)}] {name}: FAILED: {str(res).splitlines()[0] if str(res) else res!r}"
-                    )
-                    continue
-                done_now.append(name)
-                _log(f"[{k}/{len(todo)}] {name}: saved ({json.dumps(res)})")
-            if phase == "free" and failed:
-                raise RuntimeError("the free-rolling run failed: the slip runs need its effective radius")
-    return done_now
+    return run_phases(
+        specs,
+        lambda chosen: _tasks(chosen, out, work, setup, mesh, deck_sha),
+        task_fn,
+        "roll360",
+        scheduler=scheduler,
+        processes=processes,
+        log=_log,
+    )
 
 
 def brush_slope(side: dict) -> float:

@@ -34,8 +34,15 @@ from . import aircraft_deck as ad
 from . import aircraft_roll360_deck as r3
 from .aircraft_export import mirror_surface, model_description, patch_metrics
 from .aircraft_roll_export import centre_of_pressure, write_map
-from .aircraft_roll_run import RollState, finished_runtime, last_increment_text, sha256_text
-from .frd import read_dat_blocks, read_frd
+from .aircraft_roll_run import (
+    RollState,
+    finished_runtime,
+    last_increment_text,
+    read_results,
+    sha256_text,
+    surface_fields,
+)
+from .frd import read_dat_blocks
 from .rig_export import bead_pressure_load
 from .solve import ModelError, run_ccx
 from .steadiness import SHARE, TOL
@@ -132,9 +139,7 @@ def collect(
 ) -> Result:
     """Read the .frd surface results at the output times and the .dat history."""
     nt = mesh.nodes.shape[0]
-    res = read_frd(inp.with_suffix(".frd"), every=True)
-    if res.node_ids[:nt].tolist() != list(range(1, nt + 1)):
-        raise ModelError(f"{inp.stem}: unexpected node numbering in the .frd file")
+    res = read_results(inp, nt)
     hist = read_history(inp.with_suffix(".dat"))
     states = []
     for case, t in info["output_times"].items():
@@ -142,11 +147,7 @@ def collect(
         k = int(np.argmin(np.abs(hist.time - t)))
         if store is None or "U" not in store or abs(hist.time[k] - t) > 1e-6:
             raise ModelError(f"{inp.stem}: no results at analysis time {t:g} ({case})")
-        u = store["U"][1][:nt] - np.array([0.0, 0.0, hist.road_z[k]])
-        cp = np.zeros(nt)
-        if "CONTACT" in store:
-            comps, c = store["CONTACT"]
-            cp = np.clip(c[:nt, comps.index("CPRESS")], 0.0, None)
+        u, cp = surface_fields(store, nt, float(hist.road_z[k]))
         states.append(
             RollState(
                 name=case,

@@ -162,24 +162,42 @@ def solve_and_export(task: Task) -> dict:
 
 def _tasks(specs, out, work, setup: Setup, deck_sha) -> tuple[list[Task], list[str]]:
     """(runs to do, runs skipped) for the runs whose deck can be written now."""
-    from .aircraft_roll_run import deck_text, sha256_text
+    from .aircraft_roll_run import deck_text
 
     mesh = build_roll_mesh(setup.mesh)
-    radius = effective_radius(out)
+    return runs_to_do(
+        specs,
+        (out, work, setup, mesh),
+        deck_sha,
+        deck_text=deck_text,
+        task_cls=Task,
+        radius=effective_radius(out),
+        finished_fn=finished,
+    )
+
+
+def runs_to_do(specs, where, deck_sha, *, deck_text, task_cls, radius, finished_fn) -> tuple[list, list[str]]:
+    """(tasks to run, names of the runs finished earlier with the same deck).
+
+    ``where`` = (out, work, setup, mesh). A slip waits for the free run's effective ``radius``
+    (None: not known yet); a run whose deck hash (``deck_sha(spec, plan)``, or of the deck
+    ``deck_text`` writes) its finished sidecar holds (``finished_fn(out, name, sha)``) is
+    skipped; the others become ``task_cls(spec, plan, setup, mesh, out, work, radius)``.
+    Shared with `aircraft_roll360_programme`."""
+    from .aircraft_roll_run import sha256_text
+
+    out, work, setup, mesh = where
     todo, skipped = [], []
     for spec in specs:
         if spec.slip is not None and radius is None:
             continue
         plan = spec.plan(radius, setup)
-        sha = (
-            deck_sha(spec, plan)
-            if deck_sha
-            else sha256_text(deck_text(mesh, plan, work / f".{spec.name}.tmp")[0])
-        )
-        if finished(out, spec.name, sha):
+        tmp = work / f".{spec.name}.tmp"
+        sha = deck_sha(spec, plan) if deck_sha else sha256_text(deck_text(mesh, plan, tmp)[0])
+        if finished_fn(out, spec.name, sha):
             skipped.append(spec.name)
         else:
-            todo.append(Task(spec, plan, setup, mesh, out, work, None if spec.slip is None else radius))
+            todo.append(task_cls(spec, plan, setup, mesh, out, work, None if spec.slip is None else radius))
     return todo, skipped
 
 
@@ -198,35 +216,56 @@ def run_programme(
     ``task_fn`` and ``deck_sha`` replace the solve and the deck's hash (tests: a
     fake solver, no CalculiX).
     """
-    from fepost.sweep.engine import Cluster
-
     specs = programme() if specs is None else specs
     work.mkdir(parents=True, exist_ok=True)
+    return run_phases(
+        specs,
+        lambda chosen: _tasks(chosen, out, work, setup, deck_sha),
+        task_fn,
+        "roll",
+        scheduler=scheduler,
+        processes=processes,
+    )
+
+
+def run_phases(
+    specs, make_tasks, task_fn, prefix: str, *, scheduler: str | None, processes: bool, log=None
+) -> list[str]:
+    """The free run(s) of ``specs`` first, then the slips (they need its effective radius), as
+    Dask tasks on one embedded worker or on ``scheduler``; the names of the runs done now.
+
+    ``make_tasks(chosen specs)`` gives (tasks to run, names finished earlier); each task's
+    ``spec.name`` keys it (``prefix-name``). A failed free run stops the programme (the slips'
+    decks need its radius); a failed slip is logged and the others go on. Shared by this
+    programme and the whole tire's (`aircraft_roll360_programme`)."""
+    from fepost.sweep.engine import Cluster
+
+    log = log or _log
     done_now: list[str] = []
     with Cluster(workers=None if scheduler else 1, scheduler=scheduler, processes=processes) as cluster:
         for phase in ("free", "slip"):
             chosen = [s for s in specs if (s.slip is None) == (phase == "free")]
-            todo, skipped = _tasks(chosen, out, work, setup, deck_sha)
+            todo, skipped = make_tasks(chosen)
             for name in skipped:
-                _log(f"{name}: finished earlier with the same deck, skipped")
+                log(f"{name}: finished earlier with the same deck, skipped")
             if not todo:
                 continue
             futures = [
-                cluster.client.submit(task_fn, t, key=f"roll-{t.spec.name}", pure=False, priority=-i)
+                cluster.client.submit(task_fn, t, key=f"{prefix}-{t.spec.name}", pure=False, priority=-i)
                 for i, t in enumerate(todo)
             ]
-            _log(f"{phase}: {len(todo)} run(s) submitted: {', '.join(t.spec.name for t in todo)}")
+            log(f"{phase}: {len(todo)} run(s) submitted: {', '.join(t.spec.name for t in todo)}")
             failed = []
             for k, (fut, res) in enumerate(cluster.as_completed(futures), start=1):
-                name = fut.key.removeprefix("roll-")
+                name = fut.key.removeprefix(f"{prefix}-")
                 if isinstance(res, BaseException):
                     failed.append(name)
-                    _log(
+                    log(
                         f"[{k}/{len(todo)}] {name}: FAILED: {str(res).splitlines()[0] if str(res) else res!r}"
                     )
                     continue
                 done_now.append(name)
-                _log(f"[{k}/{len(todo)}] {name}: saved ({json.dumps(res)})")
+                log(f"[{k}/{len(todo)}] {name}: saved ({json.dumps(res)})")
             if phase == "free" and failed:
                 raise RuntimeError("the free-rolling run failed: the slip runs need its effective radius")
     return done_now

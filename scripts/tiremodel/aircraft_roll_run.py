@@ -157,6 +157,26 @@ def last_increment_text(dat: Path) -> str:
     return "\n".join(lines[starts[-1] :]).rstrip() + "\n"
 
 
+def read_results(inp: Path, nt: int):
+    """The .frd results of every written increment of the run ``inp`` (its first ``nt`` nodes
+    the tire's, numbered 1..nt, as the decks write them)."""
+    res = read_frd(inp.with_suffix(".frd"), every=True)
+    if res.node_ids[:nt].tolist() != list(range(1, nt + 1)):
+        raise ModelError(f"{inp.stem}: unexpected node numbering in the .frd file")
+    return res
+
+
+def surface_fields(store: dict, nt: int, road_z: float) -> tuple[np.ndarray, np.ndarray]:
+    """(displacement of the ``nt`` tire nodes in the frame that follows the road's height
+    ``road_z``, their contact pressure CPRESS clipped at 0) from one .frd result block."""
+    u = store["U"][1][:nt] - np.array([0.0, 0.0, road_z])
+    cp = np.zeros(nt)
+    if "CONTACT" in store:
+        comps, c = store["CONTACT"]
+        cp = np.clip(c[:nt, comps.index("CPRESS")], 0.0, None)
+    return u, cp
+
+
 def collect(
     mesh: AircraftMesh,
     inp: Path,
@@ -168,9 +188,7 @@ def collect(
     deck_sha256: str,
 ) -> RollResult:
     nt = mesh.nodes.shape[0]
-    res = read_frd(inp.with_suffix(".frd"), every=True)
-    if res.node_ids[:nt].tolist() != list(range(1, nt + 1)):
-        raise ModelError(f"{inp.stem}: unexpected node numbering in the .frd file")
+    res = read_results(inp, nt)
     hist = read_history(inp.with_suffix(".dat"), plan)
     states = []
     for case, t in info["output_times"].items():
@@ -181,11 +199,7 @@ def collect(
         if abs(hist.time[k] - t) > 1e-6:
             raise ModelError(f"{inp.stem}: no printed reactions at analysis time {t:g} ({case})")
         road = float(hist.road_z[k])
-        u = store["U"][1][:nt] - np.array([0.0, 0.0, road])
-        cp = np.zeros(nt)
-        if "CONTACT" in store:
-            comps, c = store["CONTACT"]
-            cp = np.clip(c[:nt, comps.index("CPRESS")], 0.0, None)
+        u, cp = surface_fields(store, nt, road)
         states.append(
             RollState(
                 name=case,
