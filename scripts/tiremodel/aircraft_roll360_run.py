@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -43,7 +42,7 @@ from .aircraft_roll_run import (
     surface_fields,
 )
 from .frd import read_dat_blocks
-from .rig_export import bead_pressure_load
+from .rig_export import bead_pressure_load, write_text
 from .solve import ModelError, run_ccx
 from .steadiness import SHARE, TOL
 
@@ -230,12 +229,6 @@ def balance(mesh: r3.Roll360Mesh, h: History, state: RollState) -> dict:
     }
 
 
-def _write_text(path: Path, text: str) -> None:
-    part = path.with_name(path.name + ".part")
-    part.write_text(text)
-    os.replace(part, path)
-
-
 def samples(mesh: r3.Roll360Mesh, result: Result) -> list[dict]:
     """The surface frames along the roll: forces, load integral and exact centre-of-pressure shift."""
     n0, x0 = centre_of_pressure(mesh, next(s for s in result.states if s.name == "static"))
@@ -296,7 +289,7 @@ def write_static(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str) -> 
         "mesh": {k: v for k, v in mesh.info.items() if isinstance(v, (int, float, str, bool, list))},
         "units": "SI (m, Pa, N, N m, rad)",
     }
-    _write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")
+    write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")
     return side
 
 
@@ -307,7 +300,7 @@ def write_run(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str, labels
     static = next(s for s in result.states if s.name == "static")
     pts, quads, cp, disp = mirror_surface(mesh, static)
     figures = write_map(mesh, state, out, name)
-    _write_text(out / f"{name}.dat.txt", result.last_increment)
+    write_text(out / f"{name}.dat.txt", result.last_increment)
     rate = steady_turn_rate(h)
     radius = labels.get("effective_rolling_radius_m")
     loaded = float(mesh.params.axle_z - state.road_z)
@@ -378,5 +371,5 @@ def write_run(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str, labels
         },
         "units": "SI (m, Pa, N, N m, rad)",
     }
-    _write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")
+    write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")
     return side

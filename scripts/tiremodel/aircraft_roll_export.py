@@ -30,6 +30,7 @@ from .aircraft_export import mirror_surface, model_description, patch_metrics
 from .aircraft_geometry import AircraftMesh
 from .aircraft_roll_run import RollResult, RollState
 from .export import quad_integral
+from .rig_export import write_text
 
 ARRAYS = {
     "CPRESS": "contact pressure from CalculiX (CSTR/CPRESS at the slave nodes), Pa, >= 0",
@@ -68,12 +69,6 @@ def _write_vtu(path: Path, pts, quads, cp, disp) -> None:
     )
     part = path.with_name(path.name + ".part.vtu")
     meshio.write(part, mesh, binary=True, compression="zlib")
-    os.replace(part, path)
-
-
-def _write_text(path: Path, text: str) -> None:
-    part = path.with_name(path.name + ".part")
-    part.write_text(text)
     os.replace(part, path)
 
 
@@ -208,7 +203,7 @@ def write_static(mesh: AircraftMesh, result: RollResult, out: Path, name: str) -
         f"(run '{result.name}' at analysis time {state.time:g}): the static partner of roll_*.vtu",
         **common_keys(mesh, result, state, figures),
     }
-    _write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")
+    write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")
     return side
 
 
@@ -219,7 +214,7 @@ def write_rolling(
     state = result.states[-1]
     static = result.state("static")
     figures = write_map(mesh, state, out, name)
-    _write_text(out / f"{name}.dat.txt", result.last_increment)
+    write_text(out / f"{name}.dat.txt", result.last_increment)
     rate = steady_turn_rate(result)
     n0, x0 = centre_of_pressure(mesh, static)
     samples = []
@@ -281,5 +276,5 @@ def write_rolling(
         "inflation, end of the vertical travel, then the samples along the roll; full tire",
         **common_keys(mesh, result, state, figures),
     }
-    _write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")
+    write_text(out / f"{name}.json", json.dumps(side, indent=2) + "\n")
     return side

@@ -73,7 +73,8 @@ def _write_vtu(path: Path, pts, quads, arrays: dict) -> None:
     os.replace(tmp, path)
 
 
-def _write_text(path: Path, text: str) -> None:
+def write_text(path: Path, text: str) -> None:
+    """``text`` into ``path`` atomically: a part file beside it, then a rename."""
     tmp = path.with_name(path.name + ".part")
     tmp.write_text(text)
     os.replace(tmp, path)
@@ -166,7 +167,7 @@ def write_static(mesh: TireMesh, res: RunResult, out: Path, info: dict, tire: rd
         "within the refined sector), m; road plane z = 0, x rolling direction, y axle",
         **info,
     }
-    _write_text(out / "static.json", json.dumps(side, indent=2) + "\n")
+    write_text(out / "static.json", json.dumps(side, indent=2) + "\n")
     return side
 
 
@@ -259,7 +260,7 @@ def write_run(
     arrays = {"CPRESS": cp, "shear": tau, "slip": slip, "displacement": disp}
     out.mkdir(parents=True, exist_ok=True)
     _write_vtu(out / f"{res.name}.vtu", pts, quads, arrays)
-    _write_text(out / f"{res.name}.dat.txt", res.dat_excerpt)
+    write_text(out / f"{res.name}.dat.txt", res.dat_excerpt)
     h = res.history
     f = h.ref_rf[-1]
     shear = shear_resultants(mesh, res, origin)
@@ -324,5 +325,5 @@ def write_run(
         **_cpu_block(res),
         **info,
     }
-    _write_text(out / f"{res.name}.json", json.dumps(side, indent=2) + "\n")
+    write_text(out / f"{res.name}.json", json.dumps(side, indent=2) + "\n")
     return side

@@ -43,7 +43,6 @@ from __future__ import annotations
 import argparse
 import copy
 import json
-import os
 import sys
 import tempfile
 from pathlib import Path
@@ -55,6 +54,7 @@ from . import aircraft_roll_programme as prog
 from .aircraft_export import mirror_surface
 from .aircraft_geometry import AircraftMesh
 from .aircraft_roll_run import RollState
+from .rig_export import write_text
 
 REPO = Path(__file__).resolve().parents[2]
 FOLDER = REPO / "meshes" / "rig-aircraft"
@@ -396,10 +396,8 @@ def changed_keys(old, new, where: str = "") -> list[str]:
 
 
 def write_json(path: Path, data: dict) -> None:
-    """Atomically: a part file beside it, then a rename (the exporter's layout: indent 2, newline)."""
-    part = path.with_name(path.name + ".part")
-    part.write_text(json.dumps(data, indent=2) + "\n")
-    os.replace(part, path)
+    """Atomically (`rig_export.write_text`), in the exporter's layout: indent 2, newline."""
+    write_text(path, json.dumps(data, indent=2) + "\n")
 
 
 def table(figures: dict[str, dict]) -> str:
