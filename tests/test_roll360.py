@@ -12,12 +12,14 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import math
 import shutil
 
 import numpy as np
 import pytest
 
 from scripts.tiremodel import aircraft_roll360_programme as prog
+from scripts.tiremodel import aircraft_roll360_results as results
 from scripts.tiremodel.aircraft_roll360_run import History, steadiness, steady_turn_rate
 
 HAVE_GMSH = importlib.util.find_spec("gmsh") is not None
@@ -45,7 +47,9 @@ def _tiny_plan(rotation=None):
 @needs_gmsh
 @needs_ccx
 def test_tiny_free_roll_end_to_end(tiny_mesh, tmp_path):
-    """The free rim rolls without torque; rim and road balance; the sidecar says what the run is."""
+    """The free rim rolls without torque; rim and road balance; the sidecar says what the run is.
+    Then the same roll driven 3 % faster than the free rim turned: a driving torque and force, and
+    free rolling found again from the two runs' torques (the driven programme's rule)."""
     from scripts.tiremodel.aircraft_roll360_run import solve, write_run, write_static
 
     spec = prog.RunSpec(prog.FREE, None)
@@ -74,7 +78,7 @@ def test_tiny_free_roll_end_to_end(tiny_mesh, tmp_path):
     assert side["cpress_integral_projected"] == pytest.approx(n, rel=0.035)
     assert "free to turn" in side["description"] and side["imposed"].startswith("axle travel only")
     assert side["steadiness"]["printed_times"] >= 2 and side["cpu_s"] > 0.0
-    assert 0.0 < prog.brush_slope(side) < 50.0
+    assert 0.0 < results.brush_slope(side) < 50.0
     for ext in (".vtu", ".dat.txt", ".json"):
         assert (tmp_path / f"{prog.FREE}{ext}").is_file()
     assert json.loads((tmp_path / f"{prog.FREE}.json").read_text())["deck_sha256"] == result.deck_sha256
@@ -82,6 +86,26 @@ def test_tiny_free_roll_end_to_end(tiny_mesh, tmp_path):
     lines = prog.progress(tmp_path)
     assert lines[0].startswith("tiny:") and len(lines) == 1 + h.time.size
     assert float(lines[-1].split()[3]) == pytest.approx(n, abs=0.1)
+
+    # driven against a reference radius: the free rim's R_e, turned at slip +0.03
+    setup = prog.Setup(mesh_kind="tiny", travel=0.02, reference_radius=radius)
+    drive = prog.RunSpec(prog.run_name(0.03), 0.03)
+    plan = _tiny_plan(drive.plan(radius, setup).rotation)
+    driven = solve(shutil.which("ccx"), tiny_mesh, "tiny_drive", plan, tmp_path / "work_drive")
+    dside = write_run(tiny_mesh, driven, tmp_path, drive.name, drive.labels(setup, radius))
+    assert "against the reference radius" in dside["description"]
+    assert "effective_rolling_radius_m" not in dside and dside["slip_radius_m"] == radius
+    # the slip read back from the printed turns (the .dat's 7 digits; measured 8e-7 off)
+    assert dside["longitudinal_slip"] == pytest.approx(0.03, abs=1e-5)
+    # a driving run: the road pushes the tire forward, the axle drives the rim (the free run's
+    # torque is 1.7e-5 of f N R; this one's is 3 orders larger)
+    assert dside["longitudinal_force_ratio"] > 0.0
+    torque = dside["axle_torque_tail_mean_Nm"]
+    assert abs(torque) > 100 * abs(side["axle_torque_tail_mean_Nm"])
+    fr = results.free_rolling([results.RunPoint.from_sidecar(s) for s in (side, dside)])
+    # the torque line's zero is the free rim's turn rate, within its residual torque's share
+    assert fr.effective_radius == pytest.approx(radius, rel=1e-3)
+    assert fr.slips[drive.name] == pytest.approx(0.03, abs=1e-3)
 
 
 @needs_gmsh
@@ -215,8 +239,73 @@ def test_committed_runs_balance_and_say_what_they_are(path):
     assert side["cpress_integral_projected"] == pytest.approx(n, rel=0.03)
 
 
+def _brush_point(name, kappa_e, radius, c_over_n, f=0.3, n=2.0e5, lever=0.5, kx=math.nan):
+    """A run of a brush tire (parabolic pressure): slip kappa_e against the true R_e, torque = the
+    force's moment about the axle (no rolling resistance)."""
+    theta = min(c_over_n * abs(kappa_e) / (3.0 * f), 1.0)
+    ratio = math.copysign(f * (3 * theta - 3 * theta**2 + theta**3), kappa_e)
+    return results.RunPoint(name, (1.0 + kappa_e) / radius, ratio * n * lever, ratio, n, f, kx)
+
+
+def test_free_rolling_from_driven_runs_of_a_brush_tire():
+    """Three runs driven against a reference 1.2 % off R_e: R_e, the slips against it, the brush
+    curve's slope recovered exactly and the secant's shortfall; k_x interpolated at free rolling."""
+    re_, c = 0.5625, 11.0
+    ref = re_ * 1.012
+    pts = [
+        _brush_point(f"r{k:+.2f}", (1 + k) * re_ / ref - 1, re_, c, kx=0.05 + 2.0 * ((1 + k) * re_ / ref - 1))
+        for k in (-0.02, 0.0, 0.02)
+    ]
+    fr = results.free_rolling(pts)
+    # the torque is odd in the slip: the line through three points is exact only to the bend's
+    # asymmetry (points at -0.032, -0.012, +0.008 about free rolling)
+    assert fr.effective_radius == pytest.approx(re_, rel=2e-3)
+    assert fr.bracketed and set(fr.runs_used) == {p.name for p in pts}
+    assert fr.brush_fit_slope == pytest.approx(c, rel=0.02)
+    assert fr.secant_slope < c  # the curve bends down: the secant falls short
+    assert fr.kx_at_free == pytest.approx(0.05, abs=0.01)
+    # symmetric runs about R_e: R_e to round-off, the brush fit exact, Fx/N = 0 at free rolling
+    sym = [_brush_point(f"s{k:+.2f}", k, re_, c) for k in (-0.02, 0.02)]
+    fs = results.free_rolling(sym)
+    assert fs.effective_radius == pytest.approx(re_, rel=1e-12)
+    assert fs.brush_fit_slope == pytest.approx(c, rel=1e-9)
+    assert fs.fx_over_n_at_free == pytest.approx(0.0, abs=1e-12)
+    assert fs.slips["s+0.02"] == pytest.approx(0.02, rel=1e-9)
+    # both runs on one side: said so
+    assert not results.free_rolling([_brush_point(f"o{k}", k, re_, c) for k in (0.01, 0.03)]).bracketed
+    with pytest.raises(ValueError, match="at least two"):
+        results.free_rolling(sym[:1])
+
+
+def test_brush_theta_inverts_the_brush_curve():
+    for theta in (0.0, 0.1, 0.5, 0.99, 1.0):
+        ratio = 3 * theta - 3 * theta**2 + theta**3
+        assert results.brush_theta(ratio) == pytest.approx(theta, abs=1e-12)
+        assert results.brush_theta(-ratio) == pytest.approx(theta, abs=1e-12)
+    assert math.isnan(results.brush_theta(1.2))
+
+
+def test_driven_programme_runs_every_slip_against_the_reference(tmp_path):
+    specs = prog.programme((-0.02, 0.02, 0.0), free=False)
+    assert [s.name for s in specs] == ["roll_brake020", "roll_drive020", "roll_ref"]
+    out, work = tmp_path / "out", tmp_path / "work"
+    out.mkdir()
+    setup = prog.Setup(mesh_kind="tiny", travel=1.0, reference_radius=0.57)
+    CALLS.clear()
+    done = prog.run_programme(
+        out, work, specs, setup, task_fn=_fake_task, deck_sha=_fake_sha, processes=False, mesh=object()
+    )
+    # no free run needed first: every slip's deck turns against the reference radius
+    assert sorted(done) == sorted(CALLS) == sorted(s.name for s in specs)
+    sha = json.loads((out / "roll_drive020.json").read_text())["deck_sha256"]
+    assert sha == f"roll_drive020:{1.02 / 0.57}"
+    labels = specs[2].labels(setup, 0.57)
+    assert "driven at the reference radius" in labels["description"] and labels["imposed_slip"] == 0.0
+    assert "not R_e" in labels["description"] and "effective_rolling_radius_m" not in labels
+
+
 def test_brush_slope_of_a_rectangular_patch():
     """Strips of one length 2a over a width w: C_kappa = (G/h) 2 a^2 w; over N."""
     strips = {"length": [0.4] * 5, "width": [0.06] * 5}
-    slope = prog.brush_slope({"static_patch_strips": strips, "static_load": 2.0e5})
+    slope = results.brush_slope({"static_patch_strips": strips, "static_load": 2.0e5})
     assert slope == pytest.approx(1.5e6 / 0.02 * 2 * 0.2**2 * 0.3 / 2.0e5, rel=1e-12)

@@ -1,52 +1,62 @@
-"""The whole tire's rolling programme: free rolling with the rim free to turn, then imposed slips.
+"""The whole tire's rolling programme: imposed slips about a reference radius, or about a free rim's.
 
 Runs (half model of the whole 360-degree tire, ``aircraft_roll360_deck``; rim travel 120.7 mm:
-the mesh's 18.4 mm inflated clearance + the static sweep's rated-load deflection of 102.3 mm):
+the mesh's 18.4 mm inflated clearance + the static sweep's rated-load deflection of 102.3 mm).
+Two ways to find free rolling:
 
-- ``roll_free``: the rim free to turn about the axle (no torque on it, no driver): free rolling
-  as it is; its steady turn per travel over the last fifth of the roll gives R_e;
-- ``roll_brake<k>`` / ``roll_drive<k>``: imposed slip kappa = -k/1000 / +k/1000 against that
-  R_e, the rim turned by (1 + kappa) X / R_e; the small slips first (the slip curve's initial
-  slope and a second, torque-zero estimate of free rolling), then the large ones.
+- **driven** (``--reference-radius R``, the fine mesh's way): every run turns the rim by
+  (1 + kappa_ref) X / R, kappa_ref from ``--slips`` (named ``roll_ref`` for 0,
+  ``roll_brake<k>`` / ``roll_drive<k>`` for -k/1000 / +k/1000). Free rolling is where the axle
+  torque is zero: ``free_rolling`` interpolates the steady torques against the turn per travel,
+  which gives R_e, and re-expresses each run's slip against it (``--table``);
+- **free rim** (no reference radius): ``roll_free`` leaves the rim free to turn about the axle
+  (no torque, no driver); its steady turn per travel over the last fifth of the roll gives R_e,
+  and the slips are imposed against that R_e.
 
-Why the free rim and not a driver: the sector's free run was driven through a torsion spring
-whose driver turned 2.4 % fast (1.87 kN m on the rim). With the turn held during inflation and
-loading and released for the roll (a second step), the free rim's roll converged on the tiny
-deck at the rotation node's residual torque of a few N m.
+Why both: the sector's free run was driven through a torsion spring whose driver turned 2.4 %
+fast (1.87 kN m on the rim). The free rim (turn held during inflation and loading, released
+for the roll) converges on the tiny deck at a residual torque of a few N m; on the fine mesh it
+did not: at 2.5 % of the roll the residual flipped between two contact nodes (5-10 N against the
+criterion's 0.85 N: 0.005 of an average nodal force of 170 N) while the increment fell to 4e-5
+of the roll. With the turn imposed the rim's rotation is no unknown held by friction alone.
 
-The runs are Dask tasks (``fepost.sweep.engine.Cluster``, one worker), each solved in
+The runs are Dask tasks (``fepost.sweep.engine.Cluster``, one worker each), each solved in
 ``work/<run>/`` on one thread (``nice -n 5``). Resume rule: a run whose ``<run>.json`` holds the
 sha256 of the deck it would now write and the current export version (its .vtu and .dat.txt
 beside it) is skipped; any other state is redone, reusing a finished CalculiX solve of the same
 deck in the work folder (an older export is thus written again without a new solve).
 
 ``python -m scripts.tiremodel.aircraft_roll360_programme --work DIR [--out DIR] [--mesh fine|mid|tiny]
-[--travel M] [--only RUN ...] [--scheduler ADDRESS]`` runs it; ``--table`` prints the finished
-runs (slip, Fx/N, torque, steadiness, balance) and the brush estimate of the initial slope.
+[--travel M] [--reference-radius R --slips K ...] [--workers W] [--only RUN ...] [--scheduler ADDRESS]``
+runs it; ``--table`` prints the finished runs (slip, Fx/N, torque, steadiness, balance), free
+rolling found from them and the brush estimate of the initial slope.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
-from . import aircraft_deck as ad
 from . import aircraft_roll360_deck as r3
+from . import aircraft_roll360_results as results
 from .aircraft_roll_programme import run_phases, runs_to_do
 
 #: braking (< 0) and driving slips, in run order: small ones first
 SLIPS = (-0.01, 0.01, -0.03, 0.03, -0.10, 0.10)
+#: the driven programme's slips against its reference radius: wide enough to straddle free rolling
+#: when the reference is off by up to 2 %, small enough for the slip curve's initial part (the
+#: brush estimate's theta = C kappa / 3 f N is 0.24 at 0.02)
+DRIVEN_SLIPS = (-0.02, 0.02, 0.0)
+#: m: the fine mesh's reference radius, an estimate of R_e before any run: the sector rig's
+#: measured effective rolling radius at the same deflection (meshes/rig-aircraft/roll)
+REFERENCE_RADIUS = 0.5694
 FREE = "roll_free"
-STATIC = "roll_static"
-TREAD_DEPTH = 0.020  # m, the crown rubber (aircraft_geometry: rubber_thickness on the crown)
+STATIC = results.STATIC
 OUT = Path(__file__).resolve().parents[2] / "meshes" / "rig-tire360" / "roll"
 
 
@@ -63,6 +73,8 @@ class Setup:
     print_every: float = 0.05  # analysis time (the roll takes 2): 40 mm of travel at 1.6 m
     frames: int = 4
     tolerances: tuple[float, float] = r3.TOLERANCES
+    #: m: None: the free rim finds R_e (``roll_free``); a number: every run is driven against it
+    reference_radius: float | None = None
 
     def plan(self, rotation: float | None) -> r3.Plan:
         return r3.Plan(self.rim_travel, self.travel, rotation, self.print_every, self.frames, self.tolerances)
@@ -92,6 +104,24 @@ class RunSpec:
                 "imposed": "axle travel only; the rim's turn is free (held during inflation and load)",
                 "effective_rolling_radius_m": radius,
                 "effective_rolling_radius_source": "this run: dX/dtheta over the last fifth of its roll",
+                "slip_radius_m": radius,
+                "slip_radius_source": "this run's effective rolling radius (its slip is 0 by definition)",
+            }
+        if setup.reference_radius is not None:
+            kind = (
+                "driven at the reference radius"
+                if self.slip == 0
+                else ("braking" if self.slip < 0 else "driving")
+            )
+            return {
+                "description": head + f"; {kind}: the rim turned at the slip {self.slip:+g} against "
+                f"the reference radius {setup.reference_radius:g} m (an estimate, not R_e)",
+                "imposed": f"rim turn (1 {self.slip:+g}) X / R_ref, linear in the axle travel X",
+                "imposed_slip": self.slip,
+                "slip_radius_m": radius,
+                "slip_radius_source": "the programme's reference radius R_ref (an estimate of R_e): "
+                "free rolling is where the axle torque vanishes (free_rolling), which gives R_e and "
+                "each run's slip against it",
             }
         kind = "braking" if self.slip < 0 else "driving"
         return {
@@ -100,17 +130,22 @@ class RunSpec:
             "imposed_slip": self.slip,
             "effective_rolling_radius_m": radius,
             "effective_rolling_radius_source": f"{FREE}.json (the free rim's dX/dtheta)",
+            "slip_radius_m": radius,
+            "slip_radius_source": f"{FREE}.json (the free rim's effective rolling radius)",
         }
 
 
 def run_name(slip: float | None) -> str:
     if slip is None:
         return FREE
+    if slip == 0:
+        return "roll_ref"
     return f"roll_{'brake' if slip < 0 else 'drive'}{round(abs(slip) * 1000):03d}"
 
 
-def programme(slips: tuple[float, ...] = SLIPS) -> list[RunSpec]:
-    return [RunSpec(FREE, None), *(RunSpec(run_name(s), s) for s in slips)]
+def programme(slips: tuple[float, ...] = SLIPS, free: bool = True) -> list[RunSpec]:
+    """The runs in solving order: the free rim first (``free``), then the imposed slips."""
+    return [*([RunSpec(FREE, None)] if free else []), *(RunSpec(run_name(s), s) for s in slips)]
 
 
 def finished(out: Path, name: str, deck_sha256: str) -> bool:
@@ -162,6 +197,9 @@ def solve_and_export(task: Task) -> dict:
     radius = task.radius
     if task.spec.slip is None:
         radius = 1.0 / steady_turn_rate(result.history)
+    if task.spec.slip is None or task.setup.reference_radius is not None:
+        # the static partner of the maps: the free run's, or (driven: every run's first step is the
+        # same deck) the latest finished run's
         write_static(task.mesh, result, task.out, STATIC)
     side = write_run(task.mesh, result, task.out, task.spec.name, task.spec.labels(task.setup, radius))
     return {
@@ -182,7 +220,7 @@ def _tasks(specs, out: Path, work: Path, setup: Setup, mesh, deck_sha) -> tuple[
         deck_sha,
         deck_text=deck_text,
         task_cls=Task,
-        radius=effective_radius(out),
+        radius=effective_radius(out) if setup.reference_radius is None else setup.reference_radius,
         finished_fn=finished,
     )
 
@@ -197,6 +235,7 @@ def run_programme(
     deck_sha: Callable[[RunSpec, r3.Plan], str] | None = None,
     processes: bool = True,
     mesh=None,
+    workers: int = 1,
 ) -> list[str]:
     """Run the programme (the free run first: the slips need its R_e); the runs done now.
 
@@ -213,69 +252,8 @@ def run_programme(
         scheduler=scheduler,
         processes=processes,
         log=_log,
+        workers=workers,
     )
-
-
-def brush_slope(side: dict) -> float:
-    """C_kappa / N of the brush model from the run's static patch, strip by strip: a lateral strip
-    of width dy and length 2 a carries bristles of stiffness G_t / h per unit area (tread rubber
-    shear modulus G_t, tread depth h = 20 mm), and under a small slip kappa its force is
-    (G_t / h) 2 a^2 kappa dy; summed over the strips, over N."""
-    strips = side["static_patch_strips"]
-    g = ad.RUBBER["TREAD"]["shear_modulus"]
-    a = np.asarray(strips["length"]) / 2.0
-    return float(g / TREAD_DEPTH * np.sum(2.0 * a**2 * np.asarray(strips["width"])) / side["static_load"])
-
-
-def fepost_kx(out: Path, name: str) -> float:
-    """k_x that ``fepost coefficients`` gives the run's map against ``roll_static``."""
-    import tempfile
-
-    from fepost.cli import main as fepost
-
-    with tempfile.TemporaryDirectory(prefix="roll360-kx-") as tmp:
-        js = Path(tmp) / "coef.json"
-        static, rolled = out / f"{STATIC}.vtu", out / f"{name}.vtu"
-        if fepost(["coefficients", str(static), "--rolling", str(rolled), "--json", str(js)]) != 0:
-            raise RuntimeError(f"fepost coefficients failed on {rolled}")
-        coef = json.loads(js.read_text())
-    return float(coef.get("coefficients", coef)["k_x"])
-
-
-def table(out: Path, kx: bool = True) -> list[str]:
-    """One line per finished run: slip, Fx/N, axle torque, steadiness, balance, fepost's k_x; the
-    slip curve's initial slope from the two smallest slips against the brush estimate."""
-    lines = [
-        f"{'run':<15} {'kappa':>7} {'Fx/N':>7} {'T kN m':>7} {'dFx/fN':>7} {'dFz/N':>7} {'dT/fNR':>7} "
-        f"{'bal x/N':>8} {'bal z/N':>8} {'k_x':>7} {'CPU s/m':>7}"
-    ]
-    slope, points = None, []
-    for p in sorted(out.glob("roll_*.json")):
-        side = json.loads(p.read_text())
-        if side.get("kind") != "rolling run":
-            continue
-        st, bal = side["steadiness"], side["balance"]["residual_over_N"]
-        kappa = side["longitudinal_slip"]
-        ratio = side["tail_means"]["Fx"] / side["tail_means"]["Fz"]
-        k = fepost_kx(out, side["case"]) if kx else math.nan
-        cpu = side["cpu_s_per_m"] or math.nan
-        lines.append(
-            f"{side['case']:<15} {kappa if kappa is not None else math.nan:7.4f} {ratio:7.4f} "
-            f"{side['axle_torque_tail_mean_Nm'] / 1e3:7.3f} {st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
-            f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {k:7.4f} {cpu:7.0f}"
-        )
-        slope = brush_slope(side)
-        if kappa is not None:
-            points.append((abs(kappa), kappa, ratio))
-    if slope is not None:
-        lines.append(f"brush estimate of the initial slope C_kappa/N (strip by strip): {slope:.2f}")
-    near = sorted(points)[:3]
-    if len(near) >= 2 and np.ptp([q[1] for q in near]) > 0:
-        fit = np.polyfit([q[1] for q in near], [q[2] for q in near], 1)
-        lines.append(
-            f"slip curve: C_kappa/N = {fit[0]:.2f} (a least-squares line, the {len(near)} smallest slips)"
-        )
-    return lines
 
 
 def progress(work: Path) -> list[str]:
@@ -305,6 +283,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--mesh", default="fine", choices=sorted(r3.MESHES))
     ap.add_argument("--travel", type=float, default=Setup.travel)
     ap.add_argument("--only", nargs="+", metavar="RUN")
+    ap.add_argument(
+        "--reference-radius",
+        type=float,
+        metavar="R",
+        help=f"drive every run against this radius, m (the fine mesh: {REFERENCE_RADIUS}); "
+        "default: the free rim first",
+    )
+    ap.add_argument("--slips", type=float, nargs="+", metavar="K", help="imposed slips, in run order")
+    ap.add_argument("--workers", type=int, default=1, help="embedded Dask workers (one CalculiX thread each)")
     ap.add_argument("--scheduler")
     ap.add_argument("--table", action="store_true", help="print the finished runs' table and stop")
     ap.add_argument("--no-kx", action="store_true", help="the table without fepost's k_x")
@@ -313,7 +300,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     a = ap.parse_args(argv)
     if a.table:
-        print("\n".join(table(a.out, kx=not a.no_kx)))
+        print("\n".join(results.table(a.out, kx=not a.no_kx)))
         return 0
     if a.work is None:
         print(f"{ap.prog}: --work DIR is needed to run the programme", file=sys.stderr)
@@ -321,7 +308,23 @@ def main(argv: list[str] | None = None) -> int:
     if a.progress:
         print("\n".join(progress(a.work)))
         return 0
-    specs = programme()
+    if a.reference_radius is not None and not 0.3 < a.reference_radius < 0.7:
+        print(
+            f"{ap.prog}: --reference-radius {a.reference_radius} m is no radius of this tire", file=sys.stderr
+        )
+        return 2
+    if a.workers < 1:
+        print(f"{ap.prog}: --workers {a.workers}: at least one", file=sys.stderr)
+        return 2
+    driven = a.reference_radius is not None
+    slips = tuple(a.slips) if a.slips else (DRIVEN_SLIPS if driven else SLIPS)
+    if any(not -0.5 < k < 0.5 for k in slips) or (not driven and 0.0 in slips):
+        print(
+            f"{ap.prog}: --slips {slips}: each in (-0.5, 0.5), and 0 only with --reference-radius",
+            file=sys.stderr,
+        )
+        return 2
+    specs = programme(slips, free=not driven)
     if a.only:
         unknown = sorted(set(a.only) - {s.name for s in specs})
         if unknown:
@@ -333,8 +336,8 @@ def main(argv: list[str] | None = None) -> int:
             f"{ap.prog}: --travel {a.travel} outside [0.01, 1.7] m (the contact slaves' arc)", file=sys.stderr
         )
         return 2
-    setup = Setup(mesh_kind=a.mesh, travel=a.travel)
-    done = run_programme(a.out, a.work, specs, setup, a.scheduler)
+    setup = Setup(mesh_kind=a.mesh, travel=a.travel, reference_radius=a.reference_radius)
+    done = run_programme(a.out, a.work, specs, setup, a.scheduler, workers=a.workers)
     _log(f"done now: {', '.join(done) or 'nothing'}")
     return 0
 

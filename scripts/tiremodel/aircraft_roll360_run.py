@@ -295,14 +295,15 @@ def write_static(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str) -> 
 
 def write_run(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str, labels: dict) -> dict:
     """``<name>.vtu``, ``<name>.dat.txt``, then ``<name>.json``; ``labels``: what the run is
-    (``description``, ``imposed``, ``effective_rolling_radius_m`` and its ``..._source``)."""
+    (``description``, ``imposed``, ``slip_radius_m``, the radius the slip is measured against, and
+    its ``slip_radius_source``; a free or free-referenced run also ``effective_rolling_radius_m``)."""
     state, h = result.states[-1], result.history
     static = next(s for s in result.states if s.name == "static")
     pts, quads, cp, disp = mirror_surface(mesh, static)
     figures = write_map(mesh, state, out, name)
     write_text(out / f"{name}.dat.txt", result.last_increment)
     rate = steady_turn_rate(h)
-    radius = labels.get("effective_rolling_radius_m")
+    radius = labels.get("slip_radius_m")
     loaded = float(mesh.params.axle_z - state.road_z)
     side = {
         "case": name,
@@ -313,8 +314,8 @@ def write_run(mesh: r3.Roll360Mesh, result: Result, out: Path, name: str, labels
         "axle_travel_m": state.axle_travel,
         "turn_per_travel_rad_per_m": rate,
         "longitudinal_slip": None if radius is None else radius * rate - 1.0,
-        "longitudinal_slip_definition": "kappa = R_e dtheta/dX - 1, dtheta/dX over the last fifth "
-        "of the roll; R_e = effective_rolling_radius_m (see its source); < 0 braking, > 0 driving",
+        "longitudinal_slip_definition": "kappa = R dtheta/dX - 1, dtheta/dX over the last fifth "
+        "of the roll; R = slip_radius_m (see its source); < 0 braking, > 0 driving",
         "axle_torque_Nm": state.axle_torque,
         "axle_torque_tail_mean_Nm": float(h.torque[rolling_part(h)].mean()),
         "axle_torque_note": "torque of the axle on the rim about +y (whole tire): the rotation node's "

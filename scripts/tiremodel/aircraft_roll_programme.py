@@ -229,7 +229,15 @@ def run_programme(
 
 
 def run_phases(
-    specs, make_tasks, task_fn, prefix: str, *, scheduler: str | None, processes: bool, log=None
+    specs,
+    make_tasks,
+    task_fn,
+    prefix: str,
+    *,
+    scheduler: str | None,
+    processes: bool,
+    log=None,
+    workers: int = 1,
 ) -> list[str]:
     """The free run(s) of ``specs`` first, then the slips (they need its effective radius), as
     Dask tasks on one embedded worker or on ``scheduler``; the names of the runs done now.
@@ -237,12 +245,13 @@ def run_phases(
     ``make_tasks(chosen specs)`` gives (tasks to run, names finished earlier); each task's
     ``spec.name`` keys it (``prefix-name``). A failed free run stops the programme (the slips'
     decks need its radius); a failed slip is logged and the others go on. Shared by this
-    programme and the whole tire's (`aircraft_roll360_programme`)."""
+    programme and the whole tire's (`aircraft_roll360_programme`); ``workers``: embedded workers
+    (one thread each)."""
     from fepost.sweep.engine import Cluster
 
     log = log or _log
     done_now: list[str] = []
-    with Cluster(workers=None if scheduler else 1, scheduler=scheduler, processes=processes) as cluster:
+    with Cluster(workers=None if scheduler else workers, scheduler=scheduler, processes=processes) as cluster:
         for phase in ("free", "slip"):
             chosen = [s for s in specs if (s.slip is None) == (phase == "free")]
             todo, skipped = make_tasks(chosen)

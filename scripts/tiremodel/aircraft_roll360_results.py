@@ -1,0 +1,195 @@
+"""What the whole tire's rolling runs say: free rolling, the slip curve's initial slope, k_x.
+
+Free rolling is the state in which the axle puts no torque on the rim. A programme driven against
+a reference radius R_ref (``aircraft_roll360_programme``) never rolls exactly there, so it is found
+from the runs: their steady axle torques T_i against their turn per travel w_i = dtheta/dX. A
+least-squares line T(w) through the runs nearest free rolling gives its zero w_0, the effective
+rolling radius R_e = 1 / w_0, and every run's slip against it, kappa_i = R_e w_i - 1. The same
+interpolation at w_0 gives Fx/N (about 0: rolling resistance aside) and fepost's k_x there.
+
+The slip curve's initial slope C_kappa / N comes two ways from the same runs:
+
+- ``secant``: the least-squares line of Fx/N against kappa (it falls short of the slope at 0 by
+  the curve's bend, about theta = C kappa / (3 f N) for a brush tire);
+- ``brush``: each run's Fx inverted through the brush curve of a parabolic pressure,
+  Fx / (f N) = 3 theta - 3 theta^2 + theta^3 (|theta| < 1, sign of kappa), with the Coulomb f
+  of the runs; the mean of the runs' C / N.
+
+Both are compared with ``brush_slope``, the brush estimate from the static patch's strips and the
+tread rubber's stiffness (no run needed). Written here, not taken from a library: the brush
+curve's inverse is one cubic root per run (numpy's ``roots``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import aircraft_deck as ad
+
+TREAD_DEPTH = 0.020  # m, the crown rubber (aircraft_geometry: rubber_thickness on the crown)
+STATIC = "roll_static"
+
+
+@dataclass(frozen=True)
+class RunPoint:
+    """One finished rolling run, reduced to what the slip curve needs (tail means)."""
+
+    name: str
+    turn_rate: float  # rad/m over the last fifth of the roll
+    torque: float  # N m, axle on rim, tail mean
+    fx_over_n: float  # tail means
+    normal_load: float  # N, tail mean
+    friction: float
+    kx: float = math.nan  # fepost's k_x of the run's map against the static one
+
+    @classmethod
+    def from_sidecar(cls, side: dict, kx: float = math.nan) -> RunPoint:
+        tail = side["tail_means"]
+        return cls(
+            side["case"],
+            float(side["turn_per_travel_rad_per_m"]),
+            float(side["axle_torque_tail_mean_Nm"]),
+            float(tail["Fx"] / tail["Fz"]),
+            float(tail["Fz"]),
+            float(side["friction"]),
+            kx,
+        )
+
+
+@dataclass(frozen=True)
+class FreeRolling:
+    """Free rolling found from driven runs, and the slip curve's initial slope."""
+
+    effective_radius: float  # m
+    runs_used: tuple[str, ...]
+    slips: dict[str, float]  # each run's slip against R_e
+    fx_over_n_at_free: float
+    kx_at_free: float
+    secant_slope: float  # C_kappa / N, least-squares line of Fx/N against kappa
+    brush_fit_slope: float  # C_kappa / N from the brush curve through each run
+    bracketed: bool  # free rolling lies between the runs' turn rates (no extrapolation)
+
+
+def brush_theta(force_ratio: float) -> float:
+    """theta in [0, 1] with 3 theta - 3 theta^2 + theta^3 = |Fx| / (f N) (brush tire, parabolic
+    pressure; 1 at full sliding); NaN where the ratio is outside [0, 1]."""
+    r = abs(force_ratio)
+    if not 0.0 <= r <= 1.0:
+        return math.nan
+    # (1 - theta)^3 = 1 - r: one real root
+    return 1.0 - (1.0 - r) ** (1.0 / 3.0)
+
+
+def free_rolling(points: list[RunPoint], nearest: int = 3) -> FreeRolling:
+    """Free rolling from the ``nearest`` runs of smallest |torque| (at least two of different turn
+    rates): a least-squares line of torque against turn rate; R_e = 1 / its zero."""
+    if len(points) < 2:
+        raise ValueError(f"free rolling needs at least two rolling runs, got {len(points)}")
+    use = sorted(points, key=lambda p: abs(p.torque))[: max(2, nearest)]
+    w = np.array([p.turn_rate for p in use])
+    if np.ptp(w) <= 0:
+        raise ValueError("the runs nearest free rolling share one turn rate: no line through them")
+    slope, icpt = np.polyfit(w, [p.torque for p in use], 1)
+    if slope == 0:
+        raise ValueError("the axle torque does not change with the turn rate")
+    w0 = -icpt / slope
+    radius = 1.0 / w0
+    kappa = {p.name: radius * p.turn_rate - 1.0 for p in points}
+    fx_line = np.polyfit(w, [p.fx_over_n for p in use], 1)
+    kxs = [(p.turn_rate, p.kx) for p in use if math.isfinite(p.kx)]
+    kx0 = math.nan
+    if len({q[0] for q in kxs}) >= 2:
+        kx0 = float(np.polyval(np.polyfit(*zip(*kxs, strict=True), 1), w0))
+    k = np.array([kappa[p.name] for p in use])
+    secant = float(np.polyfit(k, [p.fx_over_n for p in use], 1)[0])
+    brush = [
+        3.0 * p.friction * brush_theta(p.fx_over_n / p.friction) / abs(kappa[p.name])
+        for p in use
+        if abs(kappa[p.name]) > 1e-3
+    ]
+    return FreeRolling(
+        effective_radius=float(radius),
+        runs_used=tuple(p.name for p in use),
+        slips={n: float(v) for n, v in kappa.items()},
+        fx_over_n_at_free=float(np.polyval(fx_line, w0)),
+        kx_at_free=kx0,
+        secant_slope=secant,
+        brush_fit_slope=float(np.nanmean(brush)) if brush else math.nan,
+        bracketed=bool(w.min() <= w0 <= w.max()),
+    )
+
+
+def brush_slope(side: dict) -> float:
+    """C_kappa / N of the brush model from the run's static patch, strip by strip: a lateral strip
+    of width dy and length 2 a carries bristles of stiffness G_t / h per unit area (tread rubber
+    shear modulus G_t, tread depth h = 20 mm), and under a small slip kappa its force is
+    (G_t / h) 2 a^2 kappa dy; summed over the strips, over N."""
+    strips = side["static_patch_strips"]
+    g = ad.RUBBER["TREAD"]["shear_modulus"]
+    a = np.asarray(strips["length"]) / 2.0
+    return float(g / TREAD_DEPTH * np.sum(2.0 * a**2 * np.asarray(strips["width"])) / side["static_load"])
+
+
+def fepost_kx(out: Path, name: str) -> float:
+    """k_x that ``fepost coefficients`` gives the run's map against ``roll_static``."""
+    from fepost.cli import main as fepost
+
+    with tempfile.TemporaryDirectory(prefix="roll360-kx-") as tmp:
+        js = Path(tmp) / "coef.json"
+        static, rolled = out / f"{STATIC}.vtu", out / f"{name}.vtu"
+        if fepost(["coefficients", str(static), "--rolling", str(rolled), "--json", str(js)]) != 0:
+            raise RuntimeError(f"fepost coefficients failed on {rolled}")
+        coef = json.loads(js.read_text())
+    return float(coef.get("coefficients", coef)["k_x"])
+
+
+def rolling_sidecars(out: Path) -> list[dict]:
+    """The finished rolling runs' sidecars in ``out``, by name."""
+    sides = [json.loads(p.read_text()) for p in sorted(out.glob("roll_*.json"))]
+    return [s for s in sides if s.get("kind") == "rolling run"]
+
+
+def table(out: Path, kx: bool = True) -> list[str]:
+    """One line per finished run: slip, Fx/N, axle torque, steadiness, balance, fepost's k_x; then
+    free rolling (from the torques where the runs are driven) and the initial slope against the
+    brush estimate."""
+    lines = [
+        f"{'run':<15} {'kappa':>7} {'Fx/N':>7} {'T kN m':>7} {'dFx/fN':>7} {'dFz/N':>7} {'dT/fNR':>7} "
+        f"{'bal x/N':>8} {'bal z/N':>8} {'k_x':>7} {'CPU s/m':>7}"
+    ]
+    sides = rolling_sidecars(out)
+    points = []
+    for side in sides:
+        st, bal = side["steadiness"], side["balance"]["residual_over_N"]
+        kappa = side["longitudinal_slip"]
+        k = fepost_kx(out, side["case"]) if kx else math.nan
+        point = RunPoint.from_sidecar(side, k)
+        points.append(point)
+        cpu = side["cpu_s_per_m"] or math.nan
+        lines.append(
+            f"{side['case']:<15} {kappa if kappa is not None else math.nan:7.4f} {point.fx_over_n:7.4f} "
+            f"{point.torque / 1e3:7.3f} {st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
+            f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {k:7.4f} {cpu:7.0f}"
+        )
+    if sides:
+        lines.append(
+            f"brush estimate of the initial slope C_kappa/N (strip by strip): {brush_slope(sides[-1]):.2f}"
+        )
+    if len({p.turn_rate for p in points}) >= 2:
+        fr = free_rolling(points)
+        where = "between the runs" if fr.bracketed else "EXTRAPOLATED beyond the runs"
+        lines += [
+            f"free rolling (axle torque 0, {where}: {', '.join(fr.runs_used)}): "
+            f"R_e = {fr.effective_radius:.4f} m, Fx/N = {fr.fx_over_n_at_free:+.4f}, "
+            f"k_x = {fr.kx_at_free:.4f}",
+            "slips against R_e: " + ", ".join(f"{n} {v:+.4f}" for n, v in fr.slips.items()),
+            f"slip curve: C_kappa/N = {fr.secant_slope:.2f} (least-squares line), "
+            f"{fr.brush_fit_slope:.2f} (each run through the brush curve, f = {points[0].friction:g})",
+        ]
+    return lines
