@@ -126,6 +126,9 @@ def test_deck_uses_the_whole_rig_tire_contact_and_releases_the_turn(tiny_mesh, t
     assert "ROTN, 2, 2," not in roll_free
     assert "ROTN, 2, 2, 3.570000000e-02" in roll_imp
     assert "SYMN, 2, 2" in roll_free and "ROADN, 1, 1, -2.000000000e-02" in roll_free
+    # the road is held along x while loading: the roll starts from where the loading left it
+    load_step = text_free.split("*STEP, NLGEOM")[1].split("*END STEP")[0]
+    assert "\nROADN, 1, 1\n" in load_step and "\nROADN, 2, 2\n" in load_step
 
 
 def _fake_task(task: prog.Task) -> dict:
