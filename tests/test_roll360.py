@@ -280,6 +280,18 @@ def test_free_rolling_from_driven_runs_of_a_brush_tire():
         results.free_rolling(sym[:1])
 
 
+def test_relaxation_length_of_a_first_order_build_up():
+    x = np.linspace(0.0, 1.6, 41)
+    side = {
+        "history": {"axle_travel_m": x.tolist(), "Fx": (-1.2e4 * -np.expm1(-x / 0.27)).tolist()},
+        "tail_means": {"Fz": 2.0e5},
+    }
+    sigma, f_inf = results.relaxation_length(side)
+    assert sigma == pytest.approx(0.27, rel=1e-6) and f_inf == pytest.approx(-1.2e4, rel=1e-6)
+    side["history"]["Fx"] = (0.0 * x).tolist()  # no force builds up: no length
+    assert all(math.isnan(v) for v in results.relaxation_length(side))
+
+
 def test_brush_theta_inverts_the_brush_curve():
     for theta in (0.0, 0.1, 0.5, 0.99, 1.0):
         ratio = 3 * theta - 3 * theta**2 + theta**3

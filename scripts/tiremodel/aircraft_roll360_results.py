@@ -16,7 +16,8 @@ The slip curve's initial slope C_kappa / N comes two ways from the same runs:
   of the runs; the mean of the runs' C / N.
 
 Both are compared with ``brush_slope``, the brush estimate from the static patch's strips and the
-tread rubber's stiffness (no run needed). Written here, not taken from a library: the brush
+tread rubber's stiffness (no run needed). ``relaxation_length`` fits the first-order build-up of
+each run's force along its roll. Written here, not taken from a library: the brush
 curve's inverse is one cubic root per run (numpy's ``roots``).
 """
 
@@ -125,6 +126,28 @@ def free_rolling(points: list[RunPoint], nearest: int = 3) -> FreeRolling:
     )
 
 
+def relaxation_length(side: dict) -> tuple[float, float]:
+    """(sigma, F_inf): the least-squares fit Fx(X) = F_inf (1 - exp(-X / sigma)) to the run's printed
+    longitudinal force along its roll (``history``; X the axle travel). The first-order build-up
+    of a slip force, whose length sigma is the tire's longitudinal relaxation length (Pacejka,
+    ch. 7); NaN, NaN where the force does not build up (a run at free rolling)."""
+    from scipy.optimize import curve_fit
+
+    h = side["history"]
+    x, fx = np.asarray(h["axle_travel_m"], float), np.asarray(h["Fx"], float)
+    keep = x > 1e-12
+    x, fx = np.concatenate([[0.0], x[keep]]), np.concatenate([[0.0], fx[keep]])
+    f_end = float(np.mean(fx[x >= 0.8 * x.max()]))
+    if x.size < 4 or abs(f_end) < 1e-3 * abs(side["tail_means"]["Fz"]):
+        return math.nan, math.nan
+
+    def model(xx, sigma, f_inf):
+        return f_inf * -np.expm1(-xx / sigma)
+
+    (sigma, f_inf), _ = curve_fit(model, x, fx, p0=(0.1 * x.max(), f_end), maxfev=2000)
+    return float(sigma), float(f_inf)
+
+
 def brush_slope(side: dict) -> float:
     """C_kappa / N of the brush model from the run's static patch, strip by strip: a lateral strip
     of width dy and length 2 a carries bristles of stiffness G_t / h per unit area (tread rubber
@@ -161,7 +184,7 @@ def table(out: Path, kx: bool = True) -> list[str]:
     brush estimate."""
     lines = [
         f"{'run':<15} {'kappa':>7} {'Fx/N':>7} {'T kN m':>7} {'dFx/fN':>7} {'dFz/N':>7} {'dT/fNR':>7} "
-        f"{'bal x/N':>8} {'bal z/N':>8} {'k_x':>7} {'CPU s/m':>7}"
+        f"{'bal x/N':>8} {'bal z/N':>8} {'k_x':>7} {'sigma m':>7} {'CPU s/m':>7}"
     ]
     sides = rolling_sidecars(out)
     points = []
@@ -175,7 +198,8 @@ def table(out: Path, kx: bool = True) -> list[str]:
         lines.append(
             f"{side['case']:<15} {kappa if kappa is not None else math.nan:7.4f} {point.fx_over_n:7.4f} "
             f"{point.torque / 1e3:7.3f} {st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
-            f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {k:7.4f} {cpu:7.0f}"
+            f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {k:7.4f} "
+            f"{relaxation_length(side)[0]:7.3f} {cpu:7.0f}"
         )
     if sides:
         lines.append(
