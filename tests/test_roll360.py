@@ -122,9 +122,14 @@ def test_deck_uses_the_whole_rig_tire_contact_and_releases_the_turn(tiny_mesh, t
     assert "\n".join(pair[k : k + 7]) in text_free
     # two steps: the turn held (ROTN 2) while loading; the roll re-states every condition
     assert text_free.count("*STEP, NLGEOM") == 2 and "*BOUNDARY, OP=NEW" in text_free
-    roll_free, roll_imp = (t.split("*BOUNDARY, OP=NEW")[1] for t in (text_free, text_imp))
+    roll_free = text_free.split("*BOUNDARY, OP=NEW")[1]
     assert "ROTN, 2, 2," not in roll_free
-    assert "ROTN, 2, 2, 3.570000000e-02" in roll_imp
+    # an imposed turn: one step, the turn and the road's travel on the roll's amplitude (0 until
+    # the roll), the roll's criteria throughout
+    assert text_imp.count("*STEP, NLGEOM") == 1 and "OP=NEW" not in text_imp
+    assert "*BOUNDARY, AMPLITUDE=AROLL\nROTN, 2, 2, 3.570000000e-02" in text_imp
+    assert "*BOUNDARY, AMPLITUDE=AROLL\nROADN, 1, 1, -2.000000000e-02" in text_imp
+    assert "*CONTROLS, PARAMETERS=FIELD\n0.005, 1.0" in text_imp
     assert "SYMN, 2, 2" in roll_free and "ROADN, 1, 1, -2.000000000e-02" in roll_free
     # the road is held along x while loading: the roll starts from where the loading left it
     load_step = text_free.split("*STEP, NLGEOM")[1].split("*END STEP")[0]
