@@ -225,3 +225,27 @@ def test_steadiness_judges_every_component_and_the_load():
     assert got.fx == pytest.approx(0.01) and got.fy == 0.0 and got.n == 0.0 and got.increments == 2
     with pytest.raises(ValueError, match="fewer than two"):
         tail_motion({"path": [0.0, 1.0], "Fx": [0, 0], "Fy": [0, 0], "Fz": [1, 1]}, 0.3)
+
+
+MESH_SERIES = ("mid", ".", "xfine")  # whole (1.8 deg, 5+3+4), whole-fine (1.5, 6+3+4), whole-xfine (1.2, 8+4+5)
+
+
+@pytest.mark.skipif(not WHOLE.is_dir(), reason="meshes/rig-tire360/ not committed")
+def test_static_maps_converge_without_r_max():
+    """The whole tire's static map on three meshes: the load, b1 and the coefficients without R
+    (a R^2, m / R^2) change by under 1 % from mesh to mesh; R = r_max, the farthest loaded node,
+    moves by 1.6 and 3.6 % and takes a and m with it (docs/rig.md)."""
+    from fepost.analysis import analyse
+
+    maps = [WHOLE / sub / "static.vtu" for sub in MESH_SERIES]
+    missing = [str(p) for p in maps if not p.is_file()]
+    assert not missing, f"committed convergence maps missing: {missing}"
+    coef = [analyse(p).coefficients for p in maps]
+    for c0, c1 in zip(coef, coef[1:], strict=False):
+        assert c1.N == pytest.approx(c0.N, rel=2e-3)
+        assert c1.b1 == pytest.approx(c0.b1, rel=5e-3)
+        assert c1.a * c1.R**2 == pytest.approx(c0.a * c0.R**2, rel=1e-2)
+        assert c1.m / c1.R**2 == pytest.approx(c0.m / c0.R**2, rel=1e-2)
+        assert c1.R < c0.R  # the outermost loaded node comes in as the edge elements shrink
+    assert coef[2].R / coef[1].R - 1 == pytest.approx(-0.0359, abs=5e-4)
+    assert coef[2].a / coef[1].a - 1 == pytest.approx(0.0707, abs=5e-4)

@@ -90,6 +90,16 @@ MESHES = {
         fine_deg=33.0,
         n_coarse=12,
     ),
+    # the convergence check's finest partner (static map only): about 1.25 x whole-fine's counts
+    # along the section (8 + 4 + 5) and around (1.2 degree layers)
+    "whole-xfine": _whole(
+        n_crown=8,
+        n_shoulder=4,
+        n_side=5,
+        first_deg=1.2,
+        fine_deg=33.0,
+        n_coarse=12,
+    ),
     # the whole tire at a few hundred elements: the mu = 0 pure-spin check of the boundary
     # conditions, solved in a few minutes (one element along the sidewall)
     "whole-tiny": _whole(

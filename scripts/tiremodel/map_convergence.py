@@ -6,6 +6,11 @@
 the map), the two values, the change from the coarse to the fine map (relative; the centre
 in mm of its shift, against ``tol`` times R), and whether it is within ``tol``. Exit status
 1 if any is not.
+
+R is r_max, the farthest loaded point from the centre (THEORY section 1): one node of the
+patch's edge, so it moves with the element size there, and a and m (which carry R) move with
+it, as R^-2 and R^2. The rows ``a R^2`` and ``m / R^2`` are the same coefficients without R
+(THEORY: "aR^2, m/R^2, k_x/R do not" change with R); ``area`` is the loaded area.
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import tempfile
 from pathlib import Path
 
 QUANTITIES = ("N", "R", "a", "m", "b", "b1")
+DERIVED = ("a R^2", "m / R^2", "area")
 
 
 def coefficients(path: Path) -> dict:
@@ -30,13 +36,17 @@ def coefficients(path: Path) -> dict:
         subprocess.run(cmd, check=True, capture_output=True)
         c = json.loads(out.read_text())
     c["peak_pressure"] = float(meshio.read(path).point_data["CPRESS"].max())
+    r = float(c["R"])
+    c["a R^2"] = float(c["a"]) * r**2
+    c["m / R^2"] = float(c["m"]) / r**2
+    c["area"] = float(c["patch"]["area"])
     return c
 
 
 def rows(coarse: dict, fine: dict, tol: float) -> list[tuple[str, float, float, float, bool]]:
     """(name, coarse, fine, change, within tol) for each quantity."""
     out = []
-    for k in (*QUANTITIES, "peak_pressure"):
+    for k in (*QUANTITIES, *DERIVED, "peak_pressure"):
         a, b = float(coarse[k]), float(fine[k])
         change = b / a - 1.0
         out.append((k, a, b, change, abs(change) <= tol))
