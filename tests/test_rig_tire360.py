@@ -227,7 +227,8 @@ def test_steadiness_judges_every_component_and_the_load():
         tail_motion({"path": [0.0, 1.0], "Fx": [0, 0], "Fy": [0, 0], "Fz": [1, 1]}, 0.3)
 
 
-MESH_SERIES = ("mid", ".", "xfine")  # whole (1.8 deg, 5+3+4), whole-fine (1.5, 6+3+4), whole-xfine (1.2, 8+4+5)
+#: whole (1.8 deg, 5+3+4), whole-fine (1.5, 6+3+4), whole-xfine (1.2, 8+4+5)
+MESH_SERIES = ("mid", ".", "xfine")
 
 
 @pytest.mark.skipif(not WHOLE.is_dir(), reason="meshes/rig-tire360/ not committed")
