@@ -5,7 +5,7 @@
 (x, y), R = r_max, a, m, b, b1 and the peak contact pressure (the largest nodal CPRESS of
 the map), the two values, the change from the coarse to the fine map (relative; the centre
 in mm of its shift, against ``tol`` times R), and whether it is within ``tol``. Exit status
-1 if any is not.
+1 if any is not (0 with ``--exit-zero``).
 
 R is r_max, the farthest loaded point from the centre (THEORY section 1): one node of the
 patch's edge, so it moves with the element size there, and a and m (which carry R) move with
@@ -52,8 +52,9 @@ def rows(coarse: dict, fine: dict, tol: float) -> list[tuple[str, float, float, 
         out.append((k, a, b, change, abs(change) <= tol))
     r = float(fine["R"])
     for i, axis in enumerate("xy"):
-        a, b = (float(c["patch"]["centre"][i]) for c in (coarse, fine))
-        out.append((f"centre {axis} (m)", a, b, (b - a) / r, abs(b - a) <= tol * r))
+        # in mm to 1e-4 mm (a centre on the symmetry line is 0 to round-off, 1e-17 m)
+        a, b = (round(1e3 * float(c["patch"]["centre"][i]), 4) + 0.0 for c in (coarse, fine))
+        out.append((f"centre {axis} (mm)", a, b, (b - a) / (1e3 * r) + 0.0, abs(b - a) <= tol * 1e3 * r))
     return out
 
 
@@ -62,13 +63,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("coarse", type=Path)
     ap.add_argument("fine", type=Path)
     ap.add_argument("--tol", type=float, default=0.02, help="relative tolerance (default 0.02)")
+    ap.add_argument("--exit-zero", action="store_true", help="exit 0 even where a quantity is not within tol")
     args = ap.parse_args(argv)
     table = rows(coefficients(args.coarse), coefficients(args.fine), args.tol)
     print(f"{'quantity':<16} {'coarse':>12} {'fine':>12} {'change':>9}  within {args.tol:g}")
     for name, a, b, change, ok in table:
         print(f"{name:<16} {a:12.6g} {b:12.6g} {100 * change:+8.2f}%  {'yes' if ok else 'NO'}")
     print("(centre: change = shift / R)")
-    return 0 if all(r[4] for r in table) else 1
+    return 0 if args.exit_zero or all(r[4] for r in table) else 1
 
 
 if __name__ == "__main__":
