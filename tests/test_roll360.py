@@ -329,3 +329,20 @@ def test_brush_slope_of_a_rectangular_patch():
     strips = {"length": [0.4] * 5, "width": [0.06] * 5}
     slope = results.brush_slope({"static_patch_strips": strips, "static_load": 2.0e5})
     assert slope == pytest.approx(1.5e6 / 0.02 * 2 * 0.2**2 * 0.3 / 2.0e5, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--tolerances", "0", "1"], "--tolerances"),
+        (["--reference-radius", "5"], "no radius of this tire"),
+        (["--workers", "0"], "at least one"),
+        (["--slips", "0.0"], "0 only with --reference-radius"),
+        (["--reference-radius", "0.57", "--slips", "0.7"], "each in (-0.5, 0.5)"),
+    ],
+)
+def test_programme_refuses_bad_arguments(tmp_path, capsys, argv, message):
+    assert prog.main(["--work", str(tmp_path / "w"), *argv]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "w").exists()  # nothing written

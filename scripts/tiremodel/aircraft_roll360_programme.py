@@ -292,6 +292,15 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--slips", type=float, nargs="+", metavar="K", help="imposed slips, in run order")
     ap.add_argument("--workers", type=int, default=1, help="embedded Dask workers (one CalculiX thread each)")
+    ap.add_argument(
+        "--tolerances",
+        type=float,
+        nargs=2,
+        metavar=("R_N", "C_N"),
+        default=r3.TOLERANCES,
+        help="the roll's CalculiX field controls: force residual and displacement correction "
+        f"(default {r3.TOLERANCES[0]} {r3.TOLERANCES[1]})",
+    )
     ap.add_argument("--scheduler")
     ap.add_argument("--table", action="store_true", help="print the finished runs' table and stop")
     ap.add_argument("--no-kx", action="store_true", help="the table without fepost's k_x")
@@ -336,7 +345,15 @@ def main(argv: list[str] | None = None) -> int:
             f"{ap.prog}: --travel {a.travel} outside [0.01, 1.7] m (the contact slaves' arc)", file=sys.stderr
         )
         return 2
-    setup = Setup(mesh_kind=a.mesh, travel=a.travel, reference_radius=a.reference_radius)
+    if not (0.0 < a.tolerances[0] <= 0.1 and 0.0 < a.tolerances[1] <= 1.0):
+        print(f"{ap.prog}: --tolerances {a.tolerances}: R_n in (0, 0.1], C_n in (0, 1]", file=sys.stderr)
+        return 2
+    setup = Setup(
+        mesh_kind=a.mesh,
+        travel=a.travel,
+        reference_radius=a.reference_radius,
+        tolerances=tuple(a.tolerances),
+    )
     done = run_programme(a.out, a.work, specs, setup, a.scheduler, workers=a.workers)
     _log(f"done now: {', '.join(done) or 'nothing'}")
     return 0
