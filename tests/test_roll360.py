@@ -279,6 +279,24 @@ def test_free_rolling_from_driven_runs_of_a_brush_tire():
     assert fs.brush_fit_slope == pytest.approx(c, rel=1e-9)
     assert fs.fx_over_n_at_free == pytest.approx(0.0, abs=1e-12)
     assert fs.slips["s+0.02"] == pytest.approx(0.02, rel=1e-9)
+    # runs still building up: the slip curve takes each run's fitted steady force
+    half = [
+        results.RunPoint(
+            q.name,
+            q.turn_rate,
+            0.5 * q.torque,
+            0.5 * q.fx_over_n,
+            q.normal_load,
+            q.friction,
+            steady_fx_over_n=q.fx_over_n,
+        )
+        for q in sym
+    ]
+    fh = results.free_rolling(half)
+    assert fh.effective_radius == pytest.approx(re_, rel=1e-12)
+    assert fh.brush_fit_slope == pytest.approx(c, rel=1e-9) and fh.secant_slope == pytest.approx(
+        fs.secant_slope
+    )
     # both runs on one side: said so
     assert not results.free_rolling([_brush_point(f"o{k}", k, re_, c) for k in (0.01, 0.03)]).bracketed
     with pytest.raises(ValueError, match="at least two"):

@@ -58,6 +58,7 @@ REFERENCE_RADIUS = 0.5694
 FREE = "roll_free"
 STATIC = results.STATIC
 OUT = Path(__file__).resolve().parents[2] / "meshes" / "rig-tire360" / "roll"
+RIG = OUT.parent
 
 
 @dataclass(frozen=True)
@@ -305,11 +306,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--table", action="store_true", help="print the finished runs' table and stop")
     ap.add_argument("--no-kx", action="store_true", help="the table without fepost's k_x")
     ap.add_argument(
+        "--rig",
+        type=Path,
+        default=RIG,
+        help="the rig's folder whose longitudinal slide gives the standstill stiffness K_x (--table)",
+    )
+    ap.add_argument(
         "--progress", action="store_true", help="print the runs' records so far (--work) and stop"
     )
     a = ap.parse_args(argv)
     if a.table:
-        print("\n".join(results.table(a.out, kx=not a.no_kx)))
+        print("\n".join(results.table(a.out, kx=not a.no_kx, rig=a.rig)))
         return 0
     if a.work is None:
         print(f"{ap.prog}: --work DIR is needed to run the programme", file=sys.stderr)

@@ -7,7 +7,8 @@ least-squares line T(w) through the runs nearest free rolling gives its zero w_0
 rolling radius R_e = 1 / w_0, and every run's slip against it, kappa_i = R_e w_i - 1. The same
 interpolation at w_0 gives Fx/N (about 0: rolling resistance aside) and fepost's k_x there.
 
-The slip curve's initial slope C_kappa / N comes two ways from the same runs:
+The slip curve's initial slope C_kappa / N comes two ways from the same runs, each run's Fx/N
+being its fitted steady value where its force was still building up (``RunPoint.slip_force``):
 
 - ``secant``: the least-squares line of Fx/N against kappa (it falls short of the slope at 0 by
   the curve's bend, about theta = C kappa / (3 f N) for a brush tire);
@@ -48,10 +49,14 @@ class RunPoint:
     normal_load: float  # N, tail mean
     friction: float
     kx: float = math.nan  # fepost's k_x of the run's map against the static one
+    #: Fx/N of the first-order build-up's limit (``relaxation_length``): the steady value of a run
+    #: that has not reached it; NaN where no build-up was fitted
+    steady_fx_over_n: float = math.nan
 
     @classmethod
     def from_sidecar(cls, side: dict, kx: float = math.nan) -> RunPoint:
         tail = side["tail_means"]
+        _, f_inf = relaxation_length(side)
         return cls(
             side["case"],
             float(side["turn_per_travel_rad_per_m"]),
@@ -60,7 +65,13 @@ class RunPoint:
             float(tail["Fz"]),
             float(side["friction"]),
             kx,
+            f_inf / float(tail["Fz"]),
         )
+
+    @property
+    def slip_force(self) -> float:
+        """Fx/N for the slip curve: the fitted steady value where there is one, else the tail mean."""
+        return self.steady_fx_over_n if math.isfinite(self.steady_fx_over_n) else self.fx_over_n
 
 
 @dataclass(frozen=True)
@@ -108,9 +119,9 @@ def free_rolling(points: list[RunPoint], nearest: int = 3) -> FreeRolling:
     if len({q[0] for q in kxs}) >= 2:
         kx0 = float(np.polyval(np.polyfit(*zip(*kxs, strict=True), 1), w0))
     k = np.array([kappa[p.name] for p in use])
-    secant = float(np.polyfit(k, [p.fx_over_n for p in use], 1)[0])
+    secant = float(np.polyfit(k, [p.slip_force for p in use], 1)[0])
     brush = [
-        3.0 * p.friction * brush_theta(p.fx_over_n / p.friction) / abs(kappa[p.name])
+        3.0 * p.friction * brush_theta(p.slip_force / p.friction) / abs(kappa[p.name])
         for p in use
         if abs(kappa[p.name]) > 1e-3
     ]
@@ -178,13 +189,15 @@ def rolling_sidecars(out: Path) -> list[dict]:
     return [s for s in sides if s.get("kind") == "rolling run"]
 
 
-def table(out: Path, kx: bool = True) -> list[str]:
-    """One line per finished run: slip, Fx/N, axle torque, steadiness, balance, fepost's k_x; then
-    free rolling (from the torques where the runs are driven) and the initial slope against the
-    brush estimate."""
+def table(out: Path, kx: bool = True, rig: Path | None = None) -> list[str]:
+    """One line per finished run: slip, Fx/N (tail mean and the build-up's fitted limit), axle
+    torque, steadiness, balance, fepost's k_x, relaxation length; then free rolling (from the
+    torques where the runs are driven), the initial slope against the brush estimate, and the
+    relaxation length against C_kappa / K_x with the rig's standstill stiffness K_x (``rig``: the
+    folder of the rig's slides, `fepost.shimmy.brush.rig_stiffness`)."""
     lines = [
-        f"{'run':<15} {'kappa':>7} {'Fx/N':>7} {'T kN m':>7} {'dFx/fN':>7} {'dFz/N':>7} {'dT/fNR':>7} "
-        f"{'bal x/N':>8} {'bal z/N':>8} {'k_x':>7} {'sigma m':>7} {'CPU s/m':>7}"
+        f"{'run':<15} {'kappa':>7} {'Fx/N':>7} {'inf':>7} {'T kN m':>7} {'dFx/fN':>7} {'dFz/N':>7} "
+        f"{'dT/fNR':>7} {'bal x/N':>8} {'bal z/N':>8} {'k_x':>7} {'sigma m':>7} {'CPU s/m':>7}"
     ]
     sides = rolling_sidecars(out)
     points = []
@@ -197,7 +210,8 @@ def table(out: Path, kx: bool = True) -> list[str]:
         cpu = side["cpu_s_per_m"] or math.nan
         lines.append(
             f"{side['case']:<15} {kappa if kappa is not None else math.nan:7.4f} {point.fx_over_n:7.4f} "
-            f"{point.torque / 1e3:7.3f} {st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
+            f"{point.steady_fx_over_n:7.4f} {point.torque / 1e3:7.3f} "
+            f"{st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
             f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {k:7.4f} "
             f"{relaxation_length(side)[0]:7.3f} {cpu:7.0f}"
         )
@@ -216,4 +230,16 @@ def table(out: Path, kx: bool = True) -> list[str]:
             f"slip curve: C_kappa/N = {fr.secant_slope:.2f} (least-squares line), "
             f"{fr.brush_fit_slope:.2f} (each run through the brush curve, f = {points[0].friction:g})",
         ]
+        sig = [relaxation_length(sd)[0] for sd in sides]
+        if rig is not None and any(math.isfinite(v) for v in sig):
+            from fepost.shimmy.brush import rig_stiffness
+
+            k_x = rig_stiffness(rig)["K_x"]
+            n = float(np.mean([p.normal_load for p in points]))
+            lines.append(
+                f"relaxation length: sigma = {np.nanmean(sig):.3f} m (fitted, mean of the runs) against "
+                f"C_kappa / K_x = {fr.secant_slope * n / k_x:.3f} m (line) .. "
+                f"{fr.brush_fit_slope * n / k_x:.3f} m "
+                f"(brush), K_x = {k_x:.4g} N/m ({rig}/d000_slide.json at standstill)"
+            )
     return lines
