@@ -137,11 +137,22 @@ def free_rolling(points: list[RunPoint], nearest: int = 3) -> FreeRolling:
     )
 
 
-def relaxation_length(side: dict) -> tuple[float, float]:
-    """(sigma, F_inf): the least-squares fit Fx(X) = F_inf (1 - exp(-X / sigma)) to the run's printed
-    longitudinal force along its roll (``history``; X the axle travel). The first-order build-up
-    of a slip force, whose length sigma is the tire's longitudinal relaxation length (Pacejka,
-    ch. 7); NaN, NaN where the force does not build up (a run at free rolling)."""
+@dataclass(frozen=True)
+class BuildUp:
+    """The first-order fit Fx(X) = F_inf (1 - exp(-X / sigma)) of a run's force along its roll,
+    with the fit's standard errors (from its residuals: the FE history is not noisy, so they say
+    how far the build-up is from first order) and the share of F_inf reached at the roll's end."""
+
+    sigma: float  # m
+    f_inf: float  # N
+    sigma_se: float
+    f_inf_se: float
+    reached: float  # 1 - exp(-X_end / sigma)
+
+
+def build_up(side: dict) -> BuildUp | None:
+    """``BuildUp`` of the run's printed longitudinal force (``history``; X the axle travel), None
+    where the force does not build up (a run at free rolling) or too few records were printed."""
     from scipy.optimize import curve_fit
 
     h = side["history"]
@@ -150,13 +161,21 @@ def relaxation_length(side: dict) -> tuple[float, float]:
     x, fx = np.concatenate([[0.0], x[keep]]), np.concatenate([[0.0], fx[keep]])
     f_end = float(np.mean(fx[x >= 0.8 * x.max()]))
     if x.size < 4 or abs(f_end) < 1e-3 * abs(side["tail_means"]["Fz"]):
-        return math.nan, math.nan
+        return None
 
     def model(xx, sigma, f_inf):
         return f_inf * -np.expm1(-xx / sigma)
 
-    (sigma, f_inf), _ = curve_fit(model, x, fx, p0=(0.1 * x.max(), f_end), maxfev=2000)
-    return float(sigma), float(f_inf)
+    (sigma, f_inf), cov = curve_fit(model, x, fx, p0=(0.1 * x.max(), f_end), maxfev=5000)
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    return BuildUp(float(sigma), float(f_inf), float(se[0]), float(se[1]), float(-np.expm1(-x.max() / sigma)))
+
+
+def relaxation_length(side: dict) -> tuple[float, float]:
+    """(sigma, F_inf) of ``build_up``: the first-order build-up of a slip force, whose length sigma
+    is the tire's longitudinal relaxation length (Pacejka, ch. 7); NaN, NaN where there is none."""
+    fit = build_up(side)
+    return (math.nan, math.nan) if fit is None else (fit.sigma, fit.f_inf)
 
 
 def brush_slope(side: dict) -> float:
@@ -215,6 +234,15 @@ def table(out: Path, kx: bool = True, rig: Path | None = None) -> list[str]:
             f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {k:7.4f} "
             f"{relaxation_length(side)[0]:7.3f} {cpu:7.0f}"
         )
+    for side in sides:
+        fit = build_up(side)
+        if fit is not None:
+            n = side["tail_means"]["Fz"]
+            lines.append(
+                f"build-up of {side['case']}: sigma = {fit.sigma:.3f} +- {fit.sigma_se:.3f} m, "
+                f"F_inf/N = {fit.f_inf / n:+.4f} +- {fit.f_inf_se / n:.4f}, {100 * fit.reached:.0f} % of it "
+                "reached at the end of the roll"
+            )
     if sides:
         lines.append(
             f"brush estimate of the initial slope C_kappa/N (strip by strip): {brush_slope(sides[-1]):.2f}"
