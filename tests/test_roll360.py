@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import json
 import math
@@ -87,13 +88,19 @@ def test_tiny_free_roll_end_to_end(tiny_mesh, tmp_path):
     assert lines[0].startswith("tiny:") and len(lines) == 1 + h.time.size
     assert float(lines[-1].split()[3]) == pytest.approx(n, abs=0.1)
 
-    # driven against a reference radius: the free rim's R_e, turned at slip +0.03
+    # driven against a reference radius: the free rim's R_e, turned at slip +0.03 and wound by
+    # 2 mrad over the roll's first 1 %
     setup = prog.Setup(mesh_kind="tiny", travel=0.02, reference_radius=radius)
-    drive = prog.RunSpec(prog.run_name(0.03), 0.03)
-    plan = _tiny_plan(drive.plan(radius, setup).rotation)
+    drive = prog.RunSpec(prog.run_name(0.03, 0.002), 0.03, 0.002)
+    assert drive.name == "roll_drive030w"
+    plan = dataclasses.replace(_tiny_plan(drive.plan(radius, setup).rotation), prewind=0.002)
     driven = solve(shutil.which("ccx"), tiny_mesh, "tiny_drive", plan, tmp_path / "work_drive")
     dside = write_run(tiny_mesh, driven, tmp_path, drive.name, drive.labels(setup, radius))
-    assert "against the reference radius" in dside["description"]
+    assert (
+        "against the reference radius" in dside["description"] and "wound by +0.002" in dside["description"]
+    )
+    # the pre-wind adds to the turn; the slip is read over the last fifth, after it
+    assert dside["rim_rotation_deg"] == pytest.approx(math.degrees(plan.rotation + 0.002), rel=1e-5)
     assert "effective_rolling_radius_m" not in dside and dside["slip_radius_m"] == radius
     # the slip read back from the printed turns (the .dat's 7 digits; measured 8e-7 off)
     assert dside["longitudinal_slip"] == pytest.approx(0.03, abs=1e-5)
@@ -130,6 +137,17 @@ def test_deck_uses_the_whole_rig_tire_contact_and_releases_the_turn(tiny_mesh, t
     assert "*BOUNDARY, AMPLITUDE=AROLL\nROTN, 2, 2, 3.570000000e-02" in text_imp
     assert "*BOUNDARY, AMPLITUDE=AROLL\nROADN, 1, 1, -2.000000000e-02" in text_imp
     assert "*CONTROLS, PARAMETERS=FIELD\n0.005, 1.0" in text_imp
+    # a pre-wind: the turn on its own amplitude, 0.01 rad more at 1 % of the roll, the total at its end
+    write_deck(tmp_path / "wind.inp", tiny_mesh, dataclasses.replace(imposed, prewind=0.01))
+    wind = (tmp_path / "wind.inp").read_text()
+    assert "*BOUNDARY, AMPLITUDE=ATURN\nROTN, 2, 2, 4.570000000e-02" in wind
+    amp = wind.split("*AMPLITUDE, NAME=ATURN, TIME=TOTAL TIME\n")[1].splitlines()[0].split(",")
+    t1, tw, value = float(amp[2]), float(amp[4]), float(amp[5])
+    assert (tw - t1) == pytest.approx(0.02) and value == pytest.approx(
+        (0.01 + 0.01 * 0.0357) / 0.0457, rel=1e-11
+    )
+    with pytest.raises(ValueError, match="needs an imposed turn"):
+        write_deck(tmp_path / "bad.inp", tiny_mesh, dataclasses.replace(free, prewind=0.01))
     assert "SYMN, 2, 2" in roll_free and "ROADN, 1, 1, -2.000000000e-02" in roll_free
     # the road is held along x while loading: the roll starts from where the loading left it
     load_step = text_free.split("*STEP, NLGEOM")[1].split("*END STEP")[0]

@@ -65,6 +65,8 @@ ROLL_INCREMENTATION = "8, 16, 16, 30, 16, 7, 0, 20"
 #: the supports of every step: symmetry plane, the road's lateral motion, the axle's position and
 #: the rim's turns about x and z
 HELD = ("SYMN, 2, 2", "ROADN, 2, 2", "REFN, 1, 3", "ROTN, 1, 1", "ROTN, 3, 3")
+#: the share of the roll over which a pre-wind (``Plan.prewind``) is applied
+PREWIND_SHARE = 0.01
 TURN_DEG = 20.0  # the mesh is turned by about this (a whole number of layers) towards +x
 
 
@@ -155,6 +157,10 @@ class Plan:
     road_face: float = 0.025  # m, road face size
     # the roll's first increment: the fine mesh cut 0.02 back four times to 3e-4
     first_roll_inc: float | None = 0.002
+    #: rad, an imposed turn's extra turn over the roll's first ``PREWIND_SHARE`` (0: none): the
+    #: carcass wound up by the steady torque before the tread renews, so the roll starts near its
+    #: steady state instead of building it up over the relaxation length
+    prewind: float = 0.0
 
 
 def roll_times(plan: Plan) -> list[float]:
@@ -233,6 +239,8 @@ def _step(mesh: Roll360Mesh, plan: Plan, times: dict[str, float]) -> list[str]:
     inflation); the free rim's roll got past it at 8e-6 of the roll, the imposed turn did not."""
     if plan.rotation is not None:
         return _one_step(mesh, plan, times)
+    if plan.prewind:
+        raise ValueError("a pre-wind needs an imposed turn (the free rim has none)")
     t1 = ad.INFLATION_TIME + LOAD_TIME
     first_roll = plan.first_roll_inc or min(FIRST_INC, plan.print_every)
     return [
@@ -288,10 +296,23 @@ def _amplitudes(plan: Plan, times: dict[str, float]) -> list[str]:
 
 
 def _one_step(mesh: Roll360Mesh, plan: Plan, times: dict[str, float]) -> list[str]:
-    """Inflation, vertical travel and the roll with the turn imposed: one step (``_step``)."""
-    t2 = ad.INFLATION_TIME + LOAD_TIME + ROLL_TIME
+    """Inflation, vertical travel and the roll with the turn imposed: one step (``_step``). The
+    turn follows the roll's amplitude, or with a pre-wind its own (``ATURN``): the extra turn over
+    the roll's first ``PREWIND_SHARE``, then the rolling turn on top, linear in the travel."""
+    t1 = ad.INFLATION_TIME + LOAD_TIME
+    t2 = t1 + ROLL_TIME
+    total = plan.rotation + plan.prewind
+    turn_amp: list[str] = []
+    if plan.prewind:
+        tw = t1 + PREWIND_SHARE * ROLL_TIME
+        at_tw = (plan.prewind + PREWIND_SHARE * plan.rotation) / total
+        turn_amp = [
+            "*AMPLITUDE, NAME=ATURN, TIME=TOTAL TIME",
+            f"0.0, 0.0, {t1:.6f}, 0.0, {tw:.6f}, {at_tw:.12e}, {t2:.6f}, 1.0",
+        ]
     return [
         *_amplitudes(plan, times),
+        *turn_amp,
         "*STEP, NLGEOM, INC=100000",
         "*STATIC",
         f"{FIRST_INC}, {t2:.6f}, 1e-9, {plan.print_every}",
@@ -302,8 +323,8 @@ def _one_step(mesh: Roll360Mesh, plan: Plan, times: dict[str, float]) -> list[st
         f"ROADN, 3, 3, {plan.travel_z:.9e}",
         "*BOUNDARY, AMPLITUDE=AROLL",
         f"ROADN, 1, 1, {-plan.travel_x:.9e}",
-        "*BOUNDARY, AMPLITUDE=AROLL",
-        f"ROTN, 2, 2, {plan.rotation:.9e}",
+        f"*BOUNDARY, AMPLITUDE={'ATURN' if plan.prewind else 'AROLL'}",
+        f"ROTN, 2, 2, {total:.9e}",
         "*DLOAD, AMPLITUDE=APRESS",
         *cx.pressure_load(mesh.hexes, mesh.inner_quads, ad.PRESSURE, face_lookup(mesh.hexes)),
         *_outputs(),

@@ -77,21 +77,31 @@ class Setup:
     #: m: None: the free rim finds R_e (``roll_free``); a number: every run is driven against it
     reference_radius: float | None = None
 
-    def plan(self, rotation: float | None) -> r3.Plan:
-        return r3.Plan(self.rim_travel, self.travel, rotation, self.print_every, self.frames, self.tolerances)
+    def plan(self, rotation: float | None, prewind: float = 0.0) -> r3.Plan:
+        return r3.Plan(
+            self.rim_travel,
+            self.travel,
+            rotation,
+            self.print_every,
+            self.frames,
+            self.tolerances,
+            prewind=prewind,
+        )
 
 
 @dataclass(frozen=True)
 class RunSpec:
     name: str
     slip: float | None  # None: the free rim
+    #: rad, the rim's extra turn at the roll's start (``aircraft_roll360_deck.Plan.prewind``)
+    prewind: float = 0.0
 
     def plan(self, radius: float | None, setup: Setup) -> r3.Plan:
         if self.slip is None:
             return setup.plan(None)
         if radius is None:
             raise ValueError(f"{self.name}: needs the free-rolling run's effective radius")
-        return setup.plan(r3.turn_for(setup.travel, radius, self.slip))
+        return setup.plan(r3.turn_for(setup.travel, radius, self.slip), self.prewind)
 
     def labels(self, setup: Setup, radius: float | None) -> dict:
         head = (
@@ -114,10 +124,18 @@ class RunSpec:
                 if self.slip == 0
                 else ("braking" if self.slip < 0 else "driving")
             )
+            wind = (
+                f", wound by {self.prewind:+.5g} rad over the roll's first {100 * r3.PREWIND_SHARE:g} % "
+                "(the carcass set near its steady wind-up)"
+                if self.prewind
+                else ""
+            )
             return {
                 "description": head + f"; {kind}: the rim turned at the slip {self.slip:+g} against "
-                f"the reference radius {setup.reference_radius:g} m (an estimate, not R_e)",
-                "imposed": f"rim turn (1 {self.slip:+g}) X / R_ref, linear in the axle travel X",
+                f"the reference radius {setup.reference_radius:g} m (an estimate, not R_e){wind}",
+                "imposed": f"rim turn (1 {self.slip:+g}) X / R_ref, linear in the axle travel X"
+                + (f", plus {self.prewind:+.5g} rad at the start" if self.prewind else ""),
+                "prewind_rad": self.prewind,
                 "imposed_slip": self.slip,
                 "slip_radius_m": radius,
                 "slip_radius_source": "the programme's reference radius R_ref (an estimate of R_e): "
@@ -136,17 +154,25 @@ class RunSpec:
         }
 
 
-def run_name(slip: float | None) -> str:
+def run_name(slip: float | None, prewind: float = 0.0) -> str:
+    """``roll_free``, ``roll_ref``, ``roll_brake<k>`` / ``roll_drive<k>`` (k = 1000 |slip|); a
+    pre-wound run ends in ``w``."""
     if slip is None:
         return FREE
     if slip == 0:
-        return "roll_ref"
-    return f"roll_{'brake' if slip < 0 else 'drive'}{round(abs(slip) * 1000):03d}"
+        name = "roll_ref"
+    else:
+        name = f"roll_{'brake' if slip < 0 else 'drive'}{round(abs(slip) * 1000):03d}"
+    return name + ("w" if prewind else "")
 
 
-def programme(slips: tuple[float, ...] = SLIPS, free: bool = True) -> list[RunSpec]:
-    """The runs in solving order: the free rim first (``free``), then the imposed slips."""
-    return [*([RunSpec(FREE, None)] if free else []), *(RunSpec(run_name(s), s) for s in slips)]
+def programme(slips: tuple[float, ...] = SLIPS, free: bool = True, prewind: float = 0.0) -> list[RunSpec]:
+    """The runs in solving order: the free rim first (``free``), then the imposed slips (each wound
+    by ``prewind`` at its start when given)."""
+    return [
+        *([RunSpec(FREE, None)] if free else []),
+        *(RunSpec(run_name(s, prewind), s, prewind) for s in slips),
+    ]
 
 
 def finished(out: Path, name: str, deck_sha256: str) -> bool:
@@ -292,6 +318,14 @@ def main(argv: list[str] | None = None) -> int:
         "default: the free rim first",
     )
     ap.add_argument("--slips", type=float, nargs="+", metavar="K", help="imposed slips, in run order")
+    ap.add_argument(
+        "--prewind",
+        type=float,
+        default=0.0,
+        metavar="RAD",
+        help="the rim's extra turn at the roll's start, for driven runs (the steady wind-up: "
+        "F_inf / (K_x R_l)); the runs are named ...w",
+    )
     ap.add_argument("--workers", type=int, default=1, help="embedded Dask workers (one CalculiX thread each)")
     ap.add_argument(
         "--tolerances",
@@ -340,7 +374,13 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
-    specs = programme(slips, free=not driven)
+    if a.prewind and (not driven or not abs(a.prewind) < 0.5):
+        print(
+            f"{ap.prog}: --prewind {a.prewind}: only with --reference-radius, and under 0.5 rad",
+            file=sys.stderr,
+        )
+        return 2
+    specs = programme(slips, free=not driven, prewind=a.prewind)
     if a.only:
         unknown = sorted(set(a.only) - {s.name for s in specs})
         if unknown:
