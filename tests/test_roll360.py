@@ -387,3 +387,19 @@ def test_programme_refuses_bad_arguments(tmp_path, capsys, argv, message):
     err = capsys.readouterr().err
     assert message in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "w").exists()  # nothing written
+
+
+@pytest.mark.skipif(not RUNS, reason="meshes/rig-tire360/roll/ holds no rolling runs yet")
+def test_table_of_the_committed_runs():
+    """The table reads every committed run: one line each, its build-up fitted where its force
+    builds up, the brush estimate; rim and road balance as the sidecars say."""
+    lines = results.table(prog.OUT, kx=False, rig=prog.RIG)
+    names = [json.loads(p.read_text())["case"] for p in RUNS]
+    for name in names:
+        assert sum(line.startswith(name + " ") for line in lines) == 1
+    for side in results.rolling_sidecars(prog.OUT):
+        fit = results.build_up(side)
+        if fit is not None:  # a slip run: its force builds up over about a metre (sigma ~ 1.1 m)
+            assert 0.5 < fit.sigma < 3.0 and fit.sigma_se < 0.05 * fit.sigma
+            assert abs(fit.f_inf) > abs(side["tail_means"]["Fx"])
+    assert any(line.startswith("brush estimate") for line in lines)

@@ -152,8 +152,12 @@ class BuildUp:
 
 def build_up(side: dict) -> BuildUp | None:
     """``BuildUp`` of the run's printed longitudinal force (``history``; X the axle travel), None
-    where the force does not build up (a run at free rolling) or too few records were printed."""
+    where the force does not build up from 0 (a run at free rolling, or one wound up at its start:
+    ``prewind_rad``) or too few records were printed."""
     from scipy.optimize import curve_fit
+
+    if side.get("prewind_rad"):
+        return None
 
     h = side["history"]
     x, fx = np.asarray(h["axle_travel_m"], float), np.asarray(h["Fx"], float)
@@ -191,13 +195,19 @@ def brush_slope(side: dict) -> float:
 
 def fepost_kx(out: Path, name: str) -> float:
     """k_x that ``fepost coefficients`` gives the run's map against ``roll_static``."""
+    import contextlib
+    import io
+
     from fepost.cli import main as fepost
 
     with tempfile.TemporaryDirectory(prefix="roll360-kx-") as tmp:
         js = Path(tmp) / "coef.json"
         static, rolled = out / f"{STATIC}.vtu", out / f"{name}.vtu"
-        if fepost(["coefficients", str(static), "--rolling", str(rolled), "--json", str(js)]) != 0:
-            raise RuntimeError(f"fepost coefficients failed on {rolled}")
+        said = io.StringIO()
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            status = fepost(["coefficients", str(static), "--rolling", str(rolled), "--json", str(js)])
+        if status != 0:
+            raise RuntimeError(f"fepost coefficients failed on {rolled}: {said.getvalue().strip()[-300:]}")
         coef = json.loads(js.read_text())
     return float(coef.get("coefficients", coef)["k_x"])
 
