@@ -52,11 +52,14 @@ class RunPoint:
     #: Fx/N of the first-order build-up's limit (``relaxation_length``): the steady value of a run
     #: that has not reached it; NaN where no build-up was fitted
     steady_fx_over_n: float = math.nan
+    #: N m, the axle torque's build-up limit, likewise
+    steady_torque_fit: float = math.nan
 
     @classmethod
     def from_sidecar(cls, side: dict, kx: float = math.nan) -> RunPoint:
         tail = side["tail_means"]
         _, f_inf = relaxation_length(side)
+        torque = build_up(side, "axle_torque_Nm")
         return cls(
             side["case"],
             float(side["turn_per_travel_rad_per_m"]),
@@ -66,7 +69,14 @@ class RunPoint:
             float(side["friction"]),
             kx,
             f_inf / float(tail["Fz"]),
+            math.nan if torque is None else torque.f_inf,
         )
+
+    @property
+    def steady_torque(self) -> float:
+        """The axle torque for free rolling: the fitted steady value where the run was still building
+        up, else the tail mean (a steady run, a pre-wound one, or one at free rolling)."""
+        return self.steady_torque_fit if math.isfinite(self.steady_torque_fit) else self.torque
 
     @property
     def slip_force(self) -> float:
@@ -99,15 +109,16 @@ def brush_theta(force_ratio: float) -> float:
 
 
 def free_rolling(points: list[RunPoint], nearest: int = 3) -> FreeRolling:
-    """Free rolling from the ``nearest`` runs of smallest |torque| (at least two of different turn
-    rates): a least-squares line of torque against turn rate; R_e = 1 / its zero."""
+    """Free rolling from the ``nearest`` runs of smallest steady |torque| (at least two of different
+    turn rates): a least-squares line of the steady torque (``RunPoint.steady_torque``) against the
+    turn rate; R_e = 1 / its zero."""
     if len(points) < 2:
         raise ValueError(f"free rolling needs at least two rolling runs, got {len(points)}")
-    use = sorted(points, key=lambda p: abs(p.torque))[: max(2, nearest)]
+    use = sorted(points, key=lambda p: abs(p.steady_torque))[: max(2, nearest)]
     w = np.array([p.turn_rate for p in use])
     if np.ptp(w) <= 0:
         raise ValueError("the runs nearest free rolling share one turn rate: no line through them")
-    slope, icpt = np.polyfit(w, [p.torque for p in use], 1)
+    slope, icpt = np.polyfit(w, [p.steady_torque for p in use], 1)
     if slope == 0:
         raise ValueError("the axle torque does not change with the turn rate")
     w0 = -icpt / slope
@@ -150,21 +161,23 @@ class BuildUp:
     reached: float  # 1 - exp(-X_end / sigma)
 
 
-def build_up(side: dict) -> BuildUp | None:
-    """``BuildUp`` of the run's printed longitudinal force (``history``; X the axle travel), None
-    where the force does not build up from 0 (a run at free rolling, or one wound up at its start:
-    ``prewind_rad``) or too few records were printed."""
+def build_up(side: dict, quantity: str = "Fx") -> BuildUp | None:
+    """``BuildUp`` of the run's printed longitudinal force (``quantity``: ``Fx``, or the axle torque
+    ``axle_torque_Nm``; ``history``; X the axle travel), None where the force does not build up
+    from 0 (a run at free rolling, or one wound up at its start: ``prewind_rad``) or too few
+    records were printed."""
     from scipy.optimize import curve_fit
 
     if side.get("prewind_rad"):
         return None
 
     h = side["history"]
-    x, fx = np.asarray(h["axle_travel_m"], float), np.asarray(h["Fx"], float)
+    x, fx = np.asarray(h["axle_travel_m"], float), np.asarray(h[quantity], float)
     keep = x > 1e-12
     x, fx = np.concatenate([[0.0], x[keep]]), np.concatenate([[0.0], fx[keep]])
     f_end = float(np.mean(fx[x >= 0.8 * x.max()]))
-    if x.size < 4 or abs(f_end) < 1e-3 * abs(side["tail_means"]["Fz"]):
+    force_end = float(np.mean(np.asarray(h["Fx"], float)[keep][x[1:] >= 0.8 * x.max()]))
+    if x.size < 4 or abs(force_end) < 1e-3 * abs(side["tail_means"]["Fz"]):
         return None
 
     def model(xx, sigma, f_inf):
