@@ -326,7 +326,11 @@ def test_relaxation_length_of_a_first_order_build_up():
     side = {
         "history": {"axle_travel_m": x.tolist(), "Fx": (-1.2e4 * -np.expm1(-x / 0.27)).tolist()},
         "tail_means": {"Fz": 2.0e5},
+        "imposed_slip": -0.01,
     }
+    # nothing builds up without an imposed slip (a free rim, a run at the reference radius)
+    assert results.build_up({**side, "imposed_slip": None}) is None
+    assert results.build_up({**side, "imposed_slip": 0.0}) is None
     sigma, f_inf = results.relaxation_length(side)
     assert sigma == pytest.approx(0.27, rel=1e-6) and f_inf == pytest.approx(-1.2e4, rel=1e-6)
     fit = results.build_up(side)

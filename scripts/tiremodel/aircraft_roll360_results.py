@@ -164,11 +164,11 @@ class BuildUp:
 def build_up(side: dict, quantity: str = "Fx") -> BuildUp | None:
     """``BuildUp`` of the run's printed longitudinal force (``quantity``: ``Fx``, or the axle torque
     ``axle_torque_Nm``; ``history``; X the axle travel), None where the force does not build up
-    from 0 (a run at free rolling, or one wound up at its start: ``prewind_rad``) or too few
-    records were printed."""
+    from 0 (no imposed slip: a free rim or a run at the reference radius; or wound up at its start:
+    ``prewind_rad``) or too few records were printed."""
     from scipy.optimize import curve_fit
 
-    if side.get("prewind_rad"):
+    if side.get("prewind_rad") or not side.get("imposed_slip"):
         return None
 
     h = side["history"]
