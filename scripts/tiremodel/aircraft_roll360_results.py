@@ -18,8 +18,8 @@ being its fitted steady value where its force was still building up (``RunPoint.
 
 Both are compared with ``brush_slope``, the brush estimate from the static patch's strips and the
 tread rubber's stiffness (no run needed). ``relaxation_length`` fits the first-order build-up of
-each run's force along its roll. Written here, not taken from a library: the brush
-curve's inverse is one cubic root per run (numpy's ``roots``).
+each run's force along its roll (scipy's ``curve_fit``). The brush curve's inverse is closed:
+1 - theta = (1 - |Fx| / (f N))^(1/3).
 """
 
 from __future__ import annotations
@@ -56,10 +56,12 @@ class RunPoint:
     steady_torque_fit: float = math.nan
 
     @classmethod
-    def from_sidecar(cls, side: dict, kx: float = math.nan) -> RunPoint:
+    def from_sidecar(cls, side: dict, kx: float = math.nan, fit: BuildUp | None = None) -> RunPoint:
+        """The run of ``side``; ``fit``: its force's ``build_up`` when the caller has it already."""
         tail = side["tail_means"]
-        _, f_inf = relaxation_length(side)
-        torque = build_up(side, "axle_torque_Nm")
+        fit = fit or build_up(side)
+        f_inf = math.nan if fit is None else fit.f_inf
+        torque = None if fit is None else build_up(side, "axle_torque_Nm")
         return cls(
             side["case"],
             float(side["turn_per_travel_rad_per_m"]),
@@ -172,18 +174,18 @@ def build_up(side: dict, quantity: str = "Fx") -> BuildUp | None:
         return None
 
     h = side["history"]
-    x, fx = np.asarray(h["axle_travel_m"], float), np.asarray(h[quantity], float)
-    keep = x > 1e-12
-    x, fx = np.concatenate([[0.0], x[keep]]), np.concatenate([[0.0], fx[keep]])
-    f_end = float(np.mean(fx[x >= 0.8 * x.max()]))
-    force_end = float(np.mean(np.asarray(h["Fx"], float)[keep][x[1:] >= 0.8 * x.max()]))
-    if x.size < 4 or abs(force_end) < 1e-3 * abs(side["tail_means"]["Fz"]):
+    travel = np.asarray(h["axle_travel_m"], float)
+    keep = travel > 1e-12
+    x = np.concatenate([[0.0], travel[keep]])
+    y, fx = (np.concatenate([[0.0], np.asarray(h[q], float)[keep]]) for q in (quantity, "Fx"))
+    tail = x >= 0.8 * x.max()
+    if x.size < 4 or abs(fx[tail].mean()) < 1e-3 * abs(side["tail_means"]["Fz"]):
         return None
 
     def model(xx, sigma, f_inf):
         return f_inf * -np.expm1(-xx / sigma)
 
-    (sigma, f_inf), cov = curve_fit(model, x, fx, p0=(0.1 * x.max(), f_end), maxfev=5000)
+    (sigma, f_inf), cov = curve_fit(model, x, y, p0=(0.1 * x.max(), float(y[tail].mean())), maxfev=5000)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     return BuildUp(float(sigma), float(f_inf), float(se[0]), float(se[1]), float(-np.expm1(-x.max() / sigma)))
 
@@ -242,12 +244,14 @@ def table(out: Path, kx: bool = True, rig: Path | None = None) -> list[str]:
         f"{'dT/fNR':>7} {'bal x/N':>8} {'bal z/N':>8} {'k_x':>7} {'sigma m':>7} {'CPU s/m':>7}"
     ]
     sides = rolling_sidecars(out)
+    fits = [build_up(side) for side in sides]
+    sig = [math.nan if fit is None else fit.sigma for fit in fits]
     points = []
-    for side in sides:
+    for side, fit, sigma in zip(sides, fits, sig, strict=True):
         st, bal = side["steadiness"], side["balance"]["residual_over_N"]
         kappa = side["longitudinal_slip"]
         k = fepost_kx(out, side["case"]) if kx else math.nan
-        point = RunPoint.from_sidecar(side, k)
+        point = RunPoint.from_sidecar(side, k, fit)
         points.append(point)
         cpu = side["cpu_s_per_m"] or math.nan
         lines.append(
@@ -255,10 +259,9 @@ def table(out: Path, kx: bool = True, rig: Path | None = None) -> list[str]:
             f"{point.steady_fx_over_n:7.4f} {point.torque / 1e3:7.3f} "
             f"{st['Fx_over_fN']:7.4f} {st['Fz_over_N']:7.4f} "
             f"{st['torque_over_fNR']:7.4f} {bal[0]:8.1e} {bal[2]:8.1e} {k:7.4f} "
-            f"{relaxation_length(side)[0]:7.3f} {cpu:7.0f}"
+            f"{sigma:7.3f} {cpu:7.0f}"
         )
-    for side in sides:
-        fit = build_up(side)
+    for side, fit in zip(sides, fits, strict=True):
         if fit is not None:
             n = side["tail_means"]["Fz"]
             lines.append(
@@ -281,7 +284,6 @@ def table(out: Path, kx: bool = True, rig: Path | None = None) -> list[str]:
             f"slip curve: C_kappa/N = {fr.secant_slope:.2f} (least-squares line), "
             f"{fr.brush_fit_slope:.2f} (each run through the brush curve, f = {points[0].friction:g})",
         ]
-        sig = [relaxation_length(sd)[0] for sd in sides]
         if rig is not None and any(math.isfinite(v) for v in sig):
             from fepost.shimmy.brush import rig_stiffness
 
