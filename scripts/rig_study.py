@@ -509,7 +509,11 @@ def heights(table, static, preds, shifts, shift_law, friction: float, diagnosis:
 
 
 #: The tracked folder each rig folder's study is kept in (rewritten only with --update).
-TRACKED = {"rig": REPO / "docs" / "rig", "rig-aircraft": REPO / "docs" / "rig" / "aircraft"}
+TRACKED = {
+    "rig": REPO / "docs" / "rig",
+    "rig-aircraft": REPO / "docs" / "rig" / "aircraft",
+    "rig-tire360": REPO / "docs" / "rig" / "tire360",
+}
 
 
 class _Progress:
@@ -524,7 +528,11 @@ class _Progress:
         self.k += 1
         print(f"rig_study: [{self.k}/{self.total}] {name} ...", end="", file=sys.stderr, flush=True)
         t0 = time.perf_counter()
-        value = func(*args)
+        try:
+            value = func(*args)
+        except BaseException:
+            print(" failed", file=sys.stderr, flush=True)
+            raise
         print(f" done in {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
         return value
 
@@ -542,14 +550,24 @@ def output_folder(rig: Path, out: Path | None, update: bool) -> Path:
             raise SystemExit("rig_study: --update writes the tracked folder; give either --out or --update")
         tracked = TRACKED.get(rig.resolve().name)
         if tracked is None or rig.resolve() != (REPO / "meshes" / rig.resolve().name).resolve():
-            raise SystemExit(
-                f"rig_study: --update: {rig} has no tracked study (only meshes/rig, meshes/rig-aircraft)"
-            )
+            known = ", ".join(f"meshes/{k}" for k in TRACKED)
+            raise SystemExit(f"rig_study: --update: {rig} has no tracked study (only {known})")
         return tracked
     return out if out is not None else Path("out") / rig.resolve().name
 
 
 def main(argv=None) -> int:
+    """The command line (module docstring); fepost's errors end it with one line and status 2."""
+    from fepost.errors import FepostError
+
+    try:
+        return _main(argv)
+    except FepostError as err:
+        print(f"rig_study: {err}", file=sys.stderr)
+        return 2
+
+
+def _main(argv) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rig", type=Path, default=REPO / "meshes" / "rig")
     ap.add_argument("--out", type=Path, default=None, help="output folder (default out/<rig folder name>)")

@@ -129,6 +129,16 @@ def test_cross_validation_holds_out_each_group(quad):
     np.testing.assert_allclose(cv.Fx, full.Fx, atol=1e-8 * quad.load)  # exact data: every fold finds h
 
 
+def test_cross_validation_refuses_a_fold_too_small_to_identify(quad):
+    shifts, forces, (vx, vy, wz) = _synthetic_runs(quad, (0.012, 0.045), 0.0, 0)
+    keep = np.arange(4)  # four runs, two groups: holding either out leaves two
+    groups = ["a", "a", "b", "b"]
+    with pytest.raises(ArgumentError, match="holding out group 'a' leaves 2 run"):
+        cross_validate(
+            quad, vx[keep], vy[keep], wz[keep], shifts=shifts[keep], forces=forces[keep], groups=groups
+        )
+
+
 def test_bad_input_is_one_line():
     with pytest.raises(ArgumentError, match=r"must both be \(n, 2\)"):
         identify_shift(np.zeros((4, 2)), np.zeros((3, 2)))
@@ -222,3 +232,20 @@ def test_report_section_with_and_without_rig_runs(committed, tmp_path):
     assert "d045_a40n" in html
     other = analyse(ROOT / "meshes" / "static.vtu")  # the sample tire: no rig runs beside it
     assert rig_section(SimpleNamespace(analysis=other, options=None), tmp_path) is None
+
+
+def test_study_with_too_few_runs_fails_in_one_line(tmp_path, capsys):
+    """Three runs in three groups: the held-out extension cannot be identified; the study says so
+    in one line, exits 2 and writes nothing."""
+    import shutil
+
+    rig = tmp_path / "rig"
+    rig.mkdir()
+    for name in ("static", "spin_p", "d000_slide", "d090_slide"):
+        for f in (ROOT / "meshes" / "rig-tire360").glob(f"{name}.*"):
+            shutil.copy(f, rig / f.name)
+    out = tmp_path / "out"
+    assert _study().main(["--rig", str(rig), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("rig_study: cross_validate: holding out group")
+    assert "need at least 3" in err[-1] and not out.exists()

@@ -276,6 +276,11 @@ def cross_validate(
     laws = []
     for name in order:
         held = np.array([str(x) == name for x in labels])
+        if np.count_nonzero(~held) < 3:
+            raise ArgumentError(
+                f"cross_validate: holding out group {name!r} leaves {np.count_nonzero(~held)} run(s) "
+                "to identify the law from; need at least 3"
+            )
         law = identify_shift(d[~held], g[~held])
         pred = predict_shifted(quad, vx[held], vy[held], wz[held], law=law, friction=friction)
         out[held] = np.column_stack([pred.resultants.Fx, pred.resultants.Fy, pred.resultants.Mz])
