@@ -31,15 +31,23 @@ STEEP_DEG = 45.0
 class FaceGroup:
     """Faces of one type.
 
-    ``conn`` (m, k); ``values`` per face (face data) or None; ``ids`` (m,) face
-    ids; ``partial`` (m,) true where some node is not loaded (the rim of the patch).
+    ``conn`` (m, k); ``values`` per face (face data) or None; ``face_ids`` (m,) face
+    ids, or a ``range`` of consecutive ones (made an array only when `ids` is asked for:
+    linear triangles never need theirs); ``partial`` (m,) true where some node is not
+    loaded (the rim of the patch).
     """
 
     ftype: str
     conn: np.ndarray
     values: np.ndarray | None
-    ids: np.ndarray
+    face_ids: np.ndarray | range
     partial: np.ndarray
+
+    @property
+    def ids(self) -> np.ndarray:
+        """The face ids as an (m,) array."""
+        r = self.face_ids
+        return np.arange(r.start, r.stop) if isinstance(r, range) else r
 
     def subset(self, keep: np.ndarray) -> FaceGroup:
         return FaceGroup(
@@ -72,13 +80,13 @@ def loaded_groups(fld: ContactField, v: np.ndarray, thr: float) -> list[FaceGrou
             fv = v[sl]
             loaded = fv > thr
             partial = np.ones(len(conn), bool)
-        ids = np.arange(sl.start, sl.stop)
         if loaded.all():
-            out.append(FaceGroup(ftype, conn, fv, ids, partial))
+            out.append(FaceGroup(ftype, conn, fv, range(sl.start, sl.stop), partial))
         elif loaded.any():
             sub = None if fv is None else fv[loaded]
+            ids = np.flatnonzero(loaded) + sl.start
             # a new array no caller holds: sealed, so the patch shares it instead of copying
-            out.append(FaceGroup(ftype, sealed(conn[loaded]), sub, ids[loaded], partial[loaded]))
+            out.append(FaceGroup(ftype, sealed(conn[loaded]), sub, ids, partial[loaded]))
     return out
 
 

@@ -21,7 +21,9 @@ result does not depend on the number of threads, bit for bit.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -49,6 +51,41 @@ TRI_BARY = np.array(
 TRI_W = np.array([0.225, *([0.132394152788506] * 3), *([0.125939180544827] * 3)])
 
 
+#: Radius about the sums' origin, as a fraction of the nodes' extent, inside which a face's
+#: term of the polar-moment enclosure takes its wide form (`PolarSums`).
+POLAR_NEAR = 0.01
+
+
+class PolarSums(NamedTuple):
+    """What the face pass adds up for an enclosure of the polar moment ∬ σ r dA about a point
+    near the coordinates' origin (`fepost.refine` decides from it whether a grid is refined).
+
+    Per face, W its load and r̄ the distance of its centre of pressure from the origin:
+    ``lo`` = Σ W r̄, ``load`` = Σ W and ``slack`` = Σ W min(2d, d²/r̄) (d the face's longest
+    edge; 2d where r̄ < ``near``). ``origin``: where that origin lies in the coordinates of
+    the caller (the patch frame moves it, `fepost.patch.build_patch`).
+    """
+
+    lo: float
+    slack: float
+    load: float
+    near: float
+    origin: tuple[float, float] = (0.0, 0.0)
+
+    def bounds(self, centre: tuple[float, float]) -> tuple[float, float] | None:
+        """(lo, hi) enclosing ∬ σ |x − ``centre``| dA, or None when ``centre`` is more than
+        ``near``/2 from the origin.
+
+        Each face's term moves by at most δ = |centre − origin| (the triangle inequality):
+        Jensen's lower bound W r̄ (`fepost.refine.polar_moment_bounds`) by at most W δ; its
+        upper slack, min(2d, d²/(2 r̄_c)) about the centre, is at most min(2d, d²/r̄)
+        where r̄ ≥ ``near`` ≥ 2δ (then r̄_c ≥ r̄/2), and 2d is always an upper bound."""
+        delta = math.hypot(centre[0] - self.origin[0], centre[1] - self.origin[1])
+        if not delta <= 0.5 * self.near:
+            return None
+        return self.lo - delta * self.load, self.lo + delta * self.load + self.slack
+
+
 @dataclass(frozen=True)
 class FaceSums:
     """Totals over the faces (SI): load N, load moments, area and its moments."""
@@ -63,6 +100,7 @@ class FaceSums:
     Syy: float
     Sxy: float
     max_edge: float  # longest face edge, m
+    polar: PolarSums | None = None  # None: the pressure has negative values (no enclosure)
 
     @property
     def centre_of_pressure(self) -> np.ndarray:
@@ -93,7 +131,8 @@ def triangle_areas(xy: np.ndarray, tri: np.ndarray) -> np.ndarray:
 
 
 def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray, location: str) -> FaceSums:
-    """Exact load, load moments and area moments of the field over the faces.
+    """Exact load, load moments and area moments of the field over the faces, and the
+    terms of an enclosure of its polar moment (`PolarSums`, for a non-negative field).
 
     ``x``, ``y`` (n,) are the in-plane node coordinates (m), ``tri`` (m, 3) the
     faces, ``values`` the pressure per node or per face (``location``).
@@ -102,19 +141,25 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
     X = np.ascontiguousarray(x, dtype=float)
     Y = np.ascontiguousarray(y, dtype=float)
     V = np.ascontiguousarray(values, dtype=float)
+    near = POLAR_NEAR * max(float(np.ptp(X)), float(np.ptp(Y))) if X.size else 0.0
     # one BLAS thread for the chunks' thin matrix products (more would only spin beside map_chunks')
     with one_blas_thread():
-        parts = map_chunks(lambda sl: _chunk_sums(X, Y, V, tri, sl, location), slices(len(tri), CHUNK))
+        parts = map_chunks(lambda sl: _chunk_sums(X, Y, V, tri, sl, location, near), slices(len(tri), CHUNK))
     # the chunks' totals in their order: the same sums on one thread or two
     gram = np.zeros((_ROWS, _ROWS))
     first = np.zeros(_ROWS)
     area2 = 0.0
-    for g, f, a, _ in parts:
+    polar = np.zeros(3)
+    for g, f, a, _, p in parts:
         gram += g
         first += f
         area2 += a
-    e2 = max((e for *_, e in parts), default=0.0)
-    return _integrals(gram, first, area2, location, float(np.sqrt(e2)))
+        polar += p
+    e2 = max((p[3] for p in parts), default=0.0)
+    # Jensen's lower bound of the enclosure needs σ ≥ 0
+    signed = V.size == 0 or float(V.min()) >= 0.0
+    pol = PolarSums(float(polar[0]), float(polar[1]), float(polar[2]), near) if signed else None
+    return _integrals(gram, first, area2, location, float(np.sqrt(e2)), pol)
 
 
 #: Rows of a chunk's corner matrix: x (3 corners), y (3), then the corner pressures (3) or,
@@ -124,10 +169,11 @@ _X, _Y, _P = slice(0, 3), slice(3, 6), slice(6, 9)
 
 
 def _chunk_sums(
-    X, Y, V, tri: np.ndarray, sl: slice, location: str
-) -> tuple[np.ndarray, np.ndarray, float, float]:
+    X, Y, V, tri: np.ndarray, sl: slice, location: str, near: float
+) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
     """The weighted Gram matrix G = Σ 2A c cᵀ of the faces ``tri[sl]``' corner vectors c (the
-    rows of `_ROWS`), their first sums Σ 2A c, Σ 2A and their longest edge².
+    rows of `_ROWS`), their first sums Σ 2A c, Σ 2A, their longest edge² and their terms of
+    `PolarSums` (`_polar_terms`).
 
     Every integral of the module docstring is 2A times a quadratic or linear form in c, so
     sums of G's entries and of the first sums give them all (`_integrals`): one matrix
@@ -150,22 +196,56 @@ def _chunk_sums(
     a = ax * by
     a -= ay * bx
     np.abs(a, out=a)  # twice the area
-    e = ax * ax
-    e += ay * ay
-    e2 = float(e.max())
-    np.multiply(bx, bx, out=e)
+    d2 = ax * ax  # the longest edge², face by face
+    d2 += ay * ay
+    e = bx * bx
     e += by * by
-    e2 = max(e2, float(e.max()))
+    np.maximum(d2, e, out=d2)
     bx -= ax
     by -= ay
     np.multiply(bx, bx, out=e)
     e += by * by
-    e2 = max(e2, float(e.max()))
+    np.maximum(d2, e, out=d2)
     w = c * a
-    return w @ c.T, w.sum(axis=1), float(a.sum()), e2
+    polar = _polar_terms(c, a, d2, location, near)
+    return w @ c.T, w.sum(axis=1), float(a.sum()), float(d2.max()), polar
 
 
-def _integrals(gram: np.ndarray, first: np.ndarray, area2: float, location: str, max_edge: float) -> FaceSums:
+def _polar_terms(c: np.ndarray, a: np.ndarray, d2: np.ndarray, location: str, near: float) -> np.ndarray:
+    """[Σ W r̄, Σ W min(2d, d²/r̄) (2d where r̄ < ``near``), Σ W] over a chunk's faces
+    (`PolarSums`): W a face's load, r̄ the distance of its centre of pressure from the origin,
+    d its longest edge (``d2``: d²), ``a`` twice its area, ``c`` its corner rows.
+
+    With σ linear the centre of pressure is P / (4 Σσ), P = Σ_k (Σσ + σ_k) x_k, so W r̄ =
+    2A |P| / 24; with σ constant it is the centroid Σ x_k / 3."""
+    if location == "point":
+        vs = _rows(c[_P])
+        t = c[_P] + vs
+        px, py = _rows(t * c[_X]), _rows(t * c[_Y])
+        scale = 4.0 * vs  # r̄ = |P| / scale
+        load = a * vs
+        load /= 6.0
+    else:
+        px, py = _rows(c[_X]), _rows(c[_Y])
+        scale = np.full(len(a), 3.0)
+        load = a * c[6]
+        load /= 2.0
+    pn = px * px
+    pn += py * py
+    np.sqrt(pn, out=pn)
+    lo = float(a @ pn) / 24.0 if location == "point" else float(load @ pn) / 3.0
+    q = np.full(len(a), np.inf)
+    # d²/r̄ = d² scale / |P| where r̄ ≥ near; elsewhere infinite, so fmin takes 2d
+    far = pn >= near * scale
+    far &= pn > 0.0
+    np.divide(d2 * scale, pn, out=q, where=far)
+    np.fmin(q, 2.0 * np.sqrt(d2), out=q)
+    return np.array([lo, float(load @ q), float(load.sum())])
+
+
+def _integrals(
+    gram: np.ndarray, first: np.ndarray, area2: float, location: str, max_edge: float, polar: PolarSums | None
+) -> FaceSums:
     """The `FaceSums` from the sums of `_chunk_sums` (``area2``: Σ 2A) and the longest edge.
 
     With 2A-weighted sums ⟨·⟩: ∬ x x dA = (⟨Σ x_k²⟩ + ⟨(Σx)²⟩)/24, the trace and the sum
@@ -195,6 +275,7 @@ def _integrals(gram: np.ndarray, first: np.ndarray, area2: float, location: str,
         quad(_Y, _Y),
         quad(_X, _Y),
         max_edge,
+        polar,
     )
 
 

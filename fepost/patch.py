@@ -51,7 +51,7 @@ import numpy as np
 from ._arrays import frozen, sealed
 from .errors import ArgumentError, DimensionError, PatchError, PressureError, PressureWarning
 from .facegroups import STEEP_DEG, drop_edge_faces, loaded_groups
-from .facesums import FaceSums, load_outside, triangle_areas
+from .facesums import FaceSums, PolarSums, load_outside, triangle_areas
 from .field import ContactField
 from .frame import Frame, fit_plane, patch_axes
 
@@ -113,6 +113,9 @@ class Patch:
     refine_error: float = 0.0  # load of the triangles / exact element load − 1
     dropped_edge_faces: int = 0
     body: str = ""
+    #: the face pass's terms of the polar-moment enclosure, about their origin in this frame
+    #: (`fepost.facesums.PolarSums`; None: no enclosure), for `fepost.refine`
+    polar: PolarSums | None = None
 
     def __post_init__(self) -> None:
         for name in ("xy", "height", "values"):
@@ -265,8 +268,10 @@ def _fit_frame(fld: ContactField, *, values: np.ndarray, thr: float, groups, rol
     if np.count_nonzero(w) < 3:
         raise PatchError(f"{src}: the contact patch has fewer than 3 loaded nodes")
     c, normal, var = fit_plane(pts_sel, w)
-    hz = np.abs(pts_sel @ normal - c @ normal)[w > 0]
-    flat = bool(hz.max() <= 1e-9 * np.sqrt(var[2]))
+    hz = pts_sel @ normal  # the loaded nodes' distances from the plane, in place
+    hz -= c @ normal
+    np.abs(hz, out=hz)
+    flat = bool(hz.max(where=w > 0, initial=0.0) <= 1e-9 * np.sqrt(var[2]))
     if var[1] <= LINE_TOL**2 * var[2]:
         raise DimensionError(
             f"{src}: the loaded nodes lie on one line: the contact is a line, not a patch "
@@ -335,7 +340,8 @@ def _in_frame(xy: np.ndarray, *, cop: np.ndarray, centroid: np.ndarray, base: Fr
     if given:
         return base, xy, (float(cop[0]), float(cop[1])), centroid
     fr = Frame(origin=base.to_global(cop[None, :])[0], axes=base.axes)  # on the plane: local z = 0
-    return fr, xy - cop, (0.0, 0.0), centroid - cop
+    xy -= cop  # in place: the projection's array, which nothing else holds
+    return fr, xy, (0.0, 0.0), centroid - cop
 
 
 def build_patch(
@@ -388,7 +394,8 @@ def build_patch(
     height = sealed(height)
     x, y = xy[:, 0], xy[:, 1]
     ellipse = _ellipse(sums)
-    r2 = x * x + y * y
+    r2 = x * x
+    r2 += y * y
     r_max = float(np.sqrt(np.max(r2)))
     r_equiv = float(np.sqrt(sums.A / np.pi))
     rms = float(np.sqrt((weights @ (height * height)) / weights.sum()))
@@ -434,7 +441,16 @@ def build_patch(
         refine_error=refine_err,
         dropped_edge_faces=n_edge,
         body=fld.body,
+        polar=_moved(sums.polar, xy_shift=None if frame is not None else cop),
     )
+
+
+def _moved(polar: PolarSums | None, *, xy_shift) -> PolarSums | None:
+    """``polar`` with its origin in the patch frame: the base frame's origin, at −(centre of
+    pressure) once the frame moved there (``xy_shift``: what `_in_frame` took from xy)."""
+    if polar is None or xy_shift is None:
+        return polar
+    return polar._replace(origin=(-float(xy_shift[0]), -float(xy_shift[1])))
 
 
 def _edge_note(n_edge: int) -> tuple[str, ...]:

@@ -63,8 +63,10 @@ def project_faces(source, points, tri, vals, location, thr, base: Frame) -> Geom
         pts = points[used]
         nvals = vals[used] if location == "point" else vals
     w = np.where(nvals > thr, nvals, 0.0) if location == "point" else np.ones(len(pts))
-    # patch coordinates: (pts − o)·e_k = pts·e_k − o·e_k
-    xy = pts @ base.axes[:2].T
+    # patch coordinates: (pts − o)·e_k = pts·e_k − o·e_k; xy column by column (Fortran order), so
+    # the passes that gather x and y (`face_sums`, `fepost.locate`) take them without a copy
+    xy = np.empty((len(pts), 2), order="F")
+    np.matmul(base.axes[:2], pts.T, out=xy.T)  # = pts @ axes[:2].T, into the transposed (C-ordered) view
     xy -= base.origin @ base.axes[:2].T
     z = pts @ base.axes[2]
     z -= base.origin @ base.axes[2]

@@ -26,10 +26,14 @@ moment ∬ σ r dA of the FE faces (`polar_moment`) both within `REFINE_TOL`, up
 more than `TRIGGER_TOL` (the pipeline's own 1 % warning), so a map the default grid
 carries keeps its numbers bit for bit (the sample tire maps: within 0.12 %).
 
-Whether it starts is decided first from an enclosure of the FE polar moment
-(`polar_moment_bounds`: one distance per face instead of the six of the degree-4 rule,
-0.04 s of CPU on a 2.2 M-triangle map against 0.25 s); only where the enclosure
-straddles the trigger, or the refinement runs, is the degree-4 value computed. On the
+Whether it starts is decided first from an enclosure of the FE polar moment. The patch
+step's face pass already sums one (`fepost.facesums.PolarSums`, about the fitted plane's
+centre, widened by the distance to the centre of pressure): on a fine map it decides
+with no pass of its own (on a 2.2 M-triangle map 0.035 s of CPU added to the face pass,
+against 0.13 s for a separate pass). Where it is missing or too wide, the enclosure of a
+separate pass (`polar_moment_bounds`: one distance per face instead of the six of the
+degree-4 rule) decides; only where that straddles the trigger too, or the refinement
+runs, is the degree-4 value computed. On the
 planar-sliding legs the refined grids are 27 × 256 (30_63.33_...) to 45 × 960 nodes
 (10_90_...), 3-6 times the default's 8192 and a tenth of the uniform 256 × 1024 that carries
 them as well; they carry the load and the polar moment within 0.17 %.
@@ -263,7 +267,12 @@ def refined_map(patch: Patch, pmap: PolarMap, mom: Moments) -> tuple[PolarMap, M
     the FE load or polar moment by more than `TRIGGER_TOL`, the first refined grid's that
     carries both within `REFINE_TOL` (the most accurate one tried when none does)."""
     centre, radius = pmap.centre, pmap.radius
-    # |G/M − 1| is largest at an end of the enclosure of M: within the trigger there, it is for M
+    # |G/M − 1| is largest at an end of the enclosure of M: within the trigger there, it is for M.
+    # The patch's own enclosure (summed in its face pass) first; where it is missing or too
+    # wide to decide, the narrower one of a pass of its own
+    bounds = None if patch.polar is None else patch.polar.bounds(centre)
+    if bounds is not None and carried_within(patch, mom, bounds) <= TRIGGER_TOL:
+        return pmap, mom
     bounds = polar_moment_bounds(patch.xy, patch.triangles, patch.values, patch.location, centre)
     if carried_within(patch, mom, bounds) <= TRIGGER_TOL:
         return pmap, mom

@@ -109,6 +109,54 @@ def test_a_carried_map_is_decided_by_the_enclosure_alone(hertz, monkeypatch):
     assert out is pmap and out_mom is mom and not calls
 
 
+def test_the_patch_enclosure_decides_a_fine_map_without_a_pass_of_its_own(hertz, monkeypatch):
+    """The face pass of the patch step already summed an enclosure (`fepost.facesums.PolarSums`):
+    on a fine map the default grid carries, neither the separate enclosure pass nor the degree-4
+    rule runs."""
+    pmap, mom = _default(hertz)
+    assert hertz.polar is not None and hertz.polar.bounds(pmap.centre) is not None
+    calls = []
+    monkeypatch.setattr(refine, "polar_moment_bounds", lambda *a: calls.append(a) or (0.0, math.inf))
+    monkeypatch.setattr(refine, "polar_moment", lambda *a: calls.append(a) or 0.0)
+    out, out_mom = refine.refined_map(hertz, pmap, mom)
+    assert out is pmap and out_mom is mom and not calls
+
+
+@pytest.mark.parametrize("location", ["point", "cell"])
+def test_the_patch_enclosure_holds_the_moment_about_nearby_centres(tmp_path, location):
+    """The face pass's enclosure about points up to near/2 from its origin (the fitted plane's
+    centre, off the patch frame's origin, the centre of pressure, on this tilted pressure)
+    holds the degree-4 value, is at most a few times wider than the separate pass's (plus the
+    2 δ N its move by δ costs), and beyond near/2 gives way (None) to that pass."""
+
+    def tilted(xy):
+        return 1.0 + np.sum(xy**2, axis=1) / A**2 + 0.5 * xy[:, 0] / A
+
+    patch = _disc(tmp_path, location, 360, 20, tilted)
+    enc = patch.polar
+    assert enc is not None and enc.origin != (0.0, 0.0)  # the fitted plane's centre is not the CoP
+    for frac in (0.0, 0.2, 0.49):
+        centre = (enc.origin[0] + 0.8 * frac * enc.near, enc.origin[1] - 0.6 * frac * enc.near)
+        lo, hi = enc.bounds(centre)
+        exact = refine.polar_moment(patch, centre)
+        assert lo <= exact <= hi, frac
+        tight = _bounds(patch, centre)
+        assert (hi - lo) < 4.0 * (tight[1] - tight[0]) + 2.5 * np.hypot(*np.subtract(centre, enc.origin)) * (
+            enc.load
+        ), frac
+    assert enc.bounds((enc.origin[0] + 0.6 * enc.near, enc.origin[1])) is None
+
+
+def test_no_patch_enclosure_for_negative_pressure():
+    """The face pass gives no enclosure where a value is negative (Jensen's bound needs σ ≥ 0)."""
+    from fepost import facesums
+
+    x, y = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    tri = np.array([[0, 1, 2]])
+    assert facesums.face_sums(x, y, tri, np.array([1.0, -0.1, 1.0]), "point").polar is None
+    assert facesums.face_sums(x, y, tri, np.array([1.0, 0.1, 1.0]), "point").polar is not None
+
+
 def test_a_missed_map_is_refined_as_before(tmp_path):
     """Two small discs far apart (the default grid falls between its nodes): the enclosure
     cannot clear it, the degree-4 value says refine, and the refined grid carries the load
