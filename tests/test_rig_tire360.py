@@ -113,6 +113,28 @@ def test_whole_decks(whole, tmp_path):
         ard.tire_for("whole", -0.1)
 
 
+@needs_gmsh
+def test_band_element_is_a_parameter_of_the_mesh(whole, tmp_path):
+    """``band_element`` puts C3D8R in the plain band (``check-elements``: 0.87 of the beam at
+    K/G = 100, C3D8 0.56), the same elements and nodes; the default stays C3D8, so the programme's
+    decks (and their sha256) are unchanged."""
+    from scripts.tiremodel import rig_deck as rd
+    from scripts.tiremodel.aircraft_rig_mesh import MESHES
+
+    reduced = dataclasses.replace(whole, params=dataclasses.replace(whole.params, band_element="C3D8R"))
+    assert ard.plain_element(whole) == "C3D8" and ard.plain_element(reduced) == "C3D8R"
+    texts = {}
+    for mesh in (whole, reduced):
+        inp = tmp_path / f"base_{ard.plain_element(mesh)}.inp"
+        rd.write_base_deck(inp, mesh, 0.12, (0.0, 0.0), ard.tire_for("whole-test"))
+        texts[ard.plain_element(mesh)] = inp.read_text()
+    band = int((~ard.incompatible_mask(whole)).sum())
+    assert _element_count(texts["C3D8R"], "C3D8R") == band == _element_count(texts["C3D8"], "C3D8")
+    assert "TYPE=C3D8, ELSET=TIRE" not in texts["C3D8R"]
+    assert texts["C3D8R"].replace("TYPE=C3D8R, ELSET=TIRE", "TYPE=C3D8, ELSET=TIRE") == texts["C3D8"]
+    assert MESHES["whole-fine-r"] == dataclasses.replace(MESHES["whole-fine"], band_element="C3D8R")
+
+
 def _element_count(text: str, etype: str) -> int:
     """Number of tire elements of ``etype`` in a deck's ``*ELEMENT, TYPE=etype, ELSET=TIRE`` card."""
     lines = text.splitlines()

@@ -8,9 +8,9 @@
 - ``rig [--mesh coarse|tiny|full] [--only RUN ...] [--out DIR] [--work DIR]``:
   the slide/spin programme on the small tire (meshes/rig/: the road moves
   rigidly with a sliding velocity and a spin, Coulomb friction 0.3);
-- ``rig-aircraft [--mesh rig|fine|whole|whole-fine|whole-xfine] [--inc F] [--path S] [--friction MU]
-  [--only RUN ...] [--out DIR] --work DIR [--workers N | --scheduler ADDRESS]``: the slide/spin
-  programme on the aircraft tire (the +-70 degree sector: meshes/rig-aircraft/; the whole tire:
+- ``rig-aircraft [--mesh rig|fine|whole|whole-fine|whole-fine-r|whole-xfine] [--inc F] [--path S]
+  [--friction MU] [--only RUN ...] [--out DIR] --work DIR [--workers N | --scheduler ADDRESS]``: the
+  slide/spin programme on the aircraft tire (the +-70 degree sector: meshes/rig-aircraft/; the whole tire:
   meshes/rig-tire360/), resumable, its runs as Dask tasks;
 - ``roll --work DIR [--only RUN ...] [--out DIR] [--scheduler ADDRESS]``: the
   aircraft tire rolling quasi-statically (free, braking, driving; meshes/rig-aircraft/roll_*);
@@ -78,10 +78,20 @@ def _parser() -> argparse.ArgumentParser:
     )
     ra.add_argument(
         "--mesh",
-        choices=["rig", "fine", "whole", "whole-fine", "whole-xfine", "whole-tiny", "whole-test"],
+        choices=[
+            "rig",
+            "fine",
+            "whole",
+            "whole-fine",
+            "whole-fine-r",
+            "whole-xfine",
+            "whole-tiny",
+            "whole-test",
+        ],
         default="rig",
         help="rig, fine: the +-70 degree sector (meshes/rig-aircraft/); whole, whole-fine: the whole "
-        "360-degree tire (meshes/rig-tire360/; whole-xfine: its finer static partner); whole-tiny, "
+        "360-degree tire (meshes/rig-tire360/; whole-xfine: its finer static partner; whole-fine-r: "
+        "whole-fine with C3D8R in its plain band); whole-tiny, "
         "whole-test: tiny versions",
     )
     ra.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")

@@ -79,11 +79,17 @@ def incompatible_mask(mesh) -> np.ndarray:
     return mask
 
 
+def plain_element(mesh) -> str:
+    """The element type of the elements ``incompatible_mask`` leaves out: C3D8, or the whole tire's
+    ``band_element`` (C3D8R on ``whole-fine-r``)."""
+    return getattr(mesh.params, "band_element", "C3D8") if mesh.info.get("whole_tire") else "C3D8"
+
+
 def tire_elements(mesh) -> list[str]:
-    """The tire's ``*ELEMENT`` cards (set TIRE), C3D8I or C3D8 by ``incompatible_mask``."""
+    """The tire's ``*ELEMENT`` cards (set TIRE), C3D8I or ``plain_element`` by ``incompatible_mask``."""
     incompatible = incompatible_mask(mesh)
     out: list[str] = []
-    for etype, sel in (("C3D8I", incompatible), ("C3D8", ~incompatible)):
+    for etype, sel in (("C3D8I", incompatible), (plain_element(mesh), ~incompatible)):
         out += cx.element_block(etype, "TIRE", np.flatnonzero(sel) + 1, mesh.hexes[sel])
     return out
 

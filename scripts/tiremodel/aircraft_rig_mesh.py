@@ -20,7 +20,7 @@ programme, ``fine`` for the convergence check, ``test`` for quick checks).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -33,6 +33,11 @@ class AircraftRigParams(AircraftParams):
     """The aircraft tire's dimensions with the rig's mesh counts and its sector."""
 
     sector_deg: float = 70.0  # half-angle of the modelled sector (cut faces at +-sector_deg)
+    # the whole tire's element in the rubber band under the patch's lateral edges
+    # (``aircraft_rig_deck.incompatible_mask``): C3D8 (the programme's), or C3D8R, which locks far
+    # less at the model's K/G = 100 (``check-elements``: 0.87 of the beam, C3D8 0.56): what the
+    # band's locking does to the runs
+    band_element: str = "C3D8"
 
     def coarse_layers(self) -> list[float]:
         """Angular sizes (deg) from ``fine_deg`` to ``sector_deg``, growing geometrically."""
@@ -89,6 +94,11 @@ MESHES = {
         first_deg=1.5,
         fine_deg=33.0,
         n_coarse=12,
+    ),
+    # the programme's mesh with a reduced-integration band (C3D8R): the band's locking measured
+    "whole-fine-r": replace(
+        _whole(n_crown=6, n_shoulder=3, n_side=4, first_deg=1.5, fine_deg=33.0, n_coarse=12),
+        band_element="C3D8R",
     ),
     # the convergence check's finest partner (static map only): about 1.25 x whole-fine's counts
     # along the section (8 + 4 + 5) and around (1.2 degree layers)

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import rig_deck as rd
-from .aircraft_rig_deck import AIRCRAFT, incompatible_mask, tire_for
+from .aircraft_rig_deck import AIRCRAFT, incompatible_mask, plain_element, tire_for
 from .aircraft_rig_mesh import build_rig_mesh
 from .rig_programme import run_name
 
@@ -219,7 +219,7 @@ def model_info(mesh, setup: Setup, rim_travel: float, clearance: float, solver: 
             "name": f"aircraft-{setup.mesh_kind}",
             "tire_nodes": int(mesh.nodes.shape[0]),
             "tire_elements": int(hexes),
-            "element_type": f"C3D8I ({incompatible}), C3D8 ({hexes - incompatible})",
+            "element_type": f"C3D8I ({incompatible}), {plain_element(mesh)} ({hexes - incompatible})",
             "contact_faces": int(mesh.contact_quads.shape[0]),
             "sector_deg": round(mesh.info["sector_deg"], 6),
             "n_crown": mesh.params.n_crown,

@@ -225,7 +225,7 @@ def write_deck(path, mesh: Roll360Mesh, plan: Plan) -> dict:
         "contact_law": law,
         "elements": {
             "C3D8I": int(ard.incompatible_mask(mesh).sum()),
-            "C3D8": int((~ard.incompatible_mask(mesh)).sum()),
+            ard.plain_element(mesh): int((~ard.incompatible_mask(mesh)).sum()),
         },
     }
 

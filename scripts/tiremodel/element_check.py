@@ -4,8 +4,9 @@ A cantilever of the tread rubber (Neo-Hooke, shear modulus G, bulk modulus K)
 with one element through half its depth (as coarse as the tire's tread) is
 loaded by a small tip force; its tip deflection is compared with Timoshenko's
 beam (E = 9KG/(3K+G), shear coefficient 5/6). Volumetric or shear locking shows
-as a deflection far below the beam's. Cases: C3D8I and C3D8, K/G = 100 (the
-tire model) and 1000.
+as a deflection far below the beam's. Cases: C3D8I, C3D8 and C3D8R (reduced
+integration with CalculiX's hourglass control, the whole tire's band on ``whole-fine-r``),
+K/G = 100 (the tire model) and 1000.
 
 Run: ``python -m scripts.tiremodel check-elements`` (a few seconds per case).
 """
@@ -104,7 +105,7 @@ def check(etype: str, bulk_ratio: float) -> tuple[float, float]:
 
 def main() -> int:
     print("element  K/G    FE tip (mm)  Timoshenko (mm)  ratio")
-    for etype in ("C3D8I", "C3D8"):
+    for etype in ("C3D8I", "C3D8", "C3D8R"):
         for ratio in (100.0, 1000.0):
             fe, beam = check(etype, ratio)
             print(f"{etype:7s} {ratio:6.0f}   {1e3 * fe:10.4f}   {1e3 * beam:14.4f}   {fe / beam:5.3f}")
