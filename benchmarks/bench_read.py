@@ -313,6 +313,7 @@ from fepost.resample import resample
 from fepost.moments import moments
 from fepost.polar import PolarGrid
 from fepost.coefficients import coefficients_from_moments
+from fepost.refine import refined_map
 _warm_up()
 lap("parent: import the pipeline (child reads meanwhile)")
 sf, child, sent = pending.result()
@@ -325,8 +326,10 @@ with threadpool_limits(limits=1, user_api="blas"):
     sm = resample(sp, PolarGrid.make(), radius=sp.r_max)
     lap("parent: resample")
     smo = moments(sm)
+    sm, smo = refined_map(sp, sm, smo)
+    lap("parent: moments, refinement check (fepost.refine)")
     coef = coefficients_from_moments(smo, None, friction=0.3)
-    lap("parent: moments, coefficients")
+    lap("parent: coefficients")
 from fepost.analysis import Analysis
 text = cli.format_analysis(Analysis(sf, sp, sm, smo, coef, None, None, None, None))
 lap("parent: format the output (generalised model summary)")

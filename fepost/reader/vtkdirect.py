@@ -237,12 +237,12 @@ def _decode_piece(fmt, data, piece, suffix, field, displacement) -> tuple[Part, 
         wanted = [a for a in piece.arrays if a.section in _CELL_SECTIONS or a.section == "Points"]
         wanted += [a for n, a in point_arrays.items() if keep is None or n in keep]
         wanted += list(cell_arrays.values())
-        jobs = {id(a): _Job(fmt, data, a) for a in wanted}
+        jobs = {id(a): _Job(fmt, data, a, lead=_is_offsets(a)) for a in wanted}
         for job in sorted(jobs.values(), key=lambda j: -len(j.out)):
             job.start(pool)  # the largest first: the two threads finish together
 
-        def decode(arr: DataArray) -> np.ndarray:
-            return jobs[id(arr)].result()
+        def decode(arr: DataArray, lead: bool = False) -> np.ndarray | None:
+            return jobs[id(arr)].led() if lead else jobs[id(arr)].result()
 
         points = decode(points_arrays[0]) if npts else np.empty(0)
         points = np.asarray(points, float).reshape(npts, 3)
@@ -280,11 +280,19 @@ def _section(piece, section: str) -> dict[str, DataArray]:
     return {a.attrs.get("Name", ""): a for a in piece.arrays if a.section == section}
 
 
+def _is_offsets(arr: DataArray) -> bool:
+    """Whether ``arr`` is the offsets array of a cell section (decoded after a 0: `_Job`)."""
+    return arr.section in _CELL_SECTIONS and arr.attrs.get("Name") == "offsets"
+
+
 def _cell_arrays(piece, section: str, decode, count: int) -> tuple[np.ndarray, np.ndarray]:
     """(offsets (count + 1), connectivity) of one cell section."""
     arrays = _section(piece, section)
     if "offsets" not in arrays or "connectivity" not in arrays:
         raise _NotHere
+    led = decode(arrays["offsets"], lead=True)  # 64-bit offsets: inflated after a 0, no copy
+    if led is not None and led.dtype == np.int64 and len(led) == count + 1:
+        return led, np.asarray(decode(arrays["connectivity"]), np.int64)
     ends = np.asarray(decode(arrays["offsets"]), np.int64)
     off = np.empty(count + 1, np.int64)
     off[0] = 0
@@ -327,16 +335,20 @@ class _Job:
     starting each array's blocks as soon as its base64 was decoded measured no faster.
     """
 
-    def __init__(self, fmt: _Format, data, arr: DataArray):
+    def __init__(self, fmt: _Format, data, arr: DataArray, lead: bool = False):
         self.fmt, self.name = fmt, arr.attrs.get("Name") or arr.section or "?"
         self.dtype = np.dtype(NUMPY_TYPES[arr.attrs["type"]]).newbyteorder(fmt.endian)
+        # ``lead``: one zero value before the array's own, where that needs no conversion (the
+        # cell offsets of an XML file are the ends of the cells: VTK's offsets start with 0)
+        self.lead = self.dtype.itemsize if lead and self.dtype.isnative else 0
         words, body = self._payload(data, arr)
         self.tasks: list = []
         self.runs: list = []
         if fmt.inflate is None:
-            self.out = _plain(fmt, words, body, self.name)
+            self.full = _plain(fmt, words, body, self.name, self.lead)
         else:
-            self.out, self.runs = _inflation(fmt, words, body, self.name)
+            self.full, self.runs = _inflation(fmt, words, body, self.name, self.lead)
+        self.out = self.full[self.lead :]
 
     def start(self, pool: ThreadPoolExecutor | None = None) -> _Job:
         """Inflate the blocks: on ``pool``, or here and now without one."""
@@ -385,6 +397,12 @@ class _Job:
             )
         values = out.view(self.dtype)
         return values if self.dtype.isnative else values.astype(self.dtype.newbyteorder("="))
+
+    def led(self) -> np.ndarray | None:
+        """0 and then the values (`result` checked), or None when the job was made without
+        room for the 0 (``lead``)."""
+        self.result()
+        return self.full.view(self.dtype) if self.lead else None
 
 
 def _values(fmt: _Format, data, arr: DataArray) -> np.ndarray:
@@ -491,20 +509,23 @@ def _raw_payload(fmt: _Format, data, start: int, name: str) -> tuple[tuple[int, 
     return words, memoryview(data)[body : body + sum(words[3:])]
 
 
-def _plain(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str) -> np.ndarray:
+def _plain(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str, lead: int = 0) -> np.ndarray:
+    """The buffer of an uncompressed array: ``lead`` zero bytes, then its ``words[0]`` bytes."""
     if len(body) < words[0]:
         raise InputFileError(f"{fmt.path}: array {name!r}: truncated data")
-    out = fresh_array(words[0], np.uint8)
-    out[:] = np.frombuffer(body, np.uint8, count=words[0])
+    out = fresh_array(lead + words[0], np.uint8)
+    out[lead:] = np.frombuffer(body, np.uint8, count=words[0])
     return out
 
 
-def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str):
-    """(the output buffer, the functions that inflate the blocks into it, `_BATCH` blocks each)."""
+def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str, lead: int = 0):
+    """(the output buffer, ``lead`` zero bytes and then the inflated bytes, and the functions
+    that inflate the blocks into it, `_BATCH` blocks each)."""
     nblocks, block, last = words[0], words[1], words[2]
     sizes = words[3:]
     total = 0 if nblocks == 0 else (nblocks - 1) * block + (last or block)
-    out = fresh_array(total, np.uint8)  # a forked reader's pages are all new: huge pages
+    whole = fresh_array(lead + total, np.uint8)  # a forked reader's pages are all new: huge pages
+    out = whole[lead:]
     starts = np.concatenate(([0], np.cumsum(sizes, dtype=np.int64))).tolist()
     if starts[-1] > len(body):
         raise InputFileError(f"{fmt.path}: array {name!r}: compressed data shorter than its header says")
@@ -528,7 +549,7 @@ def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str
                 )
             out[i * block : i * block + want] = np.frombuffer(got, np.uint8)
 
-    return out, [partial(run, i, min(i + _BATCH, nblocks)) for i in range(0, nblocks, _BATCH)]
+    return whole, [partial(run, i, min(i + _BATCH, nblocks)) for i in range(0, nblocks, _BATCH)]
 
 
 # ----------------------------------------------------------------------------- arrays decoded later
