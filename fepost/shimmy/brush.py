@@ -103,6 +103,12 @@ class BrushTire:
         """Half the patch length along x (m): the brush's relaxation length to first order."""
         return 0.5 * self.h * (int(np.max(self._row_position())) + 1)
 
+    def slip_stiffness(self) -> float:
+        """C_κ (N): the steady longitudinal force per unit slip of small slips, every element sticking,
+        Σ k_xi h (m_i + 1) with m_i the element's place in its row from the leading edge (the steady
+        march's e_i = −h (m_i + 1) κ / (1 − κ), κ → 0)."""
+        return float(np.sum(self.kx * self.h * (self._row_position() + 1)))
+
     def _row_position(self) -> np.ndarray:
         pos = np.zeros(self.n, int)
         for i in range(self.n):
@@ -226,6 +232,16 @@ class BrushTire:
     def dissipation(self, ex, ey, lam, scale: float = 1.0) -> float:
         """Power of the sliding elements (W): Σ |F_i| λ_i (|F_i| = s f n_i on the limit)."""
         return float(scale * (np.hypot(self.kx * ex, self.ky * ey) * lam).sum())
+
+    def released(self, ex, ey, vr: float) -> float:
+        """Power of the transport term (W, at the full load): Σ F_i · V_r (e_ahead − e_i)/h (the tread
+        leaving the patch)."""
+        ax, ay = self.ahead_deflections(ex, ey)
+        return float(vr / self.h * np.sum(self.kx * ex * (ax - ex) + self.ky * ey * (ay - ey)))
+
+    def on_limit(self, ex, ey) -> np.ndarray:
+        """Mask of the elements at their friction limit (|F_i| at f n_i to `ON_LIMIT`)."""
+        return np.hypot(self.kx * ex, self.ky * ey) >= (1 - ON_LIMIT) * self.limit
 
     def steady(self, vx: float, vy: float, wz: float, vr: float) -> tuple[np.ndarray, np.ndarray]:
         """The elements' steady deflections (ex, ey) at a constant slip (the rates' fixed point).

@@ -26,9 +26,17 @@ model they enter):
 ``tire_stiffness_x``     N/m       the tire's tangential stiffness against the road, along x
 ``tire_stiffness_y``     N/m       … along y (the brush tire, `fepost.shimmy.brush`)
 ``tire_deflection``      m         the tire's vertical deflection under its full load (touchdown)
+``tread_slip_stiffness`` –         C_κ/N of the tread alone: with it the tire is the brush on a
+                                   carcass (`fepost.shimmy.carcass`), its elements calibrated to
+                                   this slip stiffness, the carcass what is left of the standstill
+                                   stiffness (0: the lumped brush)
+``tire_stiffness_z``     N m/rad   the tire's standstill torsional stiffness about the patch centre
+                                   (with ``tread_slip_stiffness``: the carcass's torsion; 0: rigid)
 =======================  ========  ==============================================
 
-The last three serve the gripping tire and the touchdown (`fepost.shimmy.touchdown`).
+The tire's stiffnesses and deflection serve the gripping tire and the touchdown
+(`fepost.shimmy.touchdown`); ``tread_slip_stiffness`` and ``tire_stiffness_z`` (optional,
+0 when absent: the lumped brush as before) put its tread on a carcass.
 The four before them are optional and default to 0, which leaves the equations as they
 were (no gyroscopic coupling, vertical strut). With them the wheels' spin couples
 yaw and lateral bending gyroscopically, G = s Σ I_w Ω (`fepost.shimmy.equations`),
@@ -80,6 +88,8 @@ ADDED: dict[str, tuple[str, bool]] = {
     "tire_stiffness_x": ("N/m", True),
     "tire_stiffness_y": ("N/m", True),
     "tire_deflection": ("m", True),
+    "tread_slip_stiffness": ("", True),
+    "tire_stiffness_z": ("N m/rad", True),
 }
 ALL_PARAMETERS = {**PARAMETERS, **ADDED}
 #: Optional keys besides the parameters.
@@ -122,6 +132,8 @@ class Gear:
     tire_stiffness_x: float = 0.0
     tire_stiffness_y: float = 0.0
     tire_deflection: float = 0.0
+    tread_slip_stiffness: float = 0.0
+    tire_stiffness_z: float = 0.0
     name: str = ""
     sources: Any = field(default_factory=dict)
     notes: str = ""

@@ -32,12 +32,13 @@ part of its eigenvalues.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import ArgumentError
-from .brush import ON_LIMIT, BrushTire
+from .brush import BrushTire
+from .carcass import CarcassTire
 from .gear import Gear
 
 #: Work integrals appended with ``energy`` (J).
@@ -49,7 +50,7 @@ class GripModel:
     """The gear on brush tires (module docstring)."""
 
     gear: Gear
-    tire: BrushTire
+    tire: BrushTire | CarcassTire
     spin: bool = False
     energy: bool = False
     crab: float = 0.0
@@ -111,7 +112,7 @@ class GripModel:
                 forward += V * (fx * c - fy * s)
                 if self.energy:
                     sliding += tire.dissipation(ex, ey, lam, scale)
-                    released += scale * _released(tire, ex, ey, vr)
+                    released += scale * tire.released(ex, ey, vr)
                     entering += growth * tire.energy(ex, ey, scale)
                 if self.spin:
                     spin_sum += spins[j]
@@ -181,14 +182,14 @@ class GripModel:
     def jacobian(self, V: float, X0: np.ndarray | None = None) -> np.ndarray:
         """∂f/∂X at the steady state (central differences, steps scaled by the states' sizes)."""
         X0 = self.steady_state(V) if X0 is None else X0
-        f = self.rhs(V)
+        f = self._sliding_branch(X0).rhs(V)
         n = X0.size
         typical = np.full(n, max(float(np.max(np.abs(X0[4:]), initial=0.0)), 1e-6))
         typical[:4] = 1e-3
         steps = 1e-6 * np.maximum(np.abs(X0), typical)
         jac = np.empty((n, n))
         f0 = f(0.0, X0)
-        outward = self._on_limit(X0)
+        outward = self._on_limit(X0) if isinstance(self.tire, BrushTire) else np.zeros(n, bool)
         for k in range(n):
             h = steps[k]
             xp = X0.copy()
@@ -202,12 +203,24 @@ class GripModel:
             jac[:, k] = (f(0.0, xp) - f(0.0, xm)) / (2 * h)
         return jac
 
+    def _sliding_branch(self, X0) -> GripModel:
+        """The model whose carcass tire keeps the elements sliding at ``X0`` on their sliding branch
+        (`fepost.shimmy.carcass.CarcassTire.frozen_at`): a step on any element moves the carcass and
+        with it every element, so the lumped brush's one-sided steps cannot keep the branch."""
+        if not isinstance(self.tire, CarcassTire):
+            return self
+        masks = [self.tire.on_limit(ex, ey) for ex, ey in self.blocks(X0)[2]]
+        if any(not np.array_equal(m, masks[0]) for m in masks[1:]):
+            raise ArgumentError(
+                "the wheels slide on different elements: no common sliding branch to linearise"
+            )
+        return replace(self, tire=self.tire.frozen_at(masks[0]))
+
     def _on_limit(self, X) -> np.ndarray:
         """Mask of the states that are sliding elements' deflections (|F_i| at f n_i to 1e-9)."""
         mask = np.zeros(X.size, bool)
-        t = self.tire
         for (ex, ey), (mask_x, mask_y) in zip(self.blocks(X)[2], self.blocks(mask)[2], strict=True):
-            mask_x[:] = mask_y[:] = np.hypot(t.kx * ex, t.ky * ey) >= (1 - ON_LIMIT) * t.limit
+            mask_x[:] = mask_y[:] = self.tire.on_limit(ex, ey)
         return mask
 
     def eigenvalues(self, V: float) -> np.ndarray:
@@ -217,9 +230,3 @@ class GripModel:
     def growth_rate(self, V: float) -> float:
         """Largest real part of the eigenvalues (1/s)."""
         return float(np.max(self.eigenvalues(V).real))
-
-
-def _released(tire: BrushTire, ex, ey, vr: float) -> float:
-    """Power of the transport term (W): Σ F_i · V_r (e_ahead − e_i)/h (the tread leaving the patch)."""
-    ax, ay = tire.ahead_deflections(ex, ey)
-    return float(vr / tire.h * np.sum(tire.kx * ex * (ax - ex) + tire.ky * ey * (ay - ey)))

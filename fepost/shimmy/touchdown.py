@@ -43,6 +43,7 @@ import numpy as np
 
 from ..errors import ArgumentError
 from .brush import BrushTire
+from .carcass import CarcassTire
 from .gear import Gear
 from .gripping import GripModel
 
@@ -119,9 +120,32 @@ def check_gear(gear: Gear, where: str = "gear") -> None:
             )
 
 
-def touchdown_tire(gear: Gear, quad, f: float, **grid) -> BrushTire:
-    """The brush tire of the gear's stiffness over the pressure quadrature ``quad``."""
+def touchdown_tire(gear: Gear, quad, f: float, **grid) -> BrushTire | CarcassTire:
+    """The brush tire of the gear's stiffness over the pressure quadrature ``quad``: with the gear's
+    ``tread_slip_stiffness`` the tread on a carcass (`fepost.shimmy.carcass.CarcassTire`; torsion
+    with ``tire_stiffness_z``), else the lumped brush."""
     check_gear(gear)
+    if gear.tread_slip_stiffness > 0:
+        try:
+            return CarcassTire.from_quadrature(
+                quad,
+                f=f,
+                standstill=(gear.tire_stiffness_x, gear.tire_stiffness_y, gear.tire_stiffness_z),
+                slip_stiffness=gear.tread_slip_stiffness,
+                blend=BLEND,
+                provenance={
+                    key: gear.sources.get(key, "")
+                    for key in (
+                        "tire_stiffness_x",
+                        "tire_stiffness_y",
+                        "tire_stiffness_z",
+                        "tread_slip_stiffness",
+                    )
+                },
+                **grid,
+            )
+        except ArgumentError as exc:
+            raise ArgumentError(f"gear: tread_slip_stiffness and the tire's stiffness: {exc}") from None
     tire = BrushTire.from_quadrature(
         quad,
         f=f,
@@ -137,7 +161,7 @@ def touchdown_tire(gear: Gear, quad, f: float, **grid) -> BrushTire:
 
 def simulate_touchdown(
     gear: Gear,
-    tire: BrushTire,
+    tire: BrushTire | CarcassTire,
     speed: float,
     *,
     sink_rate: float = 1.5,
@@ -234,7 +258,9 @@ def read_touchdown(t, x, gear: Gear, speed: float, crab: float = 0.0):
     return ts, verdict, float(np.max(np.abs(psi))), tuple(amps)
 
 
-def touchdown_sweep(gear: Gear, tire: BrushTire, speeds, sink_rates=(1.5,), yaws=(0.0,), crabs=(0.0,), **kw):
+def touchdown_sweep(
+    gear: Gear, tire: BrushTire | CarcassTire, speeds, sink_rates=(1.5,), yaws=(0.0,), crabs=(0.0,), **kw
+):
     """`simulate_touchdown` over every combination (speed outermost)."""
     return [
         simulate_touchdown(gear, tire, float(v), sink_rate=float(s), yaw=float(p), crab=float(c), **kw)
