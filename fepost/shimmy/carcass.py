@@ -130,11 +130,12 @@ class CarcassTire:
     @property
     def standstill(self) -> tuple[float, float, float]:
         """The tire's standstill stiffness (K_x, K_y, K_z): tread and carcass in series, per direction."""
-        t = self._tread_totals
+        t = self.tread_totals
         return tuple(1.0 / (1.0 / k + 1.0 / kt) for k, kt in zip(self.carcass, t, strict=True))  # type: ignore[return-value]
 
     @cached_property
-    def _tread_totals(self) -> tuple[float, float, float]:
+    def tread_totals(self) -> tuple[float, float, float]:
+        """The tread's own stiffness K_t: Σ k_xi, Σ k_yi (N/m) and Σ (k_yi x_i² + k_xi y_i²) (N m/rad)."""
         t = self.tread
         return float(t.kx.sum()), float(t.ky.sum()), float((t.ky * t.x**2 + t.kx * t.y**2).sum())
 

@@ -69,24 +69,28 @@ class WholeTire:
         )
 
 
-def build_up(tire, kappa: float, travel: float, points: int = 41) -> tuple[np.ndarray, np.ndarray]:
+def build_up(
+    tire, kappa: float, travel: float, points: int = 41, side: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
     """(X, Fx) of the tire rolled from rest at the slip ``kappa`` (against the rolling speed's
-    road speed V: V_r = (1 + κ) V) over ``travel`` metres (quasi-static: the rates scale with V)."""
+    road speed V: V_r = (1 + κ) V) over ``travel`` metres (quasi-static: the rates scale with V);
+    with ``side`` (a side slip angle, rad, κ = 0) (X, Fy) of the side force's build-up instead."""
     from scipy.integrate import solve_ivp
 
     V, n = 1.0, tire.n
     vr = (1.0 + kappa) * V
 
     def rhs(_t, X):
-        dx, dy, _ = tire.rates(X[:n], X[n:], V - vr, 0.0, 0.0, vr)
+        dx, dy, _ = tire.rates(X[:n], X[n:], V - vr, side * V, 0.0, vr)
         return np.concatenate([dx, dy])
 
     xs = np.linspace(0.0, travel, points)
     sol = solve_ivp(
         rhs, (0.0, travel / V), np.zeros(2 * n), method="RK23", t_eval=xs / V, rtol=1e-7, atol=1e-12
     )
-    fx = np.array([tire.resultants(sol.y[:n, k], sol.y[n:, k])[0] for k in range(xs.size)])
-    return xs, fx
+    axis = 1 if side else 0
+    force = np.array([tire.resultants(sol.y[:n, k], sol.y[n:, k])[axis] for k in range(xs.size)])
+    return xs, force
 
 
 def first_order(x, fx) -> tuple[float, float]:
@@ -106,7 +110,8 @@ def fe_lines(whole: WholeTire, grid=(16, 6)) -> list[str]:
         f"standstill K_x, K_y, K_z = {whole.standstill[0]:.4g} N/m, {whole.standstill[1]:.4g} N/m, "
         f"{whole.standstill[2]:.4g} N m/rad; tread {ct.provenance['tread_stiffness']}",
         f"carcass K_cx, K_cy, K_cz = {kc[0]:.4g} N/m, {kc[1]:.4g} N/m, {kc[2]:.4g} N m/rad; "
-        f"tread K_t = {ct.tread.kx.sum():.4g} N/m; grid {grid[0]} x {grid[1]}, a = {ct.half_length:.3f} m",
+        f"tread K_t = {ct.tread_totals[0]:.4g} N/m, {ct.tread_totals[2]:.4g} N m/rad; "
+        f"grid {grid[0]} x {grid[1]}, a = {ct.half_length:.3f} m",
     ]
     V, kap = 1.0, FE_SLIP
     for name, tire in (("carcass", ct), ("lumped", lump)):
@@ -115,10 +120,13 @@ def fe_lines(whole: WholeTire, grid=(16, 6)) -> list[str]:
         x, f = build_up(tire, kap, FE_TRAVEL)
         sigma, f_inf = first_order(x, f / tire.load)
         ca = -tire.resultants(*tire.steady(0.0, 1e-4 * V, 0.0, V))[1] / 1e-4 / tire.load
+        xs, fy = build_up(tire, 0.0, 5 * FE_TRAVEL, points=81, side=1e-4)
+        sigma_y = first_order(xs, fy / tire.load)[0]
         out.append(
             f"{name}: C_kappa/N {c_k:.2f}, steady Fx/N at kappa {kap:+.4f} {fx:+.4f} (FE {FE_FORCE:+.3f}), "
-            f"build-up over {FE_TRAVEL:g} m: sigma {sigma:.3f} m (FE {FE_SIGMA:.2f}), F_inf/N {f_inf:+.4f}, "
-            f"C_alpha/N {ca:.2f}"
+            f"build-up over {FE_TRAVEL:g} m: sigma {sigma:.3f} m (FE {FE_SIGMA:.2f}), F_inf/N {f_inf:+.4f}; "
+            f"C_alpha/N {ca:.2f}, side force's build-up at 1e-4 rad over {5 * FE_TRAVEL:g} m: "
+            f"sigma_y {sigma_y:.3f} m"
         )
     return out
 
@@ -141,9 +149,16 @@ def gripping_lines(whole: WholeTire, grid=(16, 6), speeds=tuple(range(20, 151, 1
         g = gear.replace(slip_ratio=kap)
         rigid = Linearisation.of(g, lump.sliding_contact())
         gr = np.array([rigid.growth(float(V))[0] for V in speeds])
-        line = f"slip {kap:g}: rigid sliding wheel max growth {gr.max():+.2f} 1/s" + (
-            f", unstable from {speeds[int(np.argmax(gr > 0))]} m/s" if np.any(gr > 0) else ""
-        )
+        line = f"slip {kap:g}: rigid sliding wheel max growth {gr.max():+.2f} 1/s"
+        if np.any(gr > 0):
+            from scipy.optimize import brentq
+
+            k = int(np.argmax(gr > 0))
+            if k > 0:
+                onset = brentq(lambda v, r=rigid: r.growth(v)[0], speeds[k - 1], speeds[k], xtol=0.01)
+                line += f", unstable above {onset:.1f} m/s"
+            else:
+                line += f", unstable from {speeds[0]} m/s"
         for name, tire in tires.items():
             rates = [GripModel(g, tire).growth_rate(float(V)) for V in speeds]
             k = int(np.argmax(rates))
