@@ -292,3 +292,41 @@ def test_slide_load_loss_is_the_released_friction_lock_in():
     assert n0 == pytest.approx(frictionless, rel=5e-4)
     assert load("static.json") / frictionless - 1 == pytest.approx(0.0112, abs=5e-4)
     assert c * 0.3**2 / frictionless == pytest.approx(-0.0026, abs=5e-4)
+
+
+#: the band under the patch's lateral edges: none (all C3D8I, the first whole-fine base), plain C3D8
+#: (the programme's) and C3D8R (``whole-fine-r``); the same mesh, deck and deflection otherwise
+BAND_SERIES = {"C3D8I": "all-c3d8i", "C3D8": ".", "C3D8R": "band-c3d8r"}
+
+
+@pytest.mark.skipif(not WHOLE.is_dir(), reason="meshes/rig-tire360/ not committed")
+def test_band_element_moves_the_integrals_little_and_the_edge_pressure_much():
+    """What the band's element does to the static map (docs/rig.md): the load rises by 0.55 %
+    (C3D8R) and 1.76 % (C3D8, which locks) over all-C3D8I, and the coefficients without R by
+    at most 1.2 %; the pressure at the patch's lateral edge is the band's own: C3D8 moves the
+    largest nodal pressure 23 mm outwards at the same value, C3D8R lowers it by 10.5 %."""
+    import meshio
+
+    from fepost.analysis import analyse
+
+    maps = {k: WHOLE / sub / "static.vtu" for k, sub in BAND_SERIES.items()}
+    missing = [str(p) for p in maps.values() if not p.is_file()]
+    assert not missing, f"committed band maps missing: {missing}"
+    coef = {k: analyse(p).coefficients for k, p in maps.items()}
+    ref = coef["C3D8I"]
+    assert coef["C3D8R"].N / ref.N - 1 == pytest.approx(0.0055, abs=5e-4)
+    assert coef["C3D8"].N / ref.N - 1 == pytest.approx(0.0176, abs=5e-4)
+    for k in ("C3D8", "C3D8R"):
+        c = coef[k]
+        assert c.a * c.R**2 == pytest.approx(ref.a * ref.R**2, rel=0.013)
+        assert c.m / c.R**2 == pytest.approx(ref.m / ref.R**2, rel=0.013)
+        assert c.b1 / c.N == pytest.approx(ref.b1 / ref.N, rel=0.013)
+    peak = {}
+    for k, p in maps.items():
+        m = meshio.read(p)
+        cp = m.point_data["CPRESS"]
+        i = int(np.argmax(cp))
+        peak[k] = (float(cp[i]), abs(float(m.points[i, 1] + m.point_data["displacement"][i, 1])))
+    assert peak["C3D8"][0] == pytest.approx(peak["C3D8I"][0], rel=0.01)
+    assert peak["C3D8"][1] - peak["C3D8I"][1] == pytest.approx(0.023, abs=0.002)
+    assert peak["C3D8R"][0] / peak["C3D8I"][0] - 1 == pytest.approx(-0.105, abs=0.003)
