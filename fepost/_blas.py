@@ -20,6 +20,11 @@ def _controller() -> ThreadpoolController:
     return ThreadpoolController()
 
 
+def warm() -> None:
+    """Make the controller now (it inspects the loaded libraries: 5-10 ms), e.g. while a file is read."""
+    _controller()
+
+
 def one_blas_thread():
     """Context manager: BLAS limited to one thread inside, its previous setting restored after."""
     return _controller().limit(limits=1, user_api="blas")

@@ -240,11 +240,15 @@ def _warm_up() -> None:
     (`Analysis.model_summary`, in `Analysis.to_dict` by default) with its error maps
     (`fepost.friction.sphere`), and what numpy imports on first use there: ``numpy.ma``
     (``np.unique``, in the model's exact integrals) and ``numpy.fft`` (the turned sums,
-    `fepost.friction.turns`): 40-60 ms that would otherwise come after the read."""
+    `fepost.friction.turns`): 40-60 ms that would otherwise come after the read; and the
+    BLAS controller the pipeline's `one_blas_thread` needs (5-10 ms)."""
     import numpy.fft
     import numpy.ma  # noqa: F401
 
+    from . import _blas
     from .friction import sphere, summary  # noqa: F401
+
+    _blas.warm()  # the BLAS controller of `one_blas_thread`, made once per process
 
 
 def _start(src, options: AnalysisOptions) -> isolate.Pending:
