@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .brush import BrushTire, rig_stiffness
-from .carcass import CarcassTire, rig_torsional_stiffness
+from .carcass import FE_TREAD_STIFFNESS, CarcassTire, rig_torsional_stiffness
 
 #: The whole tire (issue 39): its rolling model's static partner, its rig folder, its rolling runs.
 WHOLE = Path("meshes/rig-tire360")
@@ -113,6 +113,18 @@ def fe_lines(whole: WholeTire, grid=(16, 6)) -> list[str]:
         f"tread K_t = {ct.tread_totals[0]:.4g} N/m, {ct.tread_totals[2]:.4g} N m/rad; "
         f"grid {grid[0]} x {grid[1]}, a = {ct.half_length:.3f} m",
     ]
+    rubber = CarcassTire.from_quadrature(
+        whole.quad,
+        f=whole.f,
+        standstill=whole.standstill,
+        tread_stiffness=FE_TREAD_STIFFNESS,
+        nx=grid[0],
+        ny=grid[1],
+    )
+    out.append(
+        f"the tread rubber's own G/h ({FE_TREAD_STIFFNESS:.3g} N/m^3) would give C_kappa/N = "
+        f"{rubber.tread.slip_stiffness() / rubber.load:.2f} on this binned map"
+    )
     V, kap = 1.0, FE_SLIP
     for name, tire in (("carcass", ct), ("lumped", lump)):
         c_k = (ct.tread if isinstance(tire, CarcassTire) else tire).slip_stiffness() / tire.load
