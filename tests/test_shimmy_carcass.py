@@ -296,6 +296,8 @@ def test_gear_keys_are_optional_and_refused_when_impossible(whole, tmp_path, cap
         CarcassTire(whole.lumped(4, 2), (1.0, -1.0, math.inf))
     with pytest.raises(ArgumentError, match="standstill K_y must be positive"):
         carcass_from_standstill(whole.lumped(4, 2), (1.0, 0.0))
+    with pytest.raises(ArgumentError, match="sliding: a mask of 24 elements expected"):
+        whole.carcass(8, 3).frozen_at(np.ones(3, bool))
     # the command: an impossible carcass is one line, exit 2, nothing written
     data = json.loads(Path(GEAR).read_text())
     data.update(tread_slip_stiffness=0.5, tire_stiffness_z=9.249e4)

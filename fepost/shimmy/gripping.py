@@ -27,6 +27,12 @@ to the integrator's tolerance.
 linearisation (central differences on the equations; the element states are
 smooth there away from the stick-slip boundary), `growth_rate` the largest real
 part of its eigenvalues.
+
+The tire may be the brush on a carcass (`fepost.shimmy.carcass.CarcassTire`): its
+element states are then the total deflections (tread and carcass), its elastic
+energy includes the carcass's, and its linearisation holds the steady state's
+sliding elements on their sliding branch (a step on one element moves the carcass
+and every element with it).
 """
 
 from __future__ import annotations

@@ -15,6 +15,10 @@ catches up with the road, then grips. Strut torsion and lateral bending respond
 through the gear's equations, with the wheels' gyroscopic coupling where the gear
 file gives ``bending_slope``.
 
+With the gear's ``tread_slip_stiffness`` the tire is the brush on a carcass
+(`fepost.shimmy.carcass.CarcassTire`, `touchdown_tire`), whose carcass springs grow
+with the load like its tread.
+
 Integration: scipy's ``solve_ivp`` (`METHOD`, rtol `RTOL`; the stick-slip switch blended
 over `BLEND` of the friction limit) with the work integrals
 of `fepost.shimmy.gripping` alongside, so the energy balance is checked on every
