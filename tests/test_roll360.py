@@ -407,3 +407,17 @@ def test_table_of_the_committed_runs():
             assert 0.5 < fit.sigma < 3.0 and fit.sigma_se < 0.05 * fit.sigma
             assert abs(fit.f_inf) > abs(side["tail_means"]["Fx"])
     assert any(line.startswith("brush estimate") for line in lines)
+
+
+def test_traction_shift_line_through_the_maps_own_forces():
+    """k_x = k0 + c Fx/N recovered from runs whose k_x lies on the line, whatever their steadiness;
+    None where the forces do not spread."""
+    pts = [
+        results.RunPoint(f"r{i}", 1.75, 0.0, 0.0, 2.0e5, 0.3, kx=0.004 + 1.4 * fx, end_fx_over_n=fx)
+        for i, fx in enumerate((-0.15, -0.11, 0.0, 0.14))
+    ]
+    ts = results.traction_shift(pts)
+    assert ts.k0 == pytest.approx(0.004, abs=1e-12) and ts.slope == pytest.approx(1.4, rel=1e-12)
+    assert ts.rms < 1e-12 and ts.runs == ("r0", "r1", "r2", "r3")
+    assert results.traction_shift(pts[:1]) is None
+    assert results.traction_shift([dataclasses.replace(p, end_fx_over_n=0.1) for p in pts]) is None

@@ -20,6 +20,9 @@ Both are compared with ``brush_slope``, the brush estimate from the static patch
 tread rubber's stiffness (no run needed). ``relaxation_length`` fits the first-order build-up of
 each run's force along its roll (scipy's ``curve_fit``). The brush curve's inverse is closed:
 1 - theta = (1 - |Fx| / (f N))^(1/3).
+
+k_x depends on the slip through the force: ``traction_shift`` fits each run's k_x against the
+Fx/N of the same instant (the end of the roll).
 """
 
 from __future__ import annotations
@@ -54,6 +57,8 @@ class RunPoint:
     steady_fx_over_n: float = math.nan
     #: N m, the axle torque's build-up limit, likewise
     steady_torque_fit: float = math.nan
+    #: Fx/N at the end of the roll, the instant of the run's map (and of its k_x)
+    end_fx_over_n: float = math.nan
 
     @classmethod
     def from_sidecar(cls, side: dict, kx: float = math.nan, fit: BuildUp | None = None) -> RunPoint:
@@ -72,6 +77,7 @@ class RunPoint:
             kx,
             f_inf / float(tail["Fz"]),
             math.nan if torque is None else torque.f_inf,
+            float(side["longitudinal_force_ratio"]),
         )
 
     @property
@@ -98,6 +104,31 @@ class FreeRolling:
     secant_slope: float  # C_kappa / N, least-squares line of Fx/N against kappa
     brush_fit_slope: float  # C_kappa / N from the brush curve through each run
     bracketed: bool  # free rolling lies between the runs' turn rates (no extrapolation)
+
+
+@dataclass(frozen=True)
+class TractionShift:
+    """k_x against the map's own longitudinal force: k_x = k0 + slope Fx/N (least squares)."""
+
+    k0: float
+    slope: float
+    rms: float  # of the residuals
+    runs: tuple[str, ...]
+
+
+def traction_shift(points: list[RunPoint]) -> TractionShift | None:
+    """The line of each run's k_x against its Fx/N at the same instant (the end of the roll), over
+    every run with both; None with fewer than two distinct forces. A map and its force belong
+    together whether the run is steady or not, so the line holds for building-up runs too: it is
+    how k_x depends on the slip, through the force the slip curve gives."""
+    use = [p for p in points if math.isfinite(p.kx) and math.isfinite(p.end_fx_over_n)]
+    x = np.array([p.end_fx_over_n for p in use])
+    if len(use) < 2 or np.ptp(x) <= 0:
+        return None
+    y = np.array([p.kx for p in use])
+    slope, k0 = np.polyfit(x, y, 1)
+    rms = float(np.sqrt(np.mean((y - (k0 + slope * x)) ** 2)))
+    return TractionShift(float(k0), float(slope), rms, tuple(p.name for p in use))
 
 
 def brush_theta(force_ratio: float) -> float:
@@ -284,6 +315,12 @@ def table(out: Path, kx: bool = True, rig: Path | None = None) -> list[str]:
             f"slip curve: C_kappa/N = {fr.secant_slope:.2f} (least-squares line), "
             f"{fr.brush_fit_slope:.2f} (each run through the brush curve, f = {points[0].friction:g})",
         ]
+        ts = traction_shift(points)
+        if ts is not None:
+            lines.append(
+                f"k_x against each map's own Fx/N (end of roll): k_x = {ts.k0:+.4f} {ts.slope:+.3f} Fx/N "
+                f"(rms {ts.rms:.4f} over {', '.join(ts.runs)})"
+            )
         if rig is not None and any(math.isfinite(v) for v in sig):
             from fepost.shimmy.brush import rig_stiffness
 
