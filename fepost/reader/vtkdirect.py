@@ -103,6 +103,8 @@ _INFLATE: dict[str, Callable[[Any, int], bytes]] = {
 _FORMATS = {".vtu": "VTK XML (.vtu)", ".vtp": "VTK XML (.vtp)"}
 #: Blocks inflated per thread task (a compressed array of more blocks is shared by two threads).
 _BATCH = 64
+#: Compressed blocks up to this size (bytes) are inflated once per distinct content (`_inflation`).
+_SAME_MAX = 1024
 _SPACE = b" \t\r\n"
 _CELL_SECTIONS = ("Cells", *(name for name, _ in POLY_SECTIONS))
 
@@ -531,10 +533,18 @@ def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str
         raise InputFileError(f"{fmt.path}: array {name!r}: compressed data shorter than its header says")
     inflate = fmt.inflate
     assert inflate is not None
+    # inflating is a function of the compressed bytes: a small compressed block (a run of one
+    # value, as the cell types of a mesh of one cell type) met again is copied, not inflated
+    seen: dict[tuple[bytes, int], np.ndarray] = {}
 
     def run(first: int, stop: int) -> None:
         for i in range(first, stop):
             want = block if i < nblocks - 1 or not last else last
+            key = (bytes(body[starts[i] : starts[i + 1]]), want) if sizes[i] <= _SAME_MAX else None
+            again = seen.get(key) if key is not None else None
+            if again is not None:
+                out[i * block : i * block + want] = again
+                continue
             try:
                 got = inflate(body[starts[i] : starts[i + 1]], want)
             except (zlib.error, ZLIB.error, lzma.LZMAError, ValueError, EOFError):
@@ -548,6 +558,8 @@ def _inflation(fmt: _Format, words: tuple[int, ...], body: memoryview, name: str
                     f"its header says {want}"
                 )
             out[i * block : i * block + want] = np.frombuffer(got, np.uint8)
+            if key is not None:
+                seen[key] = np.frombuffer(got, np.uint8)
 
     return whole, [partial(run, i, min(i + _BATCH, nblocks)) for i in range(0, nblocks, _BATCH)]
 
