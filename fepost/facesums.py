@@ -220,8 +220,10 @@ def _polar_terms(c: np.ndarray, a: np.ndarray, d2: np.ndarray, location: str, ne
     2A |P| / 24; with σ constant it is the centroid Σ x_k / 3."""
     if location == "point":
         vs = _rows(c[_P])
-        t = c[_P] + vs
-        px, py = _rows(t * c[_X]), _rows(t * c[_Y])
+        px = np.einsum("ij,ij->j", c[_P], c[_X])  # Σ σ_k x_k, then + Σσ Σx
+        px += vs * _rows(c[_X])
+        py = np.einsum("ij,ij->j", c[_P], c[_Y])
+        py += vs * _rows(c[_Y])
         scale = 4.0 * vs  # r̄ = |P| / scale
         load = a * vs
         load /= 6.0
