@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ._arrays import sealed
+from ._chunks import map_chunks, slices
 from .field import ContactField
 from .reader import quadratic
 
@@ -25,6 +26,8 @@ from .reader import quadratic
 #: faces at the rim of the sample tire patches lean up to 14 deg; the sides of a block, 90 deg; the
 #: slanted face of a corner tetrahedron, 55 deg.
 STEEP_DEG = 45.0
+#: Faces per chunk of the loaded-face test (its temporaries stay in the cache).
+ROW_CHUNK = 1 << 16
 
 
 @dataclass(frozen=True)
@@ -68,14 +71,8 @@ def loaded_groups(fld: ContactField, v: np.ndarray, thr: float) -> list[FaceGrou
     hot = v > thr if fld.location == "point" else None
     for ftype, conn, sl in fld.face_groups():
         if hot is not None:
-            h = hot[conn[:, 0]]
-            loaded, full = h.copy(), h
-            for k in range(1, conn.shape[1]):
-                h = hot[conn[:, k]]
-                loaded |= h
-                full &= h
+            loaded, partial = _loaded_rows(hot, conn)
             fv = None
-            partial = ~full
         else:
             fv = v[sl]
             loaded = fv > thr
@@ -88,6 +85,26 @@ def loaded_groups(fld: ContactField, v: np.ndarray, thr: float) -> list[FaceGrou
             # a new array no caller holds: sealed, so the patch shares it instead of copying
             out.append(FaceGroup(ftype, sealed(conn[loaded]), sub, ids, partial[loaded]))
     return out
+
+
+def _loaded_rows(hot: np.ndarray, conn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(some node hot, not every node hot) per face of ``conn``, in chunks of `ROW_CHUNK`
+    faces shared by two threads (`fepost._chunks`)."""
+
+    def chunk(sl: slice) -> tuple[np.ndarray, np.ndarray]:
+        c = conn[sl]
+        h = hot[c[:, 0]]
+        loaded, full = h.copy(), h
+        for k in range(1, c.shape[1]):
+            h = hot[c[:, k]]
+            loaded |= h
+            full &= h
+        return loaded, ~full
+
+    parts = map_chunks(chunk, slices(len(conn), ROW_CHUNK))
+    if len(parts) <= 1:
+        return parts[0] if parts else (np.zeros(0, bool), np.zeros(0, bool))
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
 
 def _steep(points: np.ndarray, corners: np.ndarray, normal: np.ndarray, cos_max: float) -> np.ndarray:

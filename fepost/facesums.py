@@ -315,13 +315,12 @@ def load_outside(
     far = R2 > rad2  # a face reaches past the circle when a corner does (one byte per node: cached gathers)
     if not far.any():
         return 0.0
-    reach = []
-    for sl in slices(len(tri), CHUNK):
+
+    def reaching(sl: slice) -> np.ndarray:
         f = far[tri[sl]]
-        hit = np.flatnonzero(f[:, 0] | f[:, 1] | f[:, 2])
-        if hit.size:
-            reach.append(hit + sl.start)
-    faces = np.concatenate(reach)
+        return np.flatnonzero(f[:, 0] | f[:, 1] | f[:, 2]) + sl.start
+
+    faces = np.concatenate(map_chunks(reaching, slices(len(tri), 8 * CHUNK)))  # in face order
     out = 0.0
     for part in slices(len(faces), CHUNK):
         idx = faces[part]
