@@ -401,6 +401,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             return BROKEN_PIPE
 
 
+#: Whether this process is the ``fepost`` command (`console_main`) rather than a program calling
+#: `main`: a command may then tune the process for its one run
+#: (`fepost.cli.coefficients.warm_heap`).
+WHOLE_PROCESS = False
+
 #: Environment variable OpenBLAS (numpy's and scipy's BLAS) reads its thread count from, once,
 #: when it loads.
 BLAS_THREADS_ENV = "OPENBLAS_NUM_THREADS"
@@ -416,6 +421,8 @@ def console_main() -> None:
     1.08 M-node surface map they took about 0.15 s of the process's CPU time
     (benchmarks/bench_read.py)."""
     os.environ.setdefault(BLAS_THREADS_ENV, "1")
+    global WHOLE_PROCESS
+    WHOLE_PROCESS = True
     status = main()
     try:
         sys.stdout.flush()

@@ -150,6 +150,7 @@ def _size(path: str) -> int:
 
 def run(args: argparse.Namespace) -> int:
     from ..reader import start_reading
+    from . import WHOLE_PROCESS
 
     options = analysis_options(args)
     # the files are read in their children while the pipeline's modules are imported
@@ -160,7 +161,8 @@ def run(args: argparse.Namespace) -> int:
         from ..analysis import analyse
         from ..output import write_json_atomic  # imported while the files are read (10-30 ms)
 
-        warm_heap(min(WARM_HEAP, _size(args.static)))
+        if WHOLE_PROCESS:  # not in a program that calls `main`: its malloc keeps its own ways
+            warm_heap(min(WARM_HEAP, _size(args.static)))
         result = analyse(*pending, friction=args.friction, options=options)
     finally:
         for p in pending:
