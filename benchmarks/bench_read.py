@@ -316,6 +316,9 @@ from fepost.coefficients import coefficients_from_moments
 from fepost.refine import refined_map
 _warm_up()
 lap("parent: import the pipeline (child reads meanwhile)")
+from fepost.cli.coefficients import WARM_HEAP, warm_heap
+warm_heap(min(WARM_HEAP, path.stat().st_size))
+lap("parent: fault in the heap (child reads meanwhile)")
 sf, child, sent = pending.result()
 got = time.time()
 lap("parent: wait for the child's answer")
