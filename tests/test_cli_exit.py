@@ -28,6 +28,7 @@ def ends(monkeypatch):
         raise _Exited("os._exit", status)
 
     monkeypatch.setattr(cli.os, "_exit", quick)
+    monkeypatch.setattr(cli, "WHOLE_PROCESS", False)  # console_main sets it: restored afterwards
     monkeypatch.setattr("atexit._run_exitfuncs", lambda: events.append("atexit"))
 
     def run(argv, status=0):

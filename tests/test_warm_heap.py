@@ -48,6 +48,7 @@ def test_warm_up_only_in_the_command_and_bounded_by_the_map_size(tmp_path, monke
     got: list[int] = []
     monkeypatch.setattr(coefficients, "warm_heap", got.append)
     m = write_map(tmp_path / "s.vtu", "hertz", radius=0.1, peak=3e5, n_rings=8)
+    monkeypatch.setattr(cli, "WHOLE_PROCESS", False)
     assert cli.main(["coefficients", str(m)]) == 0
     assert got == []
     monkeypatch.setattr(cli, "WHOLE_PROCESS", True)
