@@ -10,9 +10,11 @@ there instead of stating its own. Three families of numbers:
   |ΔMz|/M0 over the kinematic sphere on the error-map grid (`fepost.friction.summary.
   ACCURACY_GRID`, the grid of every accuracy fepost states), on reference maps (circular,
   and ellipses up to aspect 3) and on the sample tire's FE maps;
-* k_x of free rolling: the rolled map ``meshes/rig-aircraft/roll_free.vtu`` with each static
-  map it can be paired with, and the sliding stand-in for comparison;
-* R = r_max of the same tire at its rated load on each of its three meshes, with what
+* k_x of free rolling: the half sector's rolled map ``meshes/rig-aircraft/roll_free.vtu`` (driven
+  through a spring 2.4 % fast) with each static map it can be paired with, the whole tire's
+  ``meshes/rig-tire360/roll/roll_ref.vtu`` (its rim turned at the free-rolling radius found from
+  the driven runs) with its own static map, and the sliding stand-in for comparison;
+* R = r_max of the same tire at its rated load on each of its meshes, with what
   makes them differ (the outermost loaded node of a coarser mesh lies further out).
 
 Reads only the repository's sample meshes; writes nothing.
@@ -29,12 +31,17 @@ if str(REPO) not in sys.path:
 
 F = 0.3
 ASPECTS = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0)
-#: The sample tire's three meshes at its rated load: file, what the mesh is.
+#: The sample tire's meshes at its rated load: file, what the mesh is.
 MESHES = (
     ("aircraft/static_100.vtu", "fine static mesh (the demo's static map, the load sweep)"),
     ("rig-aircraft/roll_static.vtu", "rolling runs' mesh, before rolling"),
     ("rig-aircraft/static.vtu", "slide/spin rig mesh"),
+    ("rig-tire360/static.vtu", "whole tire on the rig (whole-fine)"),
+    ("rig-tire360/roll/roll_static.vtu", "whole tire's rolling mesh, before rolling"),
 )
+#: The whole tire driven at its free-rolling radius, and its partner before rolling.
+WHOLE_ROLLED = "rig-tire360/roll/roll_ref.vtu"
+WHOLE_STATIC = "rig-tire360/roll/roll_static.vtu"
 ROLLED = "rig-aircraft/roll_free.vtu"
 STAND_IN = "aircraft/rolling_100.vtu"
 
@@ -95,22 +102,32 @@ def sample_lines() -> list[str]:
     meshes = REPO / "meshes"
     lines = ["", "the sample aircraft tire at its rated load, by mesh:"]
     lines.append(
-        "  mesh                           N (N)    R = r_max (m)  r_equiv (m)  aspect  closed forms' error"
+        "  mesh                               N (N)    R = r_max (m)  r_equiv (m)  aspect  "
+        "closed forms' error"
     )
     for name, what in MESHES:
         a = fepost.analyse(meshes / name, friction=F)
         c, p = a.coefficients, a.static_patch
         worst = a.model_summary.static_errors.worst("paper")
         lines.append(
-            f"  {name:30s} {c.N:7.0f}  {c.R:.4f}         {p.r_equiv:.4f}       {p.aspect:.3f}   "
+            f"  {name:34s} {c.N:7.0f}  {c.R:.4f}         {p.r_equiv:.4f}       {p.aspect:.3f}   "
             f"{worst['force']:.3f}, {worst['torque']:.3f}   ({what})"
         )
-    lines += ["", f"k_x of free rolling ({ROLLED}, rim turned over 0.75 m of axle travel):"]
+    lines += [
+        "",
+        "k_x of free rolling:",
+        f"  the half sector's {ROLLED} (driven through a spring 2.4 % fast, 0.75 m of axle travel):",
+    ]
     demo = None
     for name, _ in MESHES[:2]:
         a = fepost.analyse(meshes / name, meshes / ROLLED, friction=F)
         demo = demo or a
-        lines.append(f"  with the static map {name:30s} k_x = {a.coefficients.k_x:.4f}")
+        lines.append(f"    with the static map {name:34s} k_x = {a.coefficients.k_x:.4f}")
+    whole = fepost.analyse(meshes / WHOLE_STATIC, meshes / WHOLE_ROLLED, friction=F)
+    lines += [
+        f"  the whole tire's {WHOLE_ROLLED} (driven at the free-rolling radius, torque-free, 0.8 m):",
+        f"    with the static map {WHOLE_STATIC:34s} k_x = {whole.coefficients.k_x:.4f}",
+    ]
     a = fepost.analyse(meshes / MESHES[0][0], meshes / STAND_IN, friction=F)
     lines.append(f"  sliding stand-in {STAND_IN} (not rolling)  k_x = {a.coefficients.k_x:.4f}")
     worst = demo.model_summary.rolling_errors.worst("paper")
