@@ -330,3 +330,28 @@ def test_band_element_moves_the_integrals_little_and_the_edge_pressure_much():
     assert peak["C3D8"][0] == pytest.approx(peak["C3D8I"][0], rel=0.01)
     assert peak["C3D8"][1] - peak["C3D8I"][1] == pytest.approx(0.023, abs=0.002)
     assert peak["C3D8R"][0] / peak["C3D8I"][0] - 1 == pytest.approx(-0.105, abs=0.003)
+
+
+@pytest.mark.skipif(
+    not (WHOLE / "band-c3d8r" / "d090_slide.json").is_file(), reason="band-c3d8r runs not committed"
+)
+def test_band_element_leaves_the_forces_where_both_converge():
+    """Pure spin and the lateral slide with the C3D8R band against the programme's C3D8 band
+    (docs/rig.md): Mz/(f N) within 0.3 %, Fy/N at the Coulomb limit in both, the loads' falls
+    within half a percentage point of each other."""
+
+    def run(folder: Path, name: str):
+        base = json.loads((folder / "static.json").read_text())["reaction_z"]
+        d = json.loads((folder / f"{name}.json").read_text())["reaction"]
+        force = np.asarray(d["force"])
+        return force, np.asarray(d["moment"]), force[2] / base - 1.0
+
+    for name in ("spin_p", "d090_slide"):
+        f8, m8, fall8 = run(WHOLE, name)
+        fr, mr, fallr = run(WHOLE / "band-c3d8r", name)
+        assert abs(fallr - fall8) < 0.005
+        if name == "spin_p":
+            assert mr[2] / fr[2] == pytest.approx(m8[2] / f8[2], rel=3e-3)
+        else:
+            assert fr[1] / fr[2] == pytest.approx(-0.3, abs=1e-4)
+            assert f8[1] / f8[2] == pytest.approx(-0.3, abs=1e-4)
