@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import threading
 
 import pytest
 
@@ -28,6 +29,12 @@ def ends(monkeypatch):
         raise _Exited("os._exit", status)
 
     monkeypatch.setattr(cli.os, "_exit", quick)
+    # the threads a test session already runs (other tests' pools) are not the command's: count
+    # only those started during this test, as a fresh ``fepost`` process would see them
+    before = set(threading.enumerate())
+    monkeypatch.setattr(
+        cli.threading, "active_count", lambda: 1 + sum(t not in before for t in threading.enumerate())
+    )
     monkeypatch.setattr(cli, "WHOLE_PROCESS", False)  # console_main sets it: restored afterwards
     monkeypatch.setattr("atexit._run_exitfuncs", lambda: events.append("atexit"))
 
@@ -57,8 +64,6 @@ def test_other_commands_end_with_the_interpreter_teardown(ends, argv):
 
 
 def test_a_running_thread_keeps_the_teardown(ends):
-    import threading
-
     stop = threading.Event()
     t = threading.Thread(target=stop.wait)
     t.start()
