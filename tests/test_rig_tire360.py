@@ -355,3 +355,14 @@ def test_band_element_leaves_the_forces_where_both_converge():
         else:
             assert fr[1] / fr[2] == pytest.approx(-0.3, abs=1e-4)
             assert f8[1] / f8[2] == pytest.approx(-0.3, abs=1e-4)
+
+
+def test_only_runs_are_solved_in_the_order_given():
+    from scripts.tiremodel.aircraft_rig_programme import programme, select_runs
+
+    names = [s.name for s in select_runs(["d090_a60p", "spin_n", "static", "d000_a20p", "spin_n"])]
+    assert names == ["d090_a60p", "spin_n", "d000_a20p"]
+    assert select_runs(None) == select_runs([]) == programme()
+    assert select_runs(["static"]) == []
+    with pytest.raises(ValueError, match="unknown run"):
+        select_runs(["d030_slide"])

@@ -96,7 +96,10 @@ def _parser() -> argparse.ArgumentParser:
     )
     ra.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
     ra.add_argument(
-        "--only", nargs="+", default=None, help="solve only these runs (names; static: the base alone)"
+        "--only",
+        nargs="+",
+        default=None,
+        help="solve only these runs, in this order (names; static: the base alone)",
     )
     ra.add_argument(
         "--path", type=float, default=None, help="reference path S of every slide, m (default: 0.30)"

@@ -273,6 +273,20 @@ def _convergence(tire: rd.RigTire) -> str:
     return f"base: {_criteria(tire.controls)}; slides: {_criteria(tire.slide_controls)}"
 
 
+def select_runs(only: list[str] | None) -> list[RunSpec]:
+    """The runs to solve, in solving order: the programme's (``only`` None or empty), else the runs
+    named in ``only`` in the order given (a user who lists runs says which matter first; repeats
+    once). "static" names the base and its static map, always solved and written, and no run."""
+    specs = programme()
+    if not only:
+        return specs
+    unknown = sorted(set(only) - {s.name for s in specs} - {"static"})
+    if unknown:
+        raise ValueError(f"--only: unknown run(s) {', '.join(unknown)}")
+    by_name = {s.name: s for s in specs}
+    return [by_name[name] for name in dict.fromkeys(only) if name in by_name]
+
+
 def run_programme(
     out: Path,
     work: Path,
@@ -285,7 +299,8 @@ def run_programme(
     workers: int | None = 2,
     scheduler: str | None = None,
 ) -> dict[str, dict]:
-    """Solve (or skip, when finished) and export the runs ``only`` (default: the whole programme)."""
+    """Solve (or skip, when finished) and export the runs ``only``, in that order (default: the whole
+    programme, in its order)."""
     import dask
 
     from fepost.sweep.engine import Cluster
@@ -295,13 +310,7 @@ def run_programme(
 
     exe = find_ccx()
     setup = Setup(mesh_kind, str(work.resolve()), inc, path, friction)
-    specs = programme()
-    if only:
-        # "static": the base and its static map (always solved and written) without any run
-        unknown = sorted(set(only) - {s.name for s in specs} - {"static"})
-        if unknown:
-            raise ValueError(f"--only: unknown run(s) {', '.join(unknown)}")
-        specs = [s for s in specs if s.name in only]
+    specs = select_runs(only)
     mesh = _mesh(mesh_kind)
     _log(f"mesh aircraft-{mesh_kind}: {mesh.nodes.shape[0]} nodes, {mesh.hexes.shape[0]} hexahedra")
     # tasks wait on the scheduler until a worker is free, so they start in the programme's order
