@@ -332,16 +332,23 @@ def rig_stiffness(folder) -> dict:
     out: dict = {}
     for axis, run in RIG_RUNS.items():
         p = Path(folder) / f"{run}.json"
-        try:
-            hist = json.loads(p.read_text(encoding="utf-8"))["history"]
-        except (OSError, ValueError, KeyError) as exc:
-            raise ArgumentError(f"{p}: cannot read the rig run's history ({type(exc).__name__})") from None
-        path = np.asarray(hist["path"], float)
-        force = np.asarray(hist["F" + axis], float)
-        m = (path > 0) & (path <= RIG_ELASTIC_PATH)
-        if m.sum() < 2:
-            raise ArgumentError(f"{p}: fewer than 2 increments within {RIG_ELASTIC_PATH} m of path")
-        k = float(-np.sum(force[m] * path[m]) / np.sum(path[m] ** 2))  # least squares through 0
+        k, n, name = rig_elastic_slope(p, "path", "F" + axis, RIG_ELASTIC_PATH, "m of path")
         out["K_" + axis] = k
-        out["K_" + axis + "_source"] = f"{p.name}: -F{axis}/path over the first {int(m.sum())} increments"
+        out["K_" + axis + "_source"] = f"{name}: -F{axis}/path over the first {n} increments"
     return out
+
+
+def rig_elastic_slope(p: Path, x_key: str, y_key: str, limit: float, unit: str) -> tuple[float, int, str]:
+    """(−y/x by least squares through 0, increments used, file name) over the increments of the rig
+    run ``p``'s ``history`` with 0 < x ≤ ``limit`` (``unit``: what x is, for the message): the
+    elastic start of a slide (force over path) or of a spin (moment over turn)."""
+    try:
+        hist = json.loads(p.read_text(encoding="utf-8"))["history"]
+        x = np.asarray(hist[x_key], float)
+        y = np.asarray(hist[y_key], float)
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ArgumentError(f"{p}: cannot read the rig run's history ({type(exc).__name__})") from None
+    m = (x > 0) & (x <= limit)
+    if m.sum() < 2:
+        raise ArgumentError(f"{p}: fewer than 2 increments within {limit} {unit}")
+    return float(-np.sum(y[m] * x[m]) / np.sum(x[m] ** 2)), int(m.sum()), p.name

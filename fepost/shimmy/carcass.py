@@ -54,7 +54,6 @@ the patch length (the closed form of a uniform patch in `buildup_length`).
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -63,7 +62,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ArgumentError
-from .brush import ON_LIMIT, BrushTire
+from .brush import ON_LIMIT, BrushTire, rig_elastic_slope
 
 #: The tread's shear stiffness per contact area (N/m³) of the FE tire: tread rubber's
 #: shear modulus 1.5e6 Pa (scripts/tiremodel/aircraft_deck.py, RUBBER["TREAD"]) over the
@@ -135,9 +134,8 @@ class CarcassTire:
 
     @cached_property
     def tread_totals(self) -> tuple[float, float, float]:
-        """The tread's own stiffness K_t: Σ k_xi, Σ k_yi (N/m) and Σ (k_yi x_i² + k_xi y_i²) (N m/rad)."""
-        t = self.tread
-        return float(t.kx.sum()), float(t.ky.sum()), float((t.ky * t.x**2 + t.kx * t.y**2).sum())
+        """The tread's own stiffness K_t (`tread_totals`)."""
+        return tread_totals(self.tread)
 
     @cached_property
     def _free(self) -> np.ndarray:
@@ -356,17 +354,19 @@ def _without_faint_cells(tire: BrushTire) -> BrushTire:
     )
 
 
+def tread_totals(tread: BrushTire) -> tuple[float, float, float]:
+    """The tread's own stiffness K_t: Σ k_xi, Σ k_yi (N/m) and Σ (k_yi x_i² + k_xi y_i²) (N m/rad)."""
+    t = tread
+    return float(t.kx.sum()), float(t.ky.sum()), float((t.ky * t.x**2 + t.kx * t.y**2).sum())
+
+
 def carcass_from_standstill(tread: BrushTire, standstill) -> tuple[float, float, float]:
-    """(K_cx, K_cy, K_cz) with 1/K = 1/K_c + 1/K_t per direction: K_t the tread's own, Σ k_i along x
-    and y, Σ (k_y x_i² + k_x y_i²) about z; ``standstill`` (K_x, K_y[, K_z]), K_z absent or 0: rigid."""
+    """(K_cx, K_cy, K_cz) with 1/K = 1/K_c + 1/K_t per direction: K_t the tread's own
+    (`tread_totals`); ``standstill`` (K_x, K_y[, K_z]), K_z absent or 0: rigid."""
     ks = [float(k) for k in standstill] + [0.0] * (3 - len(standstill))
     if len(ks) != 3:
         raise ArgumentError(f"standstill: (K_x, K_y[, K_z]) expected, got {standstill!r}")
-    kt = (
-        float(tread.kx.sum()),
-        float(tread.ky.sum()),
-        float((tread.ky * tread.x**2 + tread.kx * tread.y**2).sum()),
-    )
+    kt = tread_totals(tread)
     out = []
     for name, k, kt_j in zip(("K_x", "K_y", "K_z"), ks, kt, strict=True):
         if name == "K_z" and k == 0.0:
@@ -386,18 +386,10 @@ def carcass_from_standstill(tread: BrushTire, standstill) -> tuple[float, float,
 def rig_torsional_stiffness(folder) -> dict:
     """The tire's standstill torsional stiffness K_z (N m/rad) from the rig's pure spin ``spin_p`` in
     ``folder``: −Mz over the turn, least squares through 0 over the turns up to `RIG_ELASTIC_TURN`."""
-    p = Path(folder) / f"{RIG_SPIN}.json"
-    try:
-        hist = json.loads(p.read_text(encoding="utf-8"))["history"]
-        turn = np.asarray(hist["tire_rotation"], float)
-        moment = np.asarray(hist["Mz"], float)
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise ArgumentError(f"{p}: cannot read the pure spin's history ({type(exc).__name__})") from None
-    m = (turn > 0) & (turn <= RIG_ELASTIC_TURN)
-    if m.sum() < 2:
-        raise ArgumentError(f"{p}: fewer than 2 increments within {RIG_ELASTIC_TURN} rad of turn")
-    k = float(-np.sum(moment[m] * turn[m]) / np.sum(turn[m] ** 2))
-    return {"K_z": k, "K_z_source": f"{p.name}: -Mz/turn over the first {int(m.sum())} increments"}
+    k, n, name = rig_elastic_slope(
+        Path(folder) / f"{RIG_SPIN}.json", "tire_rotation", "Mz", RIG_ELASTIC_TURN, "rad of turn"
+    )
+    return {"K_z": k, "K_z_source": f"{name}: -Mz/turn over the first {n} increments"}
 
 
 def buildup_length(slip_stiffness: float, carcass: float, length: float) -> float:

@@ -17,7 +17,7 @@ being its fitted steady value where its force was still building up (``RunPoint.
   of the runs; the mean of the runs' C / N.
 
 Both are compared with ``brush_slope``, the brush estimate from the static patch's strips and the
-tread rubber's stiffness (no run needed). ``relaxation_length`` fits the first-order build-up of
+tread rubber's stiffness (no run needed). ``build_up`` fits the first-order build-up of
 each run's force along its roll (scipy's ``curve_fit``). The brush curve's inverse is closed:
 1 - theta = (1 - |Fx| / (f N))^(1/3).
 
@@ -52,7 +52,7 @@ class RunPoint:
     normal_load: float  # N, tail mean
     friction: float
     kx: float = math.nan  # fepost's k_x of the run's map against the static one
-    #: Fx/N of the first-order build-up's limit (``relaxation_length``): the steady value of a run
+    #: Fx/N of the first-order build-up's limit (``build_up``): the steady value of a run
     #: that has not reached it; NaN where no build-up was fitted
     steady_fx_over_n: float = math.nan
     #: N m, the axle torque's build-up limit, likewise
@@ -187,7 +187,7 @@ class BuildUp:
     with the fit's standard errors (from its residuals: the FE history is not noisy, so they say
     how far the build-up is from first order) and the share of F_inf reached at the roll's end."""
 
-    sigma: float  # m
+    sigma: float  # m: the tire's longitudinal relaxation length (Pacejka, ch. 7)
     f_inf: float  # N
     sigma_se: float
     f_inf_se: float
@@ -219,13 +219,6 @@ def build_up(side: dict, quantity: str = "Fx") -> BuildUp | None:
     (sigma, f_inf), cov = curve_fit(model, x, y, p0=(0.1 * x.max(), float(y[tail].mean())), maxfev=5000)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     return BuildUp(float(sigma), float(f_inf), float(se[0]), float(se[1]), float(-np.expm1(-x.max() / sigma)))
-
-
-def relaxation_length(side: dict) -> tuple[float, float]:
-    """(sigma, F_inf) of ``build_up``: the first-order build-up of a slip force, whose length sigma
-    is the tire's longitudinal relaxation length (Pacejka, ch. 7); NaN, NaN where there is none."""
-    fit = build_up(side)
-    return (math.nan, math.nan) if fit is None else (fit.sigma, fit.f_inf)
 
 
 def brush_slope(side: dict) -> float:
