@@ -135,6 +135,29 @@ def test_band_element_is_a_parameter_of_the_mesh(whole, tmp_path):
     assert MESHES["whole-fine-r"] == dataclasses.replace(MESHES["whole-fine"], band_element="C3D8R")
 
 
+@needs_gmsh
+def test_band_closes_into_a_ring_on_meshes_with_band_edge_x(whole):
+    """``band_edge_x`` adds to the lateral band the fine rubber fore and aft of it (a ring round the
+    patch); elsewhere and by default the band is the lateral one (the programme's decks unchanged)."""
+    from scripts.tiremodel.aircraft_rig_mesh import MESHES
+
+    edge = 0.15
+    ring = dataclasses.replace(whole, params=dataclasses.replace(whole.params, band_edge_x=edge))
+    lateral, closed = ~ard.incompatible_mask(whole), ~ard.incompatible_mask(ring)
+    centroid = whole.nodes[whole.hexes].mean(axis=1)
+    rubber = whole.fine & (whole.layer == 0)
+    added = closed & ~lateral
+    assert np.all(lateral <= closed) and added.any()
+    assert np.all(rubber[added]) and np.all(np.abs(centroid[added, 0]) > edge)
+    assert np.all(np.abs(centroid[added, 1]) <= ard.PLAIN_EDGE_Y)
+    # every fine rubber element beyond the edge is plain; none inside the ring's hole is
+    beyond = rubber & (np.abs(centroid[:, 0]) > edge)
+    assert np.all(closed[beyond])
+    assert not np.any(closed[rubber & ~beyond & (np.abs(centroid[:, 1]) <= ard.PLAIN_EDGE_Y)])
+    assert MESHES["whole-fine-ring"] == dataclasses.replace(MESHES["whole-fine"], band_edge_x=0.20)
+    assert MESHES["whole-fine"].band_edge_x is None
+
+
 def _element_count(text: str, etype: str) -> int:
     """Number of tire elements of ``etype`` in a deck's ``*ELEMENT, TYPE=etype, ELSET=TIRE`` card."""
     lines = text.splitlines()
@@ -366,3 +389,23 @@ def test_only_runs_are_solved_in_the_order_given():
     assert select_runs(["static"]) == []
     with pytest.raises(ValueError, match="unknown run"):
         select_runs(["d030_slide"])
+
+
+@pytest.mark.skipif(
+    not all((WHOLE / f"{n}.json").is_file() for n in ("spin_p", "spin_n")), reason="pure spins not committed"
+)
+def test_the_two_pure_spins_mirror_each_other():
+    """The whole tire is symmetric about its mid-plane, so the pure spin one way is the other's
+    mirror image: the same load, the opposite torque, no force in the plane (two separate solves)."""
+
+    def end(name: str):
+        d = json.loads((WHOLE / f"{name}.json").read_text())
+        return np.asarray(d["reaction"]["force"]), np.asarray(d["reaction"]["moment"]), d["kinematics"]["wz"]
+
+    (fp, mp, wp), (fn, mn, wn) = end("spin_p"), end("spin_n")
+    assert wp == -wn > 0.0
+    assert fn[2] == pytest.approx(fp[2], rel=1e-6)
+    assert mn[2] == pytest.approx(-mp[2], rel=1e-6)
+    assert mp[2] < 0.0  # the road resists the turn
+    for f in (fp, fn):
+        assert np.abs(f[:2]).max() < 1e-6 * f[2]
