@@ -70,12 +70,17 @@ def incompatible_mask(mesh) -> np.ndarray:
 
     The sector: the sweep's split (``aircraft_deck.incompatible_mask``). The whole tire: C3D8I
     except the rubber of the fine region whose centroid lies more than ``PLAIN_EDGE_Y`` from the
-    mid-plane, the band under the patch's lateral edges (see ``PLAIN_EDGE_Y``).
+    mid-plane, the band under the patch's lateral edges (see ``PLAIN_EDGE_Y``), and on meshes with a
+    ``band_edge_x`` also the fine rubber farther than that fore or aft (a ring round the patch).
     """
     mask = ad.incompatible_mask(mesh)
     if mesh.info.get("whole_tire"):
-        off_centre = np.abs(mesh.nodes[mesh.hexes, 1].mean(axis=1))
-        mask = mask & ~(mesh.fine & (mesh.layer == 0) & (off_centre > PLAIN_EDGE_Y))
+        centroid = mesh.nodes[mesh.hexes].mean(axis=1)
+        band = np.abs(centroid[:, 1]) > PLAIN_EDGE_Y
+        edge_x = getattr(mesh.params, "band_edge_x", None)
+        if edge_x is not None:
+            band |= np.abs(centroid[:, 0]) > edge_x
+        mask = mask & ~(mesh.fine & (mesh.layer == 0) & band)
     return mask
 
 

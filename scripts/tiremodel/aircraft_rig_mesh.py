@@ -38,6 +38,10 @@ class AircraftRigParams(AircraftParams):
     # less at the model's K/G = 100 (``check-elements``: 0.87 of the beam, C3D8 0.56): what the
     # band's locking does to the runs
     band_element: str = "C3D8"
+    # m or None: the whole tire's band also takes the fine region's rubber whose centroid lies
+    # farther than this fore or aft of the bottom, under the patch's leading and trailing edges
+    # (``aircraft_rig_deck.incompatible_mask``); None: the band under the lateral edges only
+    band_edge_x: float | None = None
 
     def coarse_layers(self) -> list[float]:
         """Angular sizes (deg) from ``fine_deg`` to ``sector_deg``, growing geometrically."""
@@ -99,6 +103,12 @@ MESHES = {
     "whole-fine-r": replace(
         _whole(n_crown=6, n_shoulder=3, n_side=4, first_deg=1.5, fine_deg=33.0, n_coarse=12),
         band_element="C3D8R",
+    ),
+    # the programme's mesh with the band closed into a ring: plain C3D8 also under the patch's
+    # leading and trailing edges (|x| > 0.20 m; the patch reaches 0.254 m fore and aft)
+    "whole-fine-ring": replace(
+        _whole(n_crown=6, n_shoulder=3, n_side=4, first_deg=1.5, fine_deg=33.0, n_coarse=12),
+        band_edge_x=0.20,
     ),
     # the convergence check's finest partner (static map only): about 1.25 x whole-fine's counts
     # along the section (8 + 4 + 5) and around (1.2 degree layers)
