@@ -139,13 +139,31 @@ def test_cross_validation_refuses_a_fold_too_small_to_identify(quad):
         )
 
 
+def test_cross_validation_names_the_fold_whose_training_runs_have_no_force_along_an_axis(quad):
+    """Holding out the only group with lateral force leaves runs whose Fy is rounding (a
+    longitudinal slide, pure spins): h_y cannot be identified, and the error says which fold
+    (an unchecked fit divided rounding by rounding and the fixed point ran away)."""
+    shifts, forces, (vx, vy, wz) = _synthetic_runs(quad, (0.012, 0.045), 0.0, 0)
+    n = len(vx)
+    groups = np.full(n, "lat", dtype=object)
+    groups[np.argsort(np.abs(forces[:, 1]))[:3]] = "other"
+    forces = forces.copy()
+    forces[groups == "other", 1] = 1e-16
+    with pytest.raises(FitError, match="holding out group 'lat': identify_shift: no run has a force along y"):
+        cross_validate(quad, vx, vy, wz, shifts=shifts, forces=forces, groups=list(groups))
+
+
 def test_bad_input_is_one_line():
     with pytest.raises(ArgumentError, match=r"must both be \(n, 2\)"):
         identify_shift(np.zeros((4, 2)), np.zeros((3, 2)))
     with pytest.raises(ArgumentError, match="at least 3 runs"):
         identify_shift(np.zeros((2, 2)), np.ones((2, 2)))
-    with pytest.raises(FitError, match="force per load is zero"):
+    with pytest.raises(FitError, match=r"no run has a force along x \(largest \|Fx/N\| 0\)"):
         identify_shift(np.ones((4, 2)), np.zeros((4, 2)))
+    # a force that is zero by symmetry comes out of a solver as rounding, not as 0
+    rounding = np.column_stack([np.full(4, 0.3), np.full(4, 1e-16)])
+    with pytest.raises(FitError, match="along y .* h_y cannot be identified"):
+        identify_shift(np.full((4, 2), 0.01), rounding)
     with pytest.raises(ArgumentError, match="law must be a ShiftLaw"):
         predict_shifted(tire_like(nr=8, nphi=16), 0.1, 0.0, 0.0, law=(0.01, 0.01))
 

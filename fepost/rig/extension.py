@@ -90,13 +90,25 @@ class ShiftLaw:
         }
 
 
-def _through_origin(y: np.ndarray, x: np.ndarray, level: float) -> tuple[float, float, tuple, float]:
-    """Slope of y = h x (least squares), its standard error, interval and residual RMS."""
+#: Force per load below which a run has no force along an axis: the solver's rounding of a
+#: force that is zero by symmetry (a pure spin's Fx/N, a longitudinal slide's Fy/N: 1e-16).
+NO_FORCE = 1e-6
+
+
+def _through_origin(
+    y: np.ndarray, x: np.ndarray, level: float, axis: str
+) -> tuple[float, float, tuple, float]:
+    """Slope of y = h x (least squares), its standard error, interval and residual RMS;
+    ``axis`` (x or y) names the component in the error when no run has a force along it."""
     from scipy import stats
 
+    largest = float(np.max(np.abs(x))) if x.size else 0.0
+    if not largest > NO_FORCE:
+        raise FitError(
+            f"identify_shift: no run has a force along {axis} (largest |F{axis}/N| {largest:.2g}); "
+            f"h_{axis} cannot be identified"
+        )
     sxx = float(x @ x)
-    if not sxx > 0.0:
-        raise FitError("identify_shift: the force per load is zero on every run; h cannot be identified")
     h = float(x @ y) / sxx
     res = y - h * x
     dof = y.size - 1
@@ -134,8 +146,8 @@ def identify_shift(shifts, forces, *, level: float = LEVEL) -> ShiftLaw:
         raise ArgumentError("identify_shift: shifts and forces must be finite")
     if not 0.0 < level < 1.0:
         raise ArgumentError(f"identify_shift: level must be in (0, 1), got {level}")
-    hx, sx, ix, rx = _through_origin(d[:, 0], g[:, 0], level)
-    hy, sy, iy, ry = _through_origin(d[:, 1], g[:, 1], level)
+    hx, sx, ix, rx = _through_origin(d[:, 0], g[:, 0], level, "x")
+    hy, sy, iy, ry = _through_origin(d[:, 1], g[:, 1], level, "y")
     return ShiftLaw(
         h_x=hx,
         h_y=hy,
@@ -281,7 +293,10 @@ def cross_validate(
                 f"cross_validate: holding out group {name!r} leaves {np.count_nonzero(~held)} run(s) "
                 "to identify the law from; need at least 3"
             )
-        law = identify_shift(d[~held], g[~held])
+        try:
+            law = identify_shift(d[~held], g[~held])
+        except FitError as exc:
+            raise FitError(f"cross_validate: holding out group {name!r}: {exc}") from None
         pred = predict_shifted(quad, vx[held], vy[held], wz[held], law=law, friction=friction)
         out[held] = np.column_stack([pred.resultants.Fx, pred.resultants.Fy, pred.resultants.Mz])
         laws.append(law)
