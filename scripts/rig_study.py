@@ -3,6 +3,7 @@
     python scripts/rig_study.py [--rig meshes/rig] [--out out/rig]
     python scripts/rig_study.py --rig meshes/rig-aircraft          # -> out/rig-aircraft
     python scripts/rig_study.py --rig meshes/rig-aircraft --update # -> docs/rig/aircraft (tracked)
+    python scripts/rig_study.py --rig meshes/rig-tire360 --no-extension [--runs NAME ...]
 
 Writes into ``out/<rig folder name>`` (or ``--out``); only ``--update`` rewrites the
 tracked copies the documentation shows (``docs/rig/`` for ``meshes/rig``,
@@ -35,6 +36,10 @@ N the run's load, R the static patch radius. Writes ``misfit.csv`` (per run),
 ``table.txt`` (RMS and max per model, the identified law), figures
 ``rig_<direction>.png``, the shifts against the forces ``rig_shift.png`` and the
 forces against the sliding path, ``rig_history.png``.
+
+``--runs`` takes only the named runs (the runs two rigs share, set side by side);
+``--no-extension`` stops after (a)-(d) and the decomposition, for a programme whose
+held-out folds cannot identify (e) yet (a fold with no force along x or y).
 
 Two more tables in ``table.txt``: the steady state (how much |F| moves over the
 last 20 % of each run's path, in f N) and the load-transfer heights found in
@@ -316,6 +321,8 @@ def figures(out: Path, rows) -> None:
         fig, ax = plt.subplots(1, 3, figsize=(12, 3.6))
         c, s_ = np.cos(np.radians(d)), np.sin(np.radians(d))
         for key, (col, mk) in styles.items():
+            if f"Fx_{key}" not in rs[0]:
+                continue  # a model the study did not compute (--no-extension)
             fx = np.array([r[f"Fx_{key}"] for r in rs])
             fy = np.array([r[f"Fy_{key}"] for r in rs])
             m = np.array([r[f"Mz_{key}"] for r in rs])
@@ -580,13 +587,33 @@ def _main(argv) -> int:
     ap.add_argument(
         "--diagnosis", type=Path, default=None, help="a `fepost diagnose` diagnosis.json to compare h with"
     )
+    ap.add_argument(
+        "--runs",
+        nargs="+",
+        default=None,
+        metavar="NAME",
+        help="only these runs of the folder (e.g. the runs two rigs share, to set them side by side)",
+    )
+    ap.add_argument(
+        "--no-extension",
+        action="store_true",
+        help="(a)-(d) and the decomposition only: no load-transfer extension (e) and no heights "
+        "(for a programme whose held-out folds cannot identify (e) yet)",
+    )
     args = ap.parse_args(argv)
     out = output_folder(args.rig, args.out, args.update)
     runs = _runs(args.rig)
     if not runs:
         print(f"rig_study: no rig runs in {args.rig}", file=sys.stderr)
         return 2
-    step = _Progress(8)
+    if args.runs is not None:
+        names = {p.stem: p for p in runs}
+        unknown = [n for n in args.runs if n not in names]
+        if unknown:
+            print(f"rig_study: --runs: no run {', '.join(unknown)} in {args.rig}", file=sys.stderr)
+            return 2
+        runs = [names[n] for n in dict.fromkeys(args.runs)]
+    step = _Progress(5 if args.no_extension else 8)
     table, static, preds, shifts = step(
         f"predictions (a)-(d) over {len(runs)} runs, a dot per run's own map",
         predictions,
@@ -595,14 +622,24 @@ def _main(argv) -> int:
         args.friction,
         step.tick,
     )
-    ext, shift_law = step(
-        "load-transfer extension (e), held out by direction", extension, table, static, shifts, args.friction
-    )
-    preds.update(ext)
+    shift_law = None
+    if not args.no_extension:
+        ext, shift_law = step(
+            "load-transfer extension (e), held out by direction",
+            extension,
+            table,
+            static,
+            shifts,
+            args.friction,
+        )
+        preds.update(ext)
     rows, summary = misfit_table(table, static, preds, args.friction)
     write_outputs(out, rows, summary, static, len(runs))
     with open(out / "table.txt", "a") as fh:
-        fh.write("\n".join(law_lines(shift_law)) + "\n")
+        if shift_law is None:
+            fh.write("\n(e) and the load-transfer heights not computed (--no-extension).\n")
+        else:
+            fh.write("\n".join(law_lines(shift_law)) + "\n")
     conv = step(
         "convergence (finer mesh, smaller increments, longer slides)",
         convergence,
@@ -621,23 +658,25 @@ def _main(argv) -> int:
         with open(out / "table.txt", "a") as fh:
             fh.write("\n".join(head + conv) + "\n")
     steady = step("steady state over the last 20 % of each path", steady_state, runs, args.friction)
-    found = step(
-        "load-transfer heights, four ways",
-        heights,
-        table,
-        static,
-        preds,
-        shifts,
-        shift_law,
-        args.friction,
-        args.diagnosis,
-    )
+    found = []
+    if shift_law is not None:
+        found = step(
+            "load-transfer heights, four ways",
+            heights,
+            table,
+            static,
+            preds,
+            shifts,
+            shift_law,
+            args.friction,
+            args.diagnosis,
+        )
     with open(out / "table.txt", "a") as fh:
         fh.write("\n".join(steady_lines(steady)) + "\n")
-        fh.write("\n".join(found))
-        fh.write("\n")
+        fh.write("".join(f"{line}\n" for line in found))
     step("figures per sliding direction", figures, out, rows)
-    step("figure of the shifts", shift_figure, out, table, shifts, shift_law)
+    if shift_law is not None:
+        step("figure of the shifts", shift_figure, out, table, shifts, shift_law)
     step("figure of the histories", history_figure, args.rig, out, runs, args.friction)
     print((out / "table.txt").read_text())
     print(f"rig_study: wrote {out}", file=sys.stderr)

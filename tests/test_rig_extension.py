@@ -3,6 +3,7 @@ and the rig section of the report (fepost.report.rigsection)."""
 
 from __future__ import annotations
 
+import csv
 import importlib.util
 import json
 import re
@@ -267,3 +268,31 @@ def test_study_with_too_few_runs_fails_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("rig_study: cross_validate: holding out group")
     assert "need at least 3" in err[-1] and not out.exists()
+
+
+def test_study_without_the_extension_sets_chosen_runs_side_by_side(tmp_path, capsys):
+    """``--runs`` picks runs by name and ``--no-extension`` stops after (a)-(d) and the
+    decomposition: what a programme whose folds cannot identify (e) yet can be compared on."""
+    names = ["d000_slide", "d090_slide", "spin_p", "d090_a20p"]
+    out = tmp_path / "out"
+    args = ["--rig", str(ROOT / "meshes" / "rig-tire360"), "--out", str(out), "--no-extension"]
+    assert _study().main([*args, "--runs", *names]) == 0
+    table = (out / "table.txt").read_text()
+    assert "Misfit over 4 rig runs" in table and "(b) - (c): pressure redistribution" in table
+    assert "(e) and the load-transfer heights not computed (--no-extension)" in table
+    assert "h_x" not in table
+    with open(out / "misfit.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["run"] for r in rows] == names
+    assert not any(k.endswith("_shift") for k in rows[0])
+    # the pure slides sit at the Coulomb limit in the FE and in every exact prediction
+    slide = rows[0]
+    assert float(slide["Fx_fe"]) == pytest.approx(-1.0, abs=1e-3)
+    assert float(slide["Fx_exact"]) == pytest.approx(-1.0, abs=1e-9)
+    assert not (out / "rig_shift.png").exists() and (out / "rig_090.png").is_file()
+    capsys.readouterr()
+    bad = tmp_path / "bad"
+    assert _study().main([*args[:2], "--out", str(bad), "--runs", "d000_slide", "d030_slide"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"rig_study: --runs: no run d030_slide in {ROOT / 'meshes' / 'rig-tire360'}"]
+    assert not bad.exists()
