@@ -391,21 +391,32 @@ def test_only_runs_are_solved_in_the_order_given():
         select_runs(["d030_slide"])
 
 
-@pytest.mark.skipif(
-    not all((WHOLE / f"{n}.json").is_file() for n in ("spin_p", "spin_n")), reason="pure spins not committed"
-)
-def test_the_two_pure_spins_mirror_each_other():
-    """The whole tire is symmetric about its mid-plane, so the pure spin one way is the other's
-    mirror image: the same load, the opposite torque, no force in the plane (two separate solves)."""
+#: pairs of runs that are each other's mirror image on the symmetric whole tire, and the signs
+#: (Fx, Fy, Mz) the mirror flips: the pure spins and the lateral runs (mirrored fore and aft,
+#: x -> -x), the longitudinal runs (mirrored across, y -> -y)
+MIRRORS = [("spin_p", "spin_n", (-1, -1, -1))]
+MIRRORS += [(f"d090_a{a}p", f"d090_a{a}n", (-1, 1, -1)) for a in ("20", "40", "60", "75")]
+MIRRORS += [(f"d000_a{a}p", f"d000_a{a}n", (1, -1, -1)) for a in ("20", "40", "60", "75")]
+
+
+@pytest.mark.parametrize("pair", MIRRORS, ids=lambda p: f"{p[0]}-{p[1]}")
+def test_mirrored_runs_mirror_each_other(pair):
+    """The whole tire is symmetric about its mid-plane and fore and aft, so a run with the spin
+    the other way (and its slide mirrored with it) is the first run's mirror image: the same
+    load, the mirrored forces and the opposite torque (two separate solves)."""
+    first, second, signs = pair
+    if not all((WHOLE / f"{n}.json").is_file() for n in (first, second)):
+        pytest.skip(f"{first} and {second} are not both committed")
 
     def end(name: str):
         d = json.loads((WHOLE / f"{name}.json").read_text())
-        return np.asarray(d["reaction"]["force"]), np.asarray(d["reaction"]["moment"]), d["kinematics"]["wz"]
+        force, moment = np.asarray(d["reaction"]["force"]), np.asarray(d["reaction"]["moment"])
+        return np.array([force[0], force[1], moment[2]]), force[2], d["kinematics"]
 
-    (fp, mp, wp), (fn, mn, wn) = end("spin_p"), end("spin_n")
-    assert wp == -wn > 0.0
-    assert fn[2] == pytest.approx(fp[2], rel=1e-6)
-    assert mn[2] == pytest.approx(-mp[2], rel=1e-6)
-    assert mp[2] < 0.0  # the road resists the turn
-    for f in (fp, fn):
-        assert np.abs(f[:2]).max() < 1e-6 * f[2]
+    (fa, na, ka), (fb, nb, kb) = end(first), end(second)
+    assert kb["wz"] == -ka["wz"] != 0.0
+    assert nb == pytest.approx(na, rel=1e-6)
+    scale = 0.3 * na * np.array([1.0, 1.0, 0.3])  # f N, f N (0.3 m)
+    np.testing.assert_allclose(fb / scale, np.asarray(signs) * fa / scale, atol=1e-6)
+    if first == "spin_p":
+        assert fa[2] < 0.0 and np.abs(fa[:2]).max() < 1e-6 * na  # the road resists the turn
