@@ -420,3 +420,33 @@ def test_traction_shift_line_through_the_maps_own_forces():
     assert ts.rms < 1e-12 and ts.runs == ("r0", "r1", "r2", "r3")
     assert results.traction_shift(pts[:1]) is None
     assert results.traction_shift([dataclasses.replace(p, end_fx_over_n=0.1) for p in pts]) is None
+
+
+def test_brush_slope_of_a_steady_run_inverts_the_brush_curve():
+    """A brush tire's force at any slip short of full sliding gives back its C_kappa / N exactly,
+    braking or driving; free rolling gives nothing."""
+    for kappa in (-0.03, -0.018, 0.0223, 0.05):
+        p = _brush_point("b", kappa, 0.57, 11.0)
+        assert results.brush_slope_of(p.fx_over_n, kappa, 0.3) == pytest.approx(11.0, rel=1e-12)
+    assert math.isnan(results.brush_slope_of(0.0, 0.0005, 0.3))
+
+
+@pytest.mark.skipif(
+    not all((prog.OUT / f"{n}.json").is_file() for n in ("roll_brake020w", "roll_drive020w")),
+    reason="the pre-wound braking and driving runs are not committed",
+)
+def test_steady_slip_runs_agree_with_the_tread_brush_estimate():
+    """The two pre-wound runs, steady over the last fifth: each one's force at its slip against R_e,
+    through the brush curve, against the brush estimate from the static patch's strips and the
+    tread rubber (no run in it): braking and driving within 3 % of it (docs/rolling.md)."""
+    sides = results.rolling_sidecars(prog.OUT)
+    points = [results.RunPoint.from_sidecar(s) for s in sides]
+    slips = results.free_rolling(points).slips
+    steady = results.steady_brush_slopes(sides, points, slips)
+    assert {"roll_brake020w", "roll_drive020w"} <= set(steady)
+    assert "roll_ref" not in steady  # steady, but it does not slip
+    strips = results.brush_slope(sides[-1])
+    assert strips == pytest.approx(11.15, abs=0.01)
+    for name in ("roll_brake020w", "roll_drive020w"):
+        assert steady[name] == pytest.approx(strips, rel=0.03)
+    assert slips["roll_brake020w"] < 0.0 < slips["roll_drive020w"]

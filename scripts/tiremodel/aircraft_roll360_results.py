@@ -141,6 +141,29 @@ def brush_theta(force_ratio: float) -> float:
     return 1.0 - (1.0 - r) ** (1.0 / 3.0)
 
 
+def brush_slope_of(fx_over_n: float, kappa: float, friction: float) -> float:
+    """C_kappa / N of one steady run: its Fx/N at slip ``kappa`` through the brush curve (parabolic
+    pressure, Coulomb ``friction``); NaN at |kappa| <= 1e-3 (free rolling says nothing of it)."""
+    if abs(kappa) <= 1e-3:
+        return math.nan
+    return 3.0 * friction * brush_theta(fx_over_n / friction) / abs(kappa)
+
+
+def steady_brush_slopes(
+    sides: list[dict], points: list[RunPoint], slips: dict[str, float]
+) -> dict[str, float]:
+    """C_kappa / N of every run that is steady over the last fifth of its roll (its sidecar's
+    ``steadiness``) and slips (``slips``: against R_e): its own tail-mean Fx/N through the brush
+    curve (`brush_slope_of`), no build-up fit in between."""
+    out = {}
+    for side, p in zip(sides, points, strict=True):
+        if side["steadiness"]["steady"] and p.name in slips:
+            c = brush_slope_of(p.fx_over_n, slips[p.name], p.friction)
+            if math.isfinite(c):
+                out[p.name] = c
+    return out
+
+
 def free_rolling(points: list[RunPoint], nearest: int = 3) -> FreeRolling:
     """Free rolling from the ``nearest`` runs of smallest steady |torque| (at least two of different
     turn rates): a least-squares line of the steady torque (``RunPoint.steady_torque``) against the
@@ -164,11 +187,7 @@ def free_rolling(points: list[RunPoint], nearest: int = 3) -> FreeRolling:
         kx0 = float(np.polyval(np.polyfit(*zip(*kxs, strict=True), 1), w0))
     k = np.array([kappa[p.name] for p in use])
     secant = float(np.polyfit(k, [p.slip_force for p in use], 1)[0])
-    brush = [
-        3.0 * p.friction * brush_theta(p.slip_force / p.friction) / abs(kappa[p.name])
-        for p in use
-        if abs(kappa[p.name]) > 1e-3
-    ]
+    brush = [c for p in use if math.isfinite(c := brush_slope_of(p.slip_force, kappa[p.name], p.friction))]
     return FreeRolling(
         effective_radius=float(radius),
         runs_used=tuple(p.name for p in use),
@@ -308,6 +327,13 @@ def table(out: Path, kx: bool = True, rig: Path | None = None) -> list[str]:
             f"slip curve: C_kappa/N = {fr.secant_slope:.2f} (least-squares line), "
             f"{fr.brush_fit_slope:.2f} (each run through the brush curve, f = {points[0].friction:g})",
         ]
+        steady = steady_brush_slopes(sides, points, fr.slips)
+        if steady:
+            lines.append(
+                "steady runs through the brush curve: C_kappa/N = "
+                + ", ".join(f"{n} {c:.2f}" for n, c in steady.items())
+                + f" (mean {np.mean(list(steady.values())):.2f})"
+            )
         ts = traction_shift(points)
         if ts is not None:
             lines.append(
