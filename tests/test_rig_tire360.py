@@ -424,3 +424,29 @@ def test_mirrored_runs_mirror_each_other(pair):
     np.testing.assert_allclose(fb / scale, np.asarray(signs) * fa / scale, atol=1e-6)
     if first == "spin_p":
         assert fa[2] < 0.0 and np.abs(fa[:2]).max() < 1e-6 * na  # the road resists the turn
+
+
+@pytest.mark.skipif(not (WHOLE / "long" / "d090_a60p.json").is_file(), reason="long/d090_a60p not committed")
+def test_the_strong_spin_lateral_run_is_still_building_up_at_twice_the_path():
+    """``long/d090_a60p`` (0.90 m) against the programme's 0.45 m run of the same motion: the two
+    agree where their paths overlap to the increments' effect (under 0.01 fN), and the long run's
+    force still grows over its last fifth (docs/rig.md): twice the path does not make it steady."""
+    from scripts.tiremodel.steadiness import run_motion
+
+    def history(side: Path):
+        h = json.loads(side.read_text())["history"]
+        fz = np.asarray(h["Fz"])
+        return np.asarray(h["path"]), np.column_stack([h["Fx"], h["Fy"]]) / (0.3 * fz[:, None])
+
+    (s1, f1), (s2, f2) = history(WHOLE / "d090_a60p.json"), history(WHOLE / "long" / "d090_a60p.json")
+    assert s1[-1] == pytest.approx(0.45, rel=1e-6) and s2[-1] == pytest.approx(0.90, rel=1e-6)
+    common = np.linspace(0.05, 0.45, 9)
+    gap = np.hypot(
+        *(np.array([np.interp(common, s2, f2[:, k]) - np.interp(common, s1, f1[:, k]) for k in (0, 1)]))
+    )
+    assert gap.max() < 0.01
+    motion = run_motion(WHOLE / "long" / "d090_a60p.json")
+    assert not motion.steady() and motion.fx == pytest.approx(0.0185, abs=5e-4)
+    # |F| / fN still rising between 0.45 and 0.90 m
+    grow = np.hypot(*f2[np.searchsorted(s2, [0.45, 0.9 - 1e-9])].T)
+    assert grow[1] - grow[0] > 0.03
