@@ -394,8 +394,11 @@ def history_figure(rig: Path, out: Path, runs: list[Path], friction: float) -> N
     plt.close(fig)
 
 
-def steady_state(runs: list[Path], friction: float, share: float = 0.2) -> list[tuple[str, float, float]]:
-    """(run, largest change of |F| over the last ``share`` of the path / fN, the same for Mz / fN R_ref)."""
+def steady_state(runs: list[Path], friction: float, share: float = 0.2) -> list[tuple[str, object, float]]:
+    """(run, its `scripts.tiremodel.steadiness.Motion` over the last ``share`` of the path (Fx, Fy
+    in f N, N relative, |F| in f N), the largest change of Mz / (f N R_ref) there)."""
+    from scripts.tiremodel.steadiness import tail_motion
+
     out = []
     for run in runs:
         side = json.loads(run.with_suffix(".json").read_text())
@@ -403,23 +406,29 @@ def steady_state(runs: list[Path], friction: float, share: float = 0.2) -> list[
         path = np.array(h["path"])
         tail = path >= (1.0 - share) * path[-1] - 1e-12
         fn = friction * np.array(h["Fz"])[tail]
-        f = np.hypot(h["Fx"], h["Fy"])[tail] / fn
         m = np.array(h["Mz"])[tail] / (fn * side["model"]["r_ref"])
-        out.append((run.stem, float(np.ptp(f)), float(np.ptp(m))))
+        out.append((run.stem, tail_motion(h, friction, share), float(np.ptp(m))))
     return out
 
 
-def steady_lines(rows: list[tuple[str, float, float]], limit: float = 0.005) -> list[str]:
-    worst = max(rows, key=lambda r: r[1])
-    over = [r[0] for r in rows if r[1] >= limit]
+def steady_lines(rows: list[tuple[str, object, float]]) -> list[str]:
+    """The steady-state table: every force component and N judged (``steadiness.TOL``), |F| beside."""
+    from scripts.tiremodel.steadiness import TOL
+
+    moving = [r for r, mo, _ in rows if not mo.steady()]
     return [
         "",
-        f"Steady state: over the last 20 % of the path |F| moves by at most {worst[1]:.4f} fN "
-        f"({worst[0]}); runs at or above {limit} fN: {', '.join(over) if over else 'none'}.",
+        f"Steady state: {len(rows) - len(moving)} of {len(rows)} runs move by less than {TOL} over the "
+        "last 20 % of the path in each of Fx, Fy (in fN) and N (relative); not steady: "
+        f"{', '.join(moving) if moving else 'none'}.",
         "",
-        "| run | max change of \\|F\\| / fN | max change of Mz / fN R_ref |",
-        "|---|---|---|",
-        *(f"| {r} | {df:.4f} | {dm:.4f} |" for r, df, dm in rows),
+        "| run | Fx / fN | Fy / fN | N / N | \\|F\\| / fN | Mz / fN R_ref | steady |",
+        "|---|---|---|---|---|---|---|",
+        *(
+            f"| {r} | {mo.fx:.4f} | {mo.fy:.4f} | {mo.n:.4f} | {mo.f_abs:.4f} | {dm:.4f} | "
+            f"{'yes' if mo.steady() else 'no'} |"
+            for r, mo, dm in rows
+        ),
     ]
 
 

@@ -296,3 +296,19 @@ def test_study_without_the_extension_sets_chosen_runs_side_by_side(tmp_path, cap
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"rig_study: --runs: no run d030_slide in {ROOT / 'meshes' / 'rig-tire360'}"]
     assert not bad.exists()
+
+
+def test_the_tracked_steady_state_tables_are_the_all_component_check():
+    """The steady-state tables of docs/rig/ and docs/rig/aircraft/ are what rig_study computes
+    now: every force component and N judged (scripts/tiremodel/steadiness), |F| beside; on the
+    sector 4 of 29 runs are steady, on the small tire 9 (docs/rig.md)."""
+    study = _study()
+    for rig, table, steady in (
+        (RIG, ROOT / "docs" / "rig" / "table.txt", 9),
+        (ROOT / "meshes" / "rig-aircraft", ROOT / "docs" / "rig" / "aircraft" / "table.txt", 4),
+    ):
+        runs = study._runs(rig)
+        lines = study.steady_lines(study.steady_state(runs, 0.3))
+        text = table.read_text()
+        assert "\n".join(lines[1:]) in text
+        assert f"Steady state: {steady} of {len(runs)} runs" in text
