@@ -19,6 +19,8 @@ from fepost.shimmy.carcass import (
     rig_torsional_stiffness,
 )
 from fepost.shimmy.carcass_study import (
+    FE_DRIVE_FORCE,
+    FE_DRIVE_SLIP,
     FE_FORCE,
     FE_SIGMA,
     FE_SLIP,
@@ -189,11 +191,16 @@ def test_against_the_whole_tires_rolling_runs(whole):
     ct, lump = whole.carcass(16, 6), whole.lumped(16, 6)
     assert ct.tread.slip_stiffness() / ct.load == pytest.approx(11.15, rel=1e-12)
     assert ct.carcass[0] == pytest.approx(2.095e6, rel=2e-3)
-    got = {}
+    got, drive = {}, {}
     for name, t in (("carcass", ct), ("lumped", lump)):
         fx = t.resultants(*t.steady(-FE_SLIP, 0.0, 0.0, 1 + FE_SLIP))[0] / t.load
         x, f = build_up(t, FE_SLIP, FE_TRAVEL)
         got[name] = (fx, first_order(x, f / t.load)[0])
+        drive[name] = t.resultants(*t.steady(-FE_DRIVE_SLIP, 0.0, 0.0, 1 + FE_DRIVE_SLIP))[0] / t.load
+    # the pre-wound driving run (roll_drive020w, +0.189 at +0.0223): the carcass tire 5 % above it
+    assert drive["carcass"] == pytest.approx(0.1993, abs=0.001)
+    assert drive["carcass"] / FE_DRIVE_FORCE - 1 == pytest.approx(0.055, abs=0.01)
+    assert drive["lumped"] == pytest.approx(0.0471, abs=0.001)
     assert got["carcass"][0] == pytest.approx(-0.1737, abs=0.001)
     assert got["carcass"][1] == pytest.approx(1.159, abs=0.005)
     assert got["lumped"][0] == pytest.approx(-0.0394, abs=0.001)

@@ -3,8 +3,8 @@
 ``python -m fepost.shimmy.carcass_study fe|gripping|touchdown`` prints the tables of
 docs/touchdown.md (the whole tire's map and stiffnesses, `WHOLE`):
 
-* ``fe``: the tread's slip stiffness, the carcass springs, the steady braking force at the
-  pre-wound run's slip and the first-order build-up fitted over the building-up run's 1.6 m,
+* ``fe``: the tread's slip stiffness, the carcass springs, the steady braking and driving
+  forces at the pre-wound runs' slips and the first-order build-up fitted over the building-up run's 1.6 m,
   for the carcass tire and for the lumped brush, beside the FE runs' values;
 * ``gripping``: the example gear's largest growth rate over 20–150 m/s at held slips of 1, 3
   and 20 %: rigid sliding wheel (the same elements' Coulomb forces), lumped brush, carcass
@@ -38,6 +38,8 @@ ROLLING_RADIUS = 0.5706
 #: The FE runs: the pre-wound braking run's slip against R_e and its steady Fx/N; the building-up
 #: run's travel (m) and its fitted relaxation length (m) (docs/rolling.md, the --table output).
 FE_SLIP, FE_FORCE, FE_TRAVEL, FE_SIGMA = -0.0178, -0.154, 1.6, 1.10
+#: The pre-wound driving run (roll_drive020w): its slip against R_e and its steady Fx/N.
+FE_DRIVE_SLIP, FE_DRIVE_FORCE = 0.0223, 0.189
 
 
 @dataclass(frozen=True)
@@ -129,6 +131,8 @@ def fe_lines(whole: WholeTire, grid=(16, 6)) -> list[str]:
     for name, tire in (("carcass", ct), ("lumped", lump)):
         c_k = (ct.tread if isinstance(tire, CarcassTire) else tire).slip_stiffness() / tire.load
         fx = tire.resultants(*tire.steady(-kap * V, 0.0, 0.0, (1 + kap) * V))[0] / tire.load
+        kd = FE_DRIVE_SLIP
+        fd = tire.resultants(*tire.steady(-kd * V, 0.0, 0.0, (1 + kd) * V))[0] / tire.load
         x, f = build_up(tire, kap, FE_TRAVEL)
         sigma, f_inf = first_order(x, f / tire.load)
         ca = -tire.resultants(*tire.steady(0.0, 1e-4 * V, 0.0, V))[1] / 1e-4 / tire.load
@@ -136,6 +140,7 @@ def fe_lines(whole: WholeTire, grid=(16, 6)) -> list[str]:
         sigma_y = first_order(xs, fy / tire.load)[0]
         out.append(
             f"{name}: C_kappa/N {c_k:.2f}, steady Fx/N at kappa {kap:+.4f} {fx:+.4f} (FE {FE_FORCE:+.3f}), "
+            f"at {kd:+.4f} {fd:+.4f} (FE {FE_DRIVE_FORCE:+.3f}), "
             f"build-up over {FE_TRAVEL:g} m: sigma {sigma:.3f} m (FE {FE_SIGMA:.2f}), F_inf/N {f_inf:+.4f}; "
             f"C_alpha/N {ca:.2f}, side force's build-up at 1e-4 rad over {5 * FE_TRAVEL:g} m: "
             f"sigma_y {sigma_y:.3f} m"
