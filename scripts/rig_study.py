@@ -41,8 +41,9 @@ forces against the sliding path, ``rig_history.png``.
 ``--no-extension`` stops after (a)-(d) and the decomposition, for a programme whose
 held-out folds cannot identify (e) yet (a fold with no force along x or y).
 
-Two more tables in ``table.txt``: the steady state (how much |F| moves over the
-last 20 % of each run's path, in f N) and the load-transfer heights found in
+Two more tables in ``table.txt``: the steady state (how much each of Fx, Fy (in f N) and
+N (relative) moves over the last 20 % of each run's path, judged as
+``scripts/tiremodel/steadiness`` does; |F| and Mz beside) and the load-transfer heights found in
 four ways (``heights``): from the runs' maps (the centre-of-pressure shifts, as
 (e)), and by least squares on the forces that the shifted static map should
 reproduce, three targets in turn: the static map moved by each run's own
