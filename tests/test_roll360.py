@@ -450,3 +450,37 @@ def test_steady_slip_runs_agree_with_the_tread_brush_estimate():
     for name in ("roll_brake020w", "roll_drive020w"):
         assert steady[name] == pytest.approx(strips, rel=0.03)
     assert slips["roll_brake020w"] < 0.0 < slips["roll_drive020w"]
+
+
+def test_driven_runs_keep_the_static_partner_the_first_one_wrote(tmp_path, monkeypatch):
+    """Every driven run's first step is the same deck, so the static partner its first finished run
+    wrote stays as it is: a later run does not rewrite it (its description named the last run)."""
+    from types import SimpleNamespace
+
+    from scripts.tiremodel import aircraft_roll360_run as run
+    from scripts.tiremodel import solve as solve_mod
+
+    written = []
+
+    def fake_static(mesh, result, out, name):
+        written.append(result.name)
+        (out / f"{name}.json").write_text(json.dumps({"description": f"from {result.name}"}))
+
+    def fake_run(mesh, result, out, name, labels):
+        return {
+            "longitudinal_slip": 0.0,
+            "longitudinal_force_ratio": 0.0,
+            "axle_torque_tail_mean_Nm": 0.0,
+            "steadiness": {"steady": True},
+            "cpu_s": 1.0,
+        }
+
+    monkeypatch.setattr(solve_mod, "find_ccx", lambda: "ccx")
+    monkeypatch.setattr(run, "solve", lambda ccx, mesh, name, plan, work: SimpleNamespace(name=name))
+    monkeypatch.setattr(run, "write_static", fake_static)
+    monkeypatch.setattr(run, "write_run", fake_run)
+    setup = prog.Setup(mesh_kind="tiny", travel=1.0, reference_radius=0.57)
+    for spec in prog.programme((-0.02, 0.02), free=False):
+        prog.solve_and_export(prog.Task(spec, None, setup, None, tmp_path, tmp_path, 0.57))
+    assert written == ["roll_brake020"]
+    assert json.loads((tmp_path / f"{prog.STATIC}.json").read_text())["description"] == "from roll_brake020"

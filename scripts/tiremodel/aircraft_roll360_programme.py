@@ -224,9 +224,10 @@ def solve_and_export(task: Task) -> dict:
     radius = task.radius
     if task.spec.slip is None:
         radius = 1.0 / steady_turn_rate(result.history)
-    if task.spec.slip is None or task.setup.reference_radius is not None:
+    driven = task.setup.reference_radius is not None
+    if task.spec.slip is None or (driven and not (task.out / f"{STATIC}.json").is_file()):
         # the static partner of the maps: the free run's, or (driven: every run's first step is the
-        # same deck) the latest finished run's
+        # same deck, so the same map) the first finished run's, kept as it is by the runs after it
         write_static(task.mesh, result, task.out, STATIC)
     side = write_run(task.mesh, result, task.out, task.spec.name, task.spec.labels(task.setup, radius))
     return {
