@@ -127,12 +127,15 @@ def fe_lines(whole: WholeTire, grid=(16, 6)) -> list[str]:
         f"the tread rubber's own G/h ({FE_TREAD_STIFFNESS:.3g} N/m^3) would give C_kappa/N = "
         f"{rubber.tread.slip_stiffness() / rubber.load:.2f} on this binned map"
     )
-    V, kap = 1.0, FE_SLIP
+    V, kap, kd = 1.0, FE_SLIP, FE_DRIVE_SLIP
+
+    def steady_fx(tire, slip: float) -> float:
+        """Steady Fx/N rolling at ``slip`` (wheel speed (1 + slip) V)."""
+        return tire.resultants(*tire.steady(-slip * V, 0.0, 0.0, (1 + slip) * V))[0] / tire.load
+
     for name, tire in (("carcass", ct), ("lumped", lump)):
         c_k = (ct.tread if isinstance(tire, CarcassTire) else tire).slip_stiffness() / tire.load
-        fx = tire.resultants(*tire.steady(-kap * V, 0.0, 0.0, (1 + kap) * V))[0] / tire.load
-        kd = FE_DRIVE_SLIP
-        fd = tire.resultants(*tire.steady(-kd * V, 0.0, 0.0, (1 + kd) * V))[0] / tire.load
+        fx, fd = steady_fx(tire, kap), steady_fx(tire, kd)
         x, f = build_up(tire, kap, FE_TRAVEL)
         sigma, f_inf = first_order(x, f / tire.load)
         ca = -tire.resultants(*tire.steady(0.0, 1e-4 * V, 0.0, V))[1] / 1e-4 / tire.load
