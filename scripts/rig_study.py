@@ -267,12 +267,13 @@ def law_lines(law) -> list[str]:
 
 
 def convergence(rig: Path, static, friction: float) -> list[str]:
-    """Markdown rows: the same run on a finer mesh (``fine/``) or a smaller increment (``inc05/``)."""
+    """Markdown rows: the same run on a finer mesh (``fine/``; the whole tire's finest mesh:
+    ``xfine/``) or a smaller increment (``inc05/``)."""
     from fepost.rig import read_run
 
     R = static.coefficients.R
     lines = []
-    for sub, what in (("fine", "finer mesh"), ("inc05", "half the increment")):
+    for sub, what in (("fine", "finer mesh"), ("xfine", "finer mesh"), ("inc05", "half the increment")):
         for side in sorted((rig / sub).glob("*.json")):
             if "kinematics" not in json.loads(side.read_text()):
                 continue

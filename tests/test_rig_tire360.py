@@ -297,6 +297,37 @@ def test_static_maps_converge_without_r_max():
     assert coef[2].a / coef[1].a - 1 == pytest.approx(0.0707, abs=5e-4)
 
 
+def _xfine_runs() -> list[str]:
+    """The slide/spin runs repeated on the finest mesh (``xfine/``), by name."""
+    folder = WHOLE / "xfine"
+    return [p.stem for p in sorted(folder.glob("*.json")) if "kinematics" in json.loads(p.read_text())]
+
+
+#: the issue's mesh-convergence bound on the forces, in f N (torque: f N R)
+FORCE_CONVERGENCE = 0.005
+
+
+@pytest.mark.skipif(not _xfine_runs(), reason="no run repeated on meshes/rig-tire360/xfine/ yet")
+@pytest.mark.parametrize("name", _xfine_runs())
+def test_forces_converge_between_the_last_two_meshes(name):
+    """A run on the programme's mesh (whole-fine) and on the finest (whole-xfine): Fx and Fy
+    in f N and Mz in f N R, each in its own load, within 0.005 of each other at the end of
+    the path; R = r_max of the programme's static map."""
+    from fepost.analysis import analyse
+    from fepost.rig import read_run
+
+    radius = analyse(WHOLE / "static.vtu").coefficients.R
+    friction = json.loads((WHOLE / f"{name}.json").read_text())["friction"]
+
+    def scaled(path: Path) -> np.ndarray:
+        r = read_run(path, shear=False).reaction
+        unit = friction * r.N
+        return np.array([r.Fx / unit, r.Fy / unit, r.Mz / (unit * radius)])
+
+    fine, finest = scaled(WHOLE / f"{name}.vtu"), scaled(WHOLE / "xfine" / f"{name}.vtu")
+    assert np.abs(finest - fine).max() < FORCE_CONVERGENCE, (name, fine, finest)
+
+
 @pytest.mark.skipif(not (WHOLE / "mu0").is_dir(), reason="meshes/rig-tire360/mu0/ not committed")
 def test_slide_load_loss_is_the_released_friction_lock_in():
     """The longitudinal slides at f = 0.15 and 0.3 carry N = N0 + c f^2; their N0 is the load of the
