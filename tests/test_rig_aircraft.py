@@ -140,6 +140,7 @@ def _fake_files(name: str, sha: str) -> dict[str, bytes]:
         "reaction": {"force": [1.0, 2.0, 3.0]},
         "history": {"Mz": [4.0]},
         "runtime_s": 1.0,
+        "cpu_s": 0.8,
     }
     return {f"{name}.vtu": b"vtu", f"{name}.dat.txt": b"dat", f"{name}.json": json.dumps(side).encode()}
 
@@ -185,6 +186,8 @@ def test_driver_skips_finished_runs_and_redoes_half_written_ones(tmp_path):
     assert sorted(done) == sorted([b, c, d])
     assert all(is_done(tmp_path, s.name, shas[s.name]) for s in specs)
     assert logs[0].startswith("1 of 4 runs already finished") and logs[-1].startswith("[4/4]")
+    # "solve" is the solver's wall time; its CPU time beside it where the sidecar has it
+    assert "solve 1 s, CPU 1 s (programme " in logs[-1]
     assert not list(tmp_path.glob("*.part"))
     # a second pass has nothing to do
     again = _FakeSolver(shas)

@@ -280,7 +280,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _shape(mesh: Mesh, node: int, shape: tuple[float, dict[int, np.ndarray]] | None) -> str:
-    """ ", smallest corner volume 0.44 of the reference at t = ..." for an element's mode."""
+    """The named element's shape (``; smallest corner volume 0.44 of the reference at t = ...``);
+    empty for a node of the deck or without results."""
     owner = mesh.extra_owner(node)
     if shape is None or owner is None:
         return ""
