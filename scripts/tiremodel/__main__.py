@@ -91,9 +91,9 @@ def _parser() -> argparse.ArgumentParser:
         ],
         default="rig",
         help="rig, fine: the +-70 degree sector (meshes/rig-aircraft/); whole, whole-fine: the whole "
-        "360-degree tire (meshes/rig-tire360/; whole-xfine: its finer static partner; whole-fine-r: "
-        "whole-fine with C3D8R in its plain band; whole-fine-ring: its band closed round the "
-        "patch); whole-tiny, whole-test: tiny versions",
+        "360-degree tire (meshes/rig-tire360/; whole-xfine: its finer partner, "
+        "meshes/rig-tire360/xfine/; whole-fine-r: whole-fine with C3D8R in its plain band; "
+        "whole-fine-ring: its band closed round the patch); whole-tiny, whole-test: tiny versions",
     )
     ra.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
     ra.add_argument(
