@@ -485,3 +485,20 @@ def test_the_strong_spin_lateral_run_is_still_building_up_at_twice_the_path():
     # |F| / fN still rising between 0.45 and 0.90 m
     grow = np.hypot(*f2[np.searchsorted(s2, [0.45, 0.9 - 1e-9])].T)
     assert grow[1] - grow[0] > 0.03
+
+
+@pytest.mark.skipif(not (WHOLE / "xfine" / "d000_a40p.json").is_file(), reason="xfine/d000_a40p absent")
+def test_the_longitudinal_run_with_spin_runs_through_on_the_finest_mesh():
+    """d000_a40p stalls at a quarter of its path on the programme's mesh (docs/rig.md: a C3D8I
+    tread element under the front of the patch); on whole-xfine it runs the whole 0.45 m and is
+    steady on every component and the load, near its Coulomb ceiling (|F| = 0.948 f N)."""
+    from scripts.tiremodel.steadiness import run_motion
+
+    side = json.loads((WHOLE / "xfine" / "d000_a40p.json").read_text())
+    path = np.asarray(side["history"]["path"])
+    assert path[-1] == pytest.approx(0.45, rel=1e-6) and side["direction_deg"] == 0
+    assert run_motion(WHOLE / "xfine" / "d000_a40p.json").steady()
+    fx, fy, fz = side["reaction"]["force"]
+    assert np.hypot(fx, fy) / (side["friction"] * fz) == pytest.approx(0.948, abs=1e-3)
+    # against the slide along +x, and a side force a fore-aft symmetric patch would not give
+    assert fx < 0 and fy < 0
