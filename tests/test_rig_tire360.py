@@ -432,23 +432,30 @@ def test_only_runs_are_solved_in_the_order_given():
 MIRRORS = [("spin_p", "spin_n", (-1, -1, -1))]
 MIRRORS += [(f"d090_a{a}p", f"d090_a{a}n", (-1, 1, -1)) for a in ("20", "40", "60", "75")]
 MIRRORS += [(f"d000_a{a}p", f"d000_a{a}n", (1, -1, -1)) for a in ("20", "40", "60", "75")]
-#: the pairs whose both runs are committed (the pure spins always are)
-MIRRORED = [p for p in MIRRORS if all((WHOLE / f"{n}.json").is_file() for n in p[:2])]
+#: the folders holding a programme: the programme's mesh and the finest (``xfine/``)
+PROGRAMMES = (".", "xfine")
+#: the pairs whose both runs are committed, with their folder (the pure spins always are, in ./)
+MIRRORED = [
+    (*pair, sub)
+    for sub in PROGRAMMES
+    for pair in MIRRORS
+    if all((WHOLE / sub / f"{n}.json").is_file() for n in pair[:2])
+]
 
 
 def test_the_pure_spins_are_a_committed_mirrored_pair():
-    assert MIRRORED and MIRRORED[0][:2] == ("spin_p", "spin_n")
+    assert MIRRORED and MIRRORED[0][:2] == ("spin_p", "spin_n") and MIRRORED[0][3] == "."
 
 
-@pytest.mark.parametrize("pair", MIRRORED, ids=lambda p: f"{p[0]}-{p[1]}")
+@pytest.mark.parametrize("pair", MIRRORED, ids=lambda p: f"{p[3]}/{p[0]}-{p[1]}")
 def test_mirrored_runs_mirror_each_other(pair):
     """The whole tire is symmetric about its mid-plane and fore and aft, so a run with the spin
     the other way (and its slide mirrored with it) is the first run's mirror image: the same
     load, the mirrored forces and the opposite torque (two separate solves)."""
-    first, second, signs = pair
+    first, second, signs, sub = pair
 
     def end(name: str):
-        d = json.loads((WHOLE / f"{name}.json").read_text())
+        d = json.loads((WHOLE / sub / f"{name}.json").read_text())
         force, moment = np.asarray(d["reaction"]["force"]), np.asarray(d["reaction"]["moment"])
         return np.array([force[0], force[1], moment[2]]), force[2], d["kinematics"]
 
