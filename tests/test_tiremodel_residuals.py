@@ -60,6 +60,8 @@ DECK = "\n".join(
         "*BOUNDARY",
         *(f"{n}, 1, 3" for n in range(1, 9)),
         *(f"{n}, 1, 1, 0.3" for n in (5, 6, 7, 8)),
+        "*NODE FILE",
+        "U",
         "*END STEP",
     ]
 )
@@ -162,7 +164,7 @@ def _ccx(folder: Path, name: str) -> str:
 
 @pytest.mark.ccx
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed")
-def test_calculix_numbers_its_added_nodes_as_the_script_says(tmp_path):
+def test_calculix_numbers_its_added_nodes_as_the_script_says(tmp_path, capsys):
     """The solver's own count and the nodes it names, in the deck's run and in a restart."""
     step = DECK[DECK.index("*STEP") :]
     (tmp_path / "base.inp").write_text(
@@ -179,6 +181,12 @@ def test_calculix_numbers_its_added_nodes_as_the_script_says(tmp_path):
         pattern = r"largest correction to disp=\s*\S+ in node (\d+)"
         corrected = {int(n) for n in re.findall(pattern, outputs[name])}
         assert corrected and all(mesh.extra_owner(n) == 1 for n in corrected), (name, corrected)
+    # the sheared brick keeps its corners' volumes (simple shear)
+    argv = [str(tmp_path / "base.inp"), "--restart", "--frd", str(tmp_path / "again.frd"), "--worst", "E1"]
+    assert residuals.main(argv) == 0
+    out = capsys.readouterr().out
+    assert "t = 2: the most distorted elements of E1" in out
+    assert "C3D8I element 1 at (+0.500, +0.500, +0.500): smallest corner volume 1.00" in out
 
 
 def test_corner_volume_ratio_of_simple_shapes():
@@ -191,3 +199,31 @@ def test_corner_volume_ratio_of_simple_shapes():
     assert residuals.corner_volume_ratio(cube, keystone) == pytest.approx(0.5)
     keystone[6] = (-0.5, 1.0, 1.0)  # past it: corner 7 turned inside out
     assert residuals.corner_volume_ratio(cube, keystone) == pytest.approx(-0.5)
+
+
+def test_most_distorted_ranks_a_sets_elements(deck):
+    mesh = residuals.read_mesh(deck)
+    still = {n: np.zeros(3) for n in mesh.nodes}
+    squeezed = dict(still)
+    for n in (9, 10, 11, 12):  # the top of the C3D8 brick pressed halfway down
+        squeezed[n] = np.array([0.0, 0.0, -0.5])
+    assert residuals.most_distorted(mesh, still, "e2") == [(pytest.approx(1.0), 2)]
+    ranked = residuals.most_distorted(mesh, squeezed, "E2")
+    assert ranked[0][1] == 2 and ranked[0][0] == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="no element set NOPE"):
+        residuals.most_distorted(mesh, still, "NOPE")
+    with pytest.raises(ValueError, match="no displacement of element set E2"):
+        residuals.most_distorted(mesh, {}, "E2")
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--worst", "E1"], "--worst and --at need --frd"),
+        (["--at", "1.0"], "--worst and --at need --frd"),
+        ([], "give a log, or --frd with --worst ELSET"),
+    ],
+)
+def test_cli_options_that_go_together(deck, capsys, argv, message):
+    assert residuals.main([str(deck), *argv]) == 2
+    assert message in capsys.readouterr().err

@@ -19,7 +19,10 @@ CalculiX writes with the residuals when it gives up: that increment holds the re
 ``FORC``, which ccx2paraview names ``RF``).
 
     python -m scripts.tiremodel.residuals BASE.inp RUN.log [RUN.log ...] [--restart] [--last 400]
-        [--top 4] [--frd RUN.frd]
+        [--top 4] [--frd RUN.frd [--worst ELSET] [--at TIME]]
+
+``--worst ELSET`` lists the most distorted elements of a set (e.g. ETREAD) at the stored
+increment nearest ``--at`` (default the last), with or without a log.
 
 ``BASE.inp`` is the deck that defines the mesh (a restarted run's log goes with its base deck).
 """
@@ -194,8 +197,9 @@ def corner_volume_ratio(reference: np.ndarray, current: np.ndarray) -> float:
     return float(min(ratios))
 
 
-def stored_displacements(frd: Path) -> tuple[float, dict[int, np.ndarray]]:
-    """(time, {node: displacement}) of the last increment ``frd`` stored as a solution."""
+def stored_displacements(frd: Path, at: float | None = None) -> tuple[float, dict[int, np.ndarray]]:
+    """(time, {node: displacement}) of the last increment ``frd`` stored as a solution, or of
+    the one whose total time is nearest ``at``."""
     from .frd import read_frd
 
     try:
@@ -206,9 +210,28 @@ def stored_displacements(frd: Path) -> tuple[float, dict[int, np.ndarray]]:
     solutions = [(t, blocks) for t, blocks in res.every if "U" in blocks and "RF" not in blocks]
     if not solutions:
         raise ValueError(f"{frd}: no stored displacement")
-    t, blocks = solutions[-1]
+    t, blocks = solutions[-1] if at is None else min(solutions, key=lambda tb: abs(tb[0] - at))
     u = blocks["U"][1]
     return t, {int(n): u[k, :3] for k, n in enumerate(res.node_ids)}
+
+
+def most_distorted(mesh: Mesh, displacement: dict[int, np.ndarray], elset: str) -> list[tuple[float, int]]:
+    """(smallest corner volume over the reference's, element) of the hexahedra of ``elset``
+    whose corners all have a displacement, most distorted first."""
+    members = mesh.elsets.get(elset.upper())
+    if not members:
+        raise ValueError(f"no element set {elset} in the deck")
+    out = []
+    for e in sorted(members):
+        if e not in mesh.elements:
+            continue
+        corners = mesh.elements[e][1][:8]
+        if all(n in displacement for n in corners):
+            ref = np.array([mesh.nodes[n] for n in corners])
+            out.append((corner_volume_ratio(ref, ref + np.array([displacement[n] for n in corners])), e))
+    if not out:
+        raise ValueError(f"the results hold no displacement of element set {elset}")
+    return sorted(out)
 
 
 def named_nodes(log: Path, last: int) -> list[int]:
@@ -237,21 +260,38 @@ def main(argv: list[str] | None = None) -> int:
         prog="python -m scripts.tiremodel.residuals", description=__doc__.splitlines()[0]
     )
     ap.add_argument("deck", type=Path, help="the deck that defines the mesh (a restart's base deck)")
-    ap.add_argument("logs", type=Path, nargs="+", help="CalculiX's printed output of the runs")
+    ap.add_argument("logs", type=Path, nargs="*", help="CalculiX's printed output of the runs")
     ap.add_argument("--last", type=int, default=400, help="iterations looked at, from the end (default 400)")
     ap.add_argument("--top", type=int, default=4, help="places listed per log (default 4)")
     ap.add_argument("--frd", type=Path, help="the run's results: the named elements' corner volumes")
     ap.add_argument("--restart", action="store_true", help="the logs are of runs restarted from the deck")
+    ap.add_argument("--worst", metavar="ELSET", help="with --frd: the most distorted elements of this set")
+    ap.add_argument("--at", type=float, help="with --frd: the stored increment nearest this total time")
     args = ap.parse_args(argv)
     if args.last < 1 or args.top < 1:
         print("residuals: --last and --top must be positive", file=sys.stderr)
         return 2
-    if args.frd is not None and len(args.logs) != 1:
+    if args.frd is not None and len(args.logs) > 1:
         print("residuals: --frd goes with one log", file=sys.stderr)
+        return 2
+    if (args.worst or args.at is not None) and args.frd is None:
+        print("residuals: --worst and --at need --frd", file=sys.stderr)
+        return 2
+    if not args.logs and not args.worst:
+        print("residuals: give a log, or --frd with --worst ELSET", file=sys.stderr)
         return 2
     try:
         mesh = read_mesh(args.deck, restart=args.restart)
-        shape = stored_displacements(args.frd) if args.frd is not None else None
+        shape = stored_displacements(args.frd, args.at) if args.frd is not None else None
+        if args.worst and shape is not None:
+            print(f"{args.frd} at t = {shape[0]:.6g}: the most distorted elements of {args.worst.upper()}")
+            for ratio, e in most_distorted(mesh, shape[1], args.worst)[: args.top]:
+                etype, conn = mesh.elements[e]
+                c = np.mean([mesh.nodes[n] for n in conn[:8]], axis=0)
+                print(
+                    f"  {etype} element {e} at ({c[0]:+.3f}, {c[1]:+.3f}, {c[2]:+.3f}): "
+                    f"smallest corner volume {ratio:.2f} of the reference"
+                )
         for log in args.logs:
             named = named_nodes(log, args.last)
             if not named:
