@@ -25,15 +25,22 @@ CalculiX writes with the residuals when it gives up: that increment holds the re
 increment nearest ``--at`` (default the last), with or without a log.
 
 ``BASE.inp`` is the deck that defines the mesh (a restarted run's log goes with its base deck).
+
+Why the deck is read here and not by meshio: meshio's Abaqus reader gives every hexahedron one
+cell type (C3D8I and C3D8 alike), numbers the nodes from zero and skips ``*RIGID BODY``; the
+mapping needs the deck's own node and element numbers, each element's type and the rigid
+bodies' node sets. Only ``*NODE``, ``*ELEMENT``, ``*NSET``, ``*ELSET`` and ``*RIGID BODY`` are read.
 """
 
 from __future__ import annotations
 
 import argparse
 import collections
+import dataclasses
 import re
 import sys
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -47,13 +54,26 @@ EXTRA_PER_RIGID_BODY = 2
 
 @dataclass(frozen=True)
 class Mesh:
-    """The nodes, the elements (type and nodes) and the element sets of a CalculiX deck."""
+    """The nodes, the elements (type and nodes) and the element sets of a CalculiX deck, numbered
+    as in the run of the deck itself or (``restart``) of a run restarted from it."""
 
     nodes: dict[int, np.ndarray]
     elements: dict[int, tuple[str, tuple[int, ...]]]
     elsets: dict[str, frozenset[int]]
-    #: nodes CalculiX adds for the rigid bodies (numbered before the incompatible modes)
-    rigid_nodes: int = 0
+    #: the rigid bodies' nodes other than their reference and rotation nodes, and the bodies
+    rigid_body_nodes: int = 0
+    rigid_bodies: int = 0
+    restart: bool = False
+
+    @property
+    def rigid_nodes(self) -> int:
+        """Nodes CalculiX adds for the rigid bodies (numbered before the incompatible modes)."""
+        return self.rigid_body_nodes + (0 if self.restart else EXTRA_PER_RIGID_BODY * self.rigid_bodies)
+
+    @cached_property
+    def incompatible(self) -> tuple[int, ...]:
+        """The C3D8I elements, in the order CalculiX gives them their modes (their numbers)."""
+        return tuple(sorted(e for e, (etype, _) in self.elements.items() if etype == "C3D8I"))
 
     @property
     def modes_from(self) -> int:
@@ -63,18 +83,29 @@ class Mesh:
     @property
     def total_nodes(self) -> int:
         """The node count CalculiX prints (``nodes:``) for this deck."""
-        incompatible = sum(1 for etype, _ in self.elements.values() if etype == "C3D8I")
-        return self.modes_from - 1 + EXTRA_PER_C3D8I * incompatible
+        return self.modes_from - 1 + EXTRA_PER_C3D8I * len(self.incompatible)
 
     def extra_owner(self, node: int) -> int | None:
         """The C3D8I element whose incompatible mode is ``node`` (None: any other node)."""
         if node < self.modes_from:
             return None
-        incompatible = sorted(e for e, (etype, _) in self.elements.items() if etype == "C3D8I")
         k = (node - self.modes_from) // EXTRA_PER_C3D8I
-        if k >= len(incompatible):
+        if k >= len(self.incompatible):
             raise ValueError(f"node {node} is beyond the deck's nodes and its C3D8I elements' modes")
-        return incompatible[k]
+        return self.incompatible[k]
+
+    def centroid(self, element: int) -> np.ndarray:
+        """The mean of the element's nodes (reference coordinates, m)."""
+        return np.mean([self.nodes[n] for n in self.elements[element][1]], axis=0)
+
+    def corner_volume(self, element: int, displacement: dict[int, np.ndarray]) -> float | None:
+        """The hexahedron's smallest corner volume over its reference's (`corner_volume_ratio`)
+        under ``displacement``; None where a corner has no displacement."""
+        corners = self.elements[element][1][:8]
+        if any(n not in displacement for n in corners):
+            return None
+        reference = np.array([self.nodes[n] for n in corners])
+        return corner_volume_ratio(reference, reference + np.array([displacement[n] for n in corners]))
 
     def place(self, node: int) -> tuple[str, int]:
         """("node", N) for a node of the deck, ("element", E) for a C3D8I element's mode."""
@@ -92,9 +123,8 @@ class Mesh:
             what = f"node {node}"
             sets = ""
         else:
-            etype, conn = self.elements[owner]
-            x = np.mean([self.nodes[n] for n in conn], axis=0)
-            what = f"{etype} element {owner} (incompatible modes)"
+            x = self.centroid(owner)
+            what = f"{self.elements[owner][0]} element {owner} (incompatible modes)"
             names = sorted(name for name, members in self.elsets.items() if owner in members)
             sets = f" in {', '.join(names)}" if names else ""
         return f"{what}{sets} at ({x[0]:+.3f}, {x[1]:+.3f}, {x[2]:+.3f})"
@@ -161,12 +191,13 @@ def read_mesh(deck: Path, restart: bool = False) -> Mesh:
             bodies.append((name.upper(), own))
     if not nodes:
         raise ValueError(f"{deck}: no *NODE card")
-    rigid = 0
-    for name, own in bodies:
-        if name not in nsets:
-            raise ValueError(f"{deck}: the rigid body's node set {name} is not defined")
-        rigid += len(nsets[name] - own) + (0 if restart else EXTRA_PER_RIGID_BODY)
-    return Mesh(nodes, elements, {k: frozenset(v) for k, v in elsets.items()}, rigid)
+    missing = [name for name, _ in bodies if name not in nsets]
+    if missing:
+        raise ValueError(f"{deck}: the rigid body's node set {missing[0]} is not defined")
+    dependent = sum(len(nsets[name] - own) for name, own in bodies)
+    return Mesh(
+        nodes, elements, {k: frozenset(v) for k, v in elsets.items()}, dependent, len(bodies), restart
+    )
 
 
 #: for each corner of a hexahedron (CalculiX order), the three corners its edges go to,
@@ -185,16 +216,10 @@ _CORNERS = (
 
 def corner_volume_ratio(reference: np.ndarray, current: np.ndarray) -> float:
     """The smallest corner volume of a hexahedron, (8, 3) corners, over its reference's."""
-    ratios = []
-    for a, b, c, d in _CORNERS:
-        now = np.linalg.det(
-            np.array([current[b] - current[a], current[c] - current[a], current[d] - current[a]])
-        )
-        ref = np.linalg.det(
-            np.array([reference[b] - reference[a], reference[c] - reference[a], reference[d] - reference[a]])
-        )
-        ratios.append(now / ref)
-    return float(min(ratios))
+    corner, ends = np.array(_CORNERS)[:, :1], np.array(_CORNERS)[:, 1:]
+    now = np.linalg.det(current[ends] - current[corner])  # (8, 3, 3): each corner's three edges
+    ref = np.linalg.det(reference[ends] - reference[corner])
+    return float(np.min(now / ref))
 
 
 def stored_displacements(frd: Path, at: float | None = None) -> tuple[float, dict[int, np.ndarray]]:
@@ -221,17 +246,11 @@ def most_distorted(mesh: Mesh, displacement: dict[int, np.ndarray], elset: str) 
     members = mesh.elsets.get(elset.upper())
     if not members:
         raise ValueError(f"no element set {elset} in the deck")
-    out = []
-    for e in sorted(members):
-        if e not in mesh.elements:
-            continue
-        corners = mesh.elements[e][1][:8]
-        if all(n in displacement for n in corners):
-            ref = np.array([mesh.nodes[n] for n in corners])
-            out.append((corner_volume_ratio(ref, ref + np.array([displacement[n] for n in corners])), e))
+    ratios = ((mesh.corner_volume(e, displacement), e) for e in sorted(members) if e in mesh.elements)
+    out = sorted((r, e) for r, e in ratios if r is not None)
     if not out:
         raise ValueError(f"the results hold no displacement of element set {elset}")
-    return sorted(out)
+    return out
 
 
 def named_nodes(log: Path, last: int) -> list[int]:
@@ -286,10 +305,9 @@ def main(argv: list[str] | None = None) -> int:
         if args.worst and shape is not None:
             print(f"{args.frd} at t = {shape[0]:.6g}: the most distorted elements of {args.worst.upper()}")
             for ratio, e in most_distorted(mesh, shape[1], args.worst)[: args.top]:
-                etype, conn = mesh.elements[e]
-                c = np.mean([mesh.nodes[n] for n in conn[:8]], axis=0)
+                c = mesh.centroid(e)
                 print(
-                    f"  {etype} element {e} at ({c[0]:+.3f}, {c[1]:+.3f}, {c[2]:+.3f}): "
+                    f"  {mesh.elements[e][0]} element {e} at ({c[0]:+.3f}, {c[1]:+.3f}, {c[2]:+.3f}): "
                     f"smallest corner volume {ratio:.2f} of the reference"
                 )
         for log in args.logs:
@@ -299,7 +317,7 @@ def main(argv: list[str] | None = None) -> int:
                 continue
             stated = re.search(r"nodes:\s*(\d+)", log.read_text(errors="replace"))
             if stated and int(stated.group(1)) != mesh.total_nodes:
-                other = read_mesh(args.deck, restart=not args.restart).total_nodes
+                other = dataclasses.replace(mesh, restart=not mesh.restart).total_nodes
                 hint = (
                     f"a {'run of the deck itself' if args.restart else 'restarted run'}? "
                     f"({'without' if args.restart else 'with'} --restart)"
@@ -326,12 +344,9 @@ def _shape(mesh: Mesh, node: int, shape: tuple[float, dict[int, np.ndarray]] | N
     if shape is None or owner is None:
         return ""
     t, u = shape
-    conn = mesh.elements[owner][1][:8]
-    missing = [n for n in conn if n not in u]
-    if missing:
-        raise ValueError(f"the results hold no displacement of node {missing[0]} (element {owner})")
-    reference = np.array([mesh.nodes[n] for n in conn])
-    ratio = corner_volume_ratio(reference, reference + np.array([u[n] for n in conn]))
+    ratio = mesh.corner_volume(owner, u)
+    if ratio is None:
+        raise ValueError(f"the results hold no displacement of element {owner}'s corners")
     return f"; smallest corner volume {ratio:.2f} of the reference at t = {t:.6g}"
 
 
