@@ -158,6 +158,23 @@ def test_band_closes_into_a_ring_on_meshes_with_band_edge_x(whole):
     assert MESHES["whole-fine"].band_edge_x is None
 
 
+@needs_gmsh
+def test_no_band_on_meshes_without_a_lateral_band(whole, tmp_path):
+    """``lateral_band=False`` (mesh kind ``whole-xfine-i``) writes C3D8I in all the rubber: no plain
+    element in the deck; the default keeps the band (the programme's decks unchanged)."""
+    from scripts.tiremodel import rig_deck as rd
+    from scripts.tiremodel.aircraft_rig_mesh import MESHES
+
+    bare = dataclasses.replace(whole, params=dataclasses.replace(whole.params, lateral_band=False))
+    assert ard.incompatible_mask(bare).all() and not ard.incompatible_mask(whole).all()
+    inp = tmp_path / "base.inp"
+    rd.write_base_deck(inp, bare, 0.12, (0.0, 0.0), ard.tire_for("whole-test"))
+    text = inp.read_text()
+    assert _element_count(text, "C3D8I") == len(whole.hexes) and "TYPE=C3D8, ELSET=TIRE" not in text
+    assert MESHES["whole-xfine-i"] == dataclasses.replace(MESHES["whole-xfine"], lateral_band=False)
+    assert all(MESHES[k].lateral_band for k in ("whole-fine", "whole-xfine", "whole-fine-r"))
+
+
 def _element_count(text: str, etype: str) -> int:
     """Number of tire elements of ``etype`` in a deck's ``*ELEMENT, TYPE=etype, ELSET=TIRE`` card."""
     lines = text.splitlines()

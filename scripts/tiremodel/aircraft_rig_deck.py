@@ -70,13 +70,16 @@ def incompatible_mask(mesh) -> np.ndarray:
 
     The sector: the sweep's split (``aircraft_deck.incompatible_mask``). The whole tire: C3D8I
     except the rubber of the fine region whose centroid lies more than ``PLAIN_EDGE_Y`` from the
-    mid-plane, the band under the patch's lateral edges (see ``PLAIN_EDGE_Y``), and on meshes with a
-    ``band_edge_x`` also the fine rubber farther than that fore or aft (a ring round the patch).
+    mid-plane, the band under the patch's lateral edges (see ``PLAIN_EDGE_Y``; none on
+    meshes whose ``lateral_band`` is False), and on meshes with a ``band_edge_x`` also the fine rubber
+    farther than that fore or aft (a ring round the patch).
     """
     mask = ad.incompatible_mask(mesh)
     if mesh.info.get("whole_tire"):
         centroid = mesh.nodes[mesh.hexes].mean(axis=1)
         band = np.abs(centroid[:, 1]) > PLAIN_EDGE_Y
+        if not getattr(mesh.params, "lateral_band", True):
+            band[:] = False
         edge_x = getattr(mesh.params, "band_edge_x", None)
         if edge_x is not None:
             band |= np.abs(centroid[:, 0]) > edge_x
@@ -95,7 +98,8 @@ def tire_elements(mesh) -> list[str]:
     incompatible = incompatible_mask(mesh)
     out: list[str] = []
     for etype, sel in (("C3D8I", incompatible), (plain_element(mesh), ~incompatible)):
-        out += cx.element_block(etype, "TIRE", np.flatnonzero(sel) + 1, mesh.hexes[sel])
+        if sel.any():  # no empty card (``whole-xfine-i`` has no plain element)
+            out += cx.element_block(etype, "TIRE", np.flatnonzero(sel) + 1, mesh.hexes[sel])
     return out
 
 

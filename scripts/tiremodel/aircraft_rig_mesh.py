@@ -42,6 +42,9 @@ class AircraftRigParams(AircraftParams):
     # farther than this fore or aft of the bottom, under the patch's leading and trailing edges
     # (``aircraft_rig_deck.incompatible_mask``); None: the band under the lateral edges only
     band_edge_x: float | None = None
+    # False: no band under the patch's lateral edges (``aircraft_rig_deck.PLAIN_EDGE_Y``), C3D8I in
+    # all the whole tire's rubber
+    lateral_band: bool = True
 
     def coarse_layers(self) -> list[float]:
         """Angular sizes (deg) from ``fine_deg`` to ``sector_deg``, growing geometrically."""
@@ -119,6 +122,11 @@ MESHES = {
         first_deg=1.2,
         fine_deg=33.0,
         n_coarse=12,
+    ),
+    # the finest mesh with no band: C3D8I in all the rubber (does the finer mesh still need it?)
+    "whole-xfine-i": replace(
+        _whole(n_crown=8, n_shoulder=4, n_side=5, first_deg=1.2, fine_deg=33.0, n_coarse=12),
+        lateral_band=False,
     ),
     # the whole tire at a few hundred elements: the mu = 0 pure-spin check of the boundary
     # conditions, solved in a few minutes (one element along the sidewall)
