@@ -10,8 +10,7 @@
   rigidly with a sliding velocity and a spin, Coulomb friction 0.3);
 - ``rig-aircraft [--mesh rig|fine|whole|whole-fine|whole-fine-r|whole-xfine|whole-xfine-i] [--inc F]
   [--path S] [--friction MU] [--only RUN ...] [--out DIR] --work DIR [--workers N | --scheduler ADDRESS]``:
-  the
-  slide/spin programme on the aircraft tire (the +-70 degree sector: meshes/rig-aircraft/; the whole tire:
+  the slide/spin programme on the aircraft tire (the +-70 degree sector: meshes/rig-aircraft/; the whole tire:
   meshes/rig-tire360/), resumable, its runs as Dask tasks;
 - ``roll --work DIR [--only RUN ...] [--out DIR] [--scheduler ADDRESS]``: the
   aircraft tire rolling quasi-statically (free, braking, driving; meshes/rig-aircraft/roll_*);
