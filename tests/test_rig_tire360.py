@@ -388,14 +388,22 @@ def test_slide_load_loss_is_the_released_friction_lock_in():
 BAND_SERIES = {"C3D8I": "all-c3d8i", "C3D8": ".", "C3D8R": "band-c3d8r"}
 
 
+def _peak_pressure(path: Path) -> tuple[float, float]:
+    """The map's largest nodal CPRESS (Pa) and its distance from the mid-plane, deformed (m)."""
+    import meshio
+
+    m = meshio.read(path)
+    cp = m.point_data["CPRESS"]
+    i = int(np.argmax(cp))
+    return float(cp[i]), abs(float(m.points[i, 1] + m.point_data["displacement"][i, 1]))
+
+
 @pytest.mark.skipif(not WHOLE.is_dir(), reason="meshes/rig-tire360/ not committed")
 def test_band_element_moves_the_integrals_little_and_the_edge_pressure_much():
     """What the band's element does to the static map (docs/rig.md): the load rises by 0.55 %
     (C3D8R) and 1.76 % (C3D8, which locks) over all-C3D8I, and the coefficients without R by
     at most 1.2 %; the pressure at the patch's lateral edge is the band's own: C3D8 moves the
     largest nodal pressure 23 mm outwards at the same value, C3D8R lowers it by 10.5 %."""
-    import meshio
-
     from fepost.analysis import analyse
 
     maps = {k: WHOLE / sub / "static.vtu" for k, sub in BAND_SERIES.items()}
@@ -410,12 +418,7 @@ def test_band_element_moves_the_integrals_little_and_the_edge_pressure_much():
         assert c.a * c.R**2 == pytest.approx(ref.a * ref.R**2, rel=0.013)
         assert c.m / c.R**2 == pytest.approx(ref.m / ref.R**2, rel=0.013)
         assert c.b1 / c.N == pytest.approx(ref.b1 / ref.N, rel=0.013)
-    peak = {}
-    for k, p in maps.items():
-        m = meshio.read(p)
-        cp = m.point_data["CPRESS"]
-        i = int(np.argmax(cp))
-        peak[k] = (float(cp[i]), abs(float(m.points[i, 1] + m.point_data["displacement"][i, 1])))
+    peak = {k: _peak_pressure(p) for k, p in maps.items()}
     assert peak["C3D8"][0] == pytest.approx(peak["C3D8I"][0], rel=0.01)
     assert peak["C3D8"][1] - peak["C3D8I"][1] == pytest.approx(0.023, abs=0.002)
     assert peak["C3D8R"][0] / peak["C3D8I"][0] - 1 == pytest.approx(-0.105, abs=0.003)
@@ -427,18 +430,12 @@ def test_the_band_does_the_same_on_the_finest_mesh():
     C3D8I; docs/rig.md): the band adds 1.55 % of load and moves the coefficients without R by
     under 1.7 %, as on whole-fine; the largest nodal pressure is the band's, 12 % lower and 17 mm
     further out with it. Between the two meshes without a band every one of them is within 1.2 %."""
-    import meshio
-
     from fepost.analysis import analyse
 
     def summary(sub: str) -> tuple:
         p = WHOLE / sub / "static.vtu"
         c = analyse(p).coefficients
-        m = meshio.read(p)
-        cp = m.point_data["CPRESS"]
-        i = int(np.argmax(cp))
-        y = abs(float(m.points[i, 1] + m.point_data["displacement"][i, 1]))
-        return c.N, c.a * c.R**2, c.m / c.R**2, c.b1 / c.N, float(cp[i]), y
+        return c.N, c.a * c.R**2, c.m / c.R**2, c.b1 / c.N, *_peak_pressure(p)
 
     band, bare, fine_bare = summary("xfine"), summary("xfine-i"), summary("all-c3d8i")
     assert band[0] / bare[0] - 1 == pytest.approx(0.0155, abs=5e-4)

@@ -77,9 +77,7 @@ def incompatible_mask(mesh) -> np.ndarray:
     mask = ad.incompatible_mask(mesh)
     if mesh.info.get("whole_tire"):
         centroid = mesh.nodes[mesh.hexes].mean(axis=1)
-        band = np.abs(centroid[:, 1]) > PLAIN_EDGE_Y
-        if not getattr(mesh.params, "lateral_band", True):
-            band[:] = False
+        band = (np.abs(centroid[:, 1]) > PLAIN_EDGE_Y) & getattr(mesh.params, "lateral_band", True)
         edge_x = getattr(mesh.params, "band_edge_x", None)
         if edge_x is not None:
             band |= np.abs(centroid[:, 0]) > edge_x

@@ -127,7 +127,12 @@ class Mesh:
             what = f"{self.elements[owner][0]} element {owner} (incompatible modes)"
             names = sorted(name for name, members in self.elsets.items() if owner in members)
             sets = f" in {', '.join(names)}" if names else ""
-        return f"{what}{sets} at ({x[0]:+.3f}, {x[1]:+.3f}, {x[2]:+.3f})"
+        return f"{what}{sets} at {_point(x)}"
+
+
+def _point(x: np.ndarray) -> str:
+    """A point (m) as the script prints it: (+x.xxx, +y.yyy, +z.zzz)."""
+    return f"({x[0]:+.3f}, {x[1]:+.3f}, {x[2]:+.3f})"
 
 
 def _cards(lines: list[str]):
@@ -305,9 +310,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.worst and shape is not None:
             print(f"{args.frd} at t = {shape[0]:.6g}: the most distorted elements of {args.worst.upper()}")
             for ratio, e in most_distorted(mesh, shape[1], args.worst)[: args.top]:
-                c = mesh.centroid(e)
                 print(
-                    f"  {mesh.elements[e][0]} element {e} at ({c[0]:+.3f}, {c[1]:+.3f}, {c[2]:+.3f}): "
+                    f"  {mesh.elements[e][0]} element {e} at {_point(mesh.centroid(e))}: "
                     f"smallest corner volume {ratio:.2f} of the reference"
                 )
         for log in args.logs:
