@@ -7,10 +7,15 @@ the map), the two values, the change from the coarse to the fine map (relative; 
 in mm of its shift, against ``tol`` times R), and whether it is within ``tol``. Exit status
 1 if any is not (0 with ``--exit-zero``).
 
-R is r_max, the farthest loaded point from the centre (THEORY section 1): one node of the
-patch's edge, so it moves with the element size there, and a and m (which carry R) move with
-it, as R^-2 and R^2. The rows ``a R^2`` and ``m / R^2`` are the same coefficients without R
-(THEORY: "aR^2, m/R^2, k_x/R do not" change with R); ``area`` is the loaded area.
+R is r_max, the smallest circle about the centre that holds the support of the FE field
+(THEORY section 1; fepost.patch): the farthest node of a face with a loaded node. Those faces
+carry load out to their unloaded nodes (the field is linear on them), so R lies one element
+beyond the farthest loaded node, and the contact's edge lies between the two: R moves with
+the element size there, and a and m (which carry R) move with it, as R^-2 and R^2. The row
+``r_loaded`` is the farthest loaded node itself (pressure above fepost's default threshold,
+deformed coordinates, about the same centre): the edge's other bound. The rows ``a R^2`` and
+``m / R^2`` are the coefficients without R (THEORY: "aR^2, m/R^2, k_x/R do not" change with R);
+``area`` is the loaded area.
 """
 
 from __future__ import annotations
@@ -22,8 +27,12 @@ import sys
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
+from fepost.patch import DEFAULT_THRESHOLD
+
 QUANTITIES = ("N", "R", "a", "m", "b", "b1")
-DERIVED = ("a R^2", "m / R^2", "area")
+DERIVED = ("r_loaded", "a R^2", "m / R^2", "area")
 
 
 def coefficients(path: Path) -> dict:
@@ -35,7 +44,11 @@ def coefficients(path: Path) -> dict:
         cmd = [sys.executable, "-m", "fepost", "coefficients", str(path), "--json", str(out)]
         subprocess.run(cmd, check=True, capture_output=True)
         c = json.loads(out.read_text())
-    c["peak_pressure"] = float(meshio.read(path).point_data["CPRESS"].max())
+    mesh = meshio.read(path)
+    p = mesh.point_data["CPRESS"]
+    xy = (mesh.points + mesh.point_data["displacement"])[:, :2] - np.asarray(c["patch"]["centre"][:2])
+    c["peak_pressure"] = float(p.max())
+    c["r_loaded"] = float(np.hypot(*xy[p > DEFAULT_THRESHOLD * p.max()].T).max())
     r = float(c["R"])
     c["a R^2"] = float(c["a"]) * r**2
     c["m / R^2"] = float(c["m"]) / r**2
