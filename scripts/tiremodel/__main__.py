@@ -8,8 +8,9 @@
 - ``rig [--mesh coarse|tiny|full] [--only RUN ...] [--out DIR] [--work DIR]``:
   the slide/spin programme on the small tire (meshes/rig/: the road moves
   rigidly with a sliding velocity and a spin, Coulomb friction 0.3);
-- ``rig-aircraft [--mesh rig|fine|whole|whole-fine|whole-fine-r|whole-xfine|whole-xfine-i|whole-xxfine] [--inc F]
-  [--path S] [--friction MU] [--only RUN ...] [--out DIR] --work DIR [--workers N | --scheduler ADDRESS]``:
+- ``rig-aircraft [--mesh rig|fine|whole|whole-fine|whole-fine-r|whole-xfine|whole-xfine-i|whole-xxfine]
+  [--inc F] [--path S] [--friction MU] [--only RUN ...] [--out DIR] --work DIR
+  [--workers N | --scheduler ADDRESS]``:
   the slide/spin programme on the aircraft tire (the +-70 degree sector: meshes/rig-aircraft/; the whole tire:
   meshes/rig-tire360/), resumable, its runs as Dask tasks;
 - ``roll --work DIR [--only RUN ...] [--out DIR] [--scheduler ADDRESS]``: the
@@ -96,7 +97,8 @@ def _parser() -> argparse.ArgumentParser:
         "360-degree tire (meshes/rig-tire360/; whole-xfine: its finer partner, "
         "meshes/rig-tire360/xfine/; whole-fine-r: whole-fine with C3D8R in its plain band; "
         "whole-fine-ring: its band closed round the patch; whole-xfine-i: whole-xfine with no band, C3D8I "
-        "in all the rubber; whole-xxfine: one step finer again, static map only); whole-tiny, whole-test: tiny versions",
+        "in all the rubber; whole-xxfine: one step finer again, static map only); whole-tiny, whole-test: "
+        "tiny versions",
     )
     ra.add_argument("--inc", type=float, default=0.1, help="largest increment of the slide step")
     ra.add_argument(
