@@ -125,14 +125,7 @@ MESHES = {
     ),
     # one step finer again (static map only): is R, one element's edge, settling? 10 + 5 + 6
     # per half section, 1.0 degree layers (about 1.25 x whole-xfine's counts both ways)
-    "whole-xxfine": _whole(
-        n_crown=10,
-        n_shoulder=5,
-        n_side=6,
-        first_deg=1.0,
-        fine_deg=33.0,
-        n_coarse=12,
-    ),
+    "whole-xxfine": _whole(n_crown=10, n_shoulder=5, n_side=6, first_deg=1.0, fine_deg=33.0, n_coarse=12),
     # the finest mesh with no band: C3D8I in all the rubber (does the finer mesh still need it?)
     "whole-xfine-i": replace(
         _whole(n_crown=8, n_shoulder=4, n_side=5, first_deg=1.2, fine_deg=33.0, n_coarse=12),
