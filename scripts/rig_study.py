@@ -286,9 +286,10 @@ def convergence(rig: Path, static, friction: float) -> list[str]:
             pa = np.array([a.Fx / ua, a.Fy / ua, a.Mz / (ua * R)])
             pb = np.array([b.Fx / ub, b.Fy / ub, b.Mz / (ub * R)])
             df = float(np.hypot(*(pb[:2] - pa[:2])))
+            # rounded first, + 0.0: a force of -1e-16 fN prints as 0.0000, not -0.0000
+            va, vb = (", ".join(f"{round(float(v), 4) + 0.0:.4f}" for v in p) for p in (pa, pb))
             lines.append(
-                f"| {side.stem} | {what} | {pa[0]:.4f}, {pa[1]:.4f}, {pa[2]:.4f} | "
-                f"{pb[0]:.4f}, {pb[1]:.4f}, {pb[2]:.4f} | {df:.4f} | {abs(pb[2] - pa[2]):.4f} | "
+                f"| {side.stem} | {what} | {va} | {vb} | {df:.4f} | {abs(pb[2] - pa[2]):.4f} | "
                 f"{b.N / a.N - 1:+.2%} |"
             )
     return lines

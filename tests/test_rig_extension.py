@@ -312,3 +312,12 @@ def test_the_tracked_steady_state_tables_are_the_all_component_check():
         text = table.read_text()
         assert "\n".join(lines[1:]) in text
         assert f"Steady state: {steady} of {len(runs)} runs" in text
+
+
+def test_convergence_rows_print_a_zero_force_as_zero(committed):
+    """The convergence rows of the small tire's study (a spin's forces of 1e-6 fN or less, a
+    slide's side force of 1e-16) print 0.0000, not -0.0000; the values are still signed."""
+    rows = _study().convergence(RIG, committed.static, 0.3)
+    spin = next(r for r in rows if r.startswith("| spin_p | finer mesh |"))
+    assert "-0.0000" not in "".join(rows)
+    assert "| 0.0000, 0.0000, -0.4953 | -0.0063, -0.0054, -0.4906 |" in spin
