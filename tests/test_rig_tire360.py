@@ -295,19 +295,6 @@ MESH_SERIES = ("mid", ".", "xfine", "xxfine")
 LAYER_DEG = (1.8, 1.5, 1.2, 1.0)
 
 
-def _loaded_edge(path: Path, centre) -> float:
-    """The farthest node with a pressure above fepost's threshold from ``centre`` (deformed, m),
-    read with meshio."""
-    import meshio
-
-    from fepost.patch import DEFAULT_THRESHOLD
-
-    m = meshio.read(path)
-    cp = m.point_data["CPRESS"]
-    xy = (m.points + m.point_data["displacement"])[:, :2] - np.asarray(centre[:2])
-    return float(np.hypot(*xy[cp > DEFAULT_THRESHOLD * cp.max()].T).max())
-
-
 @pytest.mark.skipif(not WHOLE.is_dir(), reason="meshes/rig-tire360/ not committed")
 def test_static_maps_converge_without_r_max():
     """The whole tire's static map on four meshes: the load, b1 and the coefficients without R
@@ -315,14 +302,17 @@ def test_static_maps_converge_without_r_max():
     two; so does the farthest loaded node (0.16 % between the last two). R = r_max, the radius of
     the field's support, lies one edge element beyond that node (19-22 mm per degree of layer),
     so it moves by 1.6, 3.6 and 2.4 % and takes a and m with it (docs/rig.md)."""
+    import meshio
+
     from fepost.analysis import analyse
+    from scripts.tiremodel.map_convergence import loaded_edge
 
     maps = [WHOLE / sub / "static.vtu" for sub in MESH_SERIES]
     missing = [str(p) for p in maps if not p.is_file()]
     assert not missing, f"committed convergence maps missing: {missing}"
     runs = [analyse(p) for p in maps]
     coef = [r.coefficients for r in runs]
-    edge = [_loaded_edge(p, r.static_patch.frame.origin) for p, r in zip(maps, runs, strict=True)]
+    edge = [loaded_edge(meshio.read(p), r.static_patch.frame.origin) for p, r in zip(maps, runs, strict=True)]
     for r, e in zip(runs, edge, strict=True):  # the same node from fepost's own patch
         sp = r.static_patch
         xy = sp.xy - np.asarray(sp.centre_of_pressure)
@@ -373,8 +363,8 @@ FORCE_CONVERGENCE = 0.005
 
 
 #: runs whose end-of-path forces on the two meshes are further apart than `FORCE_CONVERGENCE`
-#: (docs/rig.md, "The forces' mesh convergence"): the lateral runs with 40 degrees of spin or more,
-#: whose force is still moving over the last fifth on both meshes
+#: (docs/rig.md, "The forces' mesh convergence"): the lateral run with 40 degrees of spin and its
+#: mirror image, with the programme's 30 mm increments (with 15 mm they agree: the increment's)
 NOT_CONVERGED = {
     "d090_a40p": "Fx 0.0128 f N apart with the programme's 30 mm increments: -0.1651 (whole-fine) against "
     "-0.1523 (whole-xfine); with 15 mm 0.0031 (test_half_the_increment_settles_the_lateral_run_...)",
@@ -621,19 +611,16 @@ def test_the_longitudinal_run_with_spin_runs_through_on_the_finest_mesh():
     assert along == pytest.approx(-0.945, abs=1e-3) and side_force == pytest.approx(0.069, abs=1e-3)
 
 
-def _fx_at(sidecar: Path, path: float) -> float:
-    """Fx / (f N) of a run's history at ``path`` (m), interpolated between increments."""
+def _scaled_history(sidecar: Path) -> tuple[np.ndarray, np.ndarray]:
+    """A run's path (m) and its Fx, Fy in f N (rows) at each increment."""
     side = json.loads(sidecar.read_text())
     h = side["history"]
-    fx = np.asarray(h["Fx"]) / (side["friction"] * np.asarray(h["Fz"]))
-    return float(np.interp(path, h["path"], fx))
+    return np.asarray(h["path"]), np.array([h["Fx"], h["Fy"]]) / (side["friction"] * np.asarray(h["Fz"]))
 
 
 def _end(sidecar: Path) -> np.ndarray:
     """Fx, Fy / (f N) at the end of a run's path."""
-    side = json.loads(sidecar.read_text())
-    h = side["history"]
-    return np.array([h["Fx"][-1], h["Fy"][-1]]) / (side["friction"] * h["Fz"][-1])
+    return _scaled_history(sidecar)[1][:, -1]
 
 
 @pytest.mark.skipif(
@@ -647,15 +634,16 @@ def test_half_the_increment_settles_the_lateral_run_with_40_degrees_of_spin():
     steady on both meshes, and they agree within the issue's 0.005 (0.0031)."""
     from scripts.tiremodel.steadiness import run_motion
 
-    short, long_ = WHOLE / "d090_a40p.json", WHOLE / "long" / "d090_a40p.json"
-    assert _fx_at(long_, 0.45) - _fx_at(short, 0.45) == pytest.approx(0.0084, abs=5e-4)
-    for side in (long_, WHOLE / "xfine-long" / "d090_a40p.json"):
-        d = json.loads(side.read_text())
-        h = d["history"]
-        tail = np.asarray(h["path"]) >= 0.45
-        fx = np.asarray(h["Fx"])[tail] / (d["friction"] * np.asarray(h["Fz"])[tail])
-        assert h["path"][-1] == pytest.approx(0.90)
-        assert np.ptp(fx) > 0.010
+    (s_short, f_short), (s_long, f_long) = (
+        _scaled_history(WHOLE / sub / "d090_a40p.json") for sub in (".", "long")
+    )
+    assert np.interp(0.45, s_long, f_long[0]) - np.interp(0.45, s_short, f_short[0]) == pytest.approx(
+        0.0084, abs=5e-4
+    )
+    for side in (WHOLE / "long" / "d090_a40p.json", WHOLE / "xfine-long" / "d090_a40p.json"):
+        path, (fx, _fy) = _scaled_history(side)
+        assert path[-1] == pytest.approx(0.90)
+        assert np.ptp(fx[path >= 0.45]) > 0.010
         assert not run_motion(side).steady()
     halves = [WHOLE / "inc05" / "d090_a40p.json", WHOLE / "xfine" / "inc05" / "d090_a40p.json"]
     assert all(run_motion(side).steady() for side in halves)

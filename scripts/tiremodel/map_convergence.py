@@ -35,6 +35,14 @@ QUANTITIES = ("N", "R", "a", "m", "b", "b1")
 DERIVED = ("r_loaded", "a R^2", "m / R^2", "area")
 
 
+def loaded_edge(mesh, centre) -> float:
+    """The farthest node of a rig map (a meshio mesh with ``CPRESS`` and ``displacement``) whose
+    pressure is above fepost's default threshold, from ``centre`` in the road plane (deformed, m)."""
+    p = mesh.point_data["CPRESS"]
+    xy = (mesh.points + mesh.point_data["displacement"])[:, :2] - np.asarray(centre[:2])
+    return float(np.hypot(*xy[p > DEFAULT_THRESHOLD * p.max()].T).max())
+
+
 def coefficients(path: Path) -> dict:
     """``fepost coefficients --json`` of one static map, with its peak CPRESS (Pa) added."""
     import meshio
@@ -45,10 +53,8 @@ def coefficients(path: Path) -> dict:
         subprocess.run(cmd, check=True, capture_output=True)
         c = json.loads(out.read_text())
     mesh = meshio.read(path)
-    p = mesh.point_data["CPRESS"]
-    xy = (mesh.points + mesh.point_data["displacement"])[:, :2] - np.asarray(c["patch"]["centre"][:2])
-    c["peak_pressure"] = float(p.max())
-    c["r_loaded"] = float(np.hypot(*xy[p > DEFAULT_THRESHOLD * p.max()].T).max())
+    c["peak_pressure"] = float(mesh.point_data["CPRESS"].max())
+    c["r_loaded"] = loaded_edge(mesh, c["patch"]["centre"])
     r = float(c["R"])
     c["a R^2"] = float(c["a"]) * r**2
     c["m / R^2"] = float(c["m"]) / r**2
