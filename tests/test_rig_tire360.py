@@ -664,3 +664,87 @@ def test_half_the_increment_leaves_the_other_unsteady_runs_unsteady():
     for half in others:
         assert np.abs(_end(half) - _end(WHOLE / "xfine" / half.name)).max() < 0.0025, half.stem
         assert not run_motion(half).steady(), half.stem
+
+
+# -- the patch stays on the road -------------------------------------------------------------------
+from scripts.tiremodel import ccxdeck as cx  # noqa: E402
+from scripts.tiremodel import rig_deck as rd  # noqa: E402
+
+
+def _square(half: float) -> np.ndarray:
+    g = np.linspace(-half, half, 21)
+    x, y = np.meshgrid(g, g)
+    return np.column_stack([x.ravel(), y.ravel()])
+
+
+def test_road_exit_of_a_straight_slide_is_where_the_edge_meets_the_limit():
+    road = cx.build_road(half_x=0.40, half_y=0.26, size=0.025)  # limits 0.375 and 0.235 m
+    ex = rd.road_exit(rd.Kinematics(0.30, 0.0, 0.0), (0.0, 0.0), _square(0.10), road)
+    # the leading edge x = 0.10 + 0.30 t passes 0.375 at t = 0.9167 (found to 1/1000)
+    assert ex is not None and 0.9167 <= ex.t <= 0.9167 + 1e-3
+    assert ex.reach == pytest.approx(0.40 / 0.375, rel=1e-12)  # |x| <= 0.40 against 0.375
+    assert rd.road_exit(rd.Kinematics(0.27, 0.0, 0.0), (0.0, 0.0), _square(0.10), road) is None
+
+
+def test_road_exit_of_a_pure_spin_is_where_the_turning_corner_meets_the_limit():
+    road = cx.build_road(half_x=0.40, half_y=0.26, size=0.025)
+    # a square of half side 0.2 m turned by 90 degrees: its largest |x| is 0.2 (cos th + sin th),
+    # 0.235 m (the y limit) at th = asin(0.235 / (0.2 sqrt 2)) - 45 degrees
+    th = np.degrees(np.arcsin(0.235 / (0.2 * np.sqrt(2.0)))) - 45.0
+    ex = rd.road_exit(rd.Kinematics(0.0, 0.0, np.pi / 2.0), (0.0, 0.0), _square(0.2), road)
+    assert ex is not None and th / 90.0 <= ex.t <= th / 90.0 + 1e-3
+    assert ex.reach == pytest.approx(0.2 * np.sqrt(2.0) / 0.235, rel=1e-6)
+
+
+def _whole_xfine_patch() -> np.ndarray:
+    import meshio
+
+    m = meshio.read(WHOLE / "xfine" / "static.vtu")
+    loaded = m.point_data["CPRESS"] > 0.0
+    return (m.points + m.point_data["displacement"])[loaded, :2]
+
+
+def test_the_programme_stays_on_the_road_and_the_stalled_path_does_not():
+    from scripts.tiremodel.aircraft_rig_programme import programme
+
+    xy, road = _whole_xfine_patch(), ard.whole_road()
+
+    def kin(spec, path):
+        return rd.kinematics(
+            spec.direction, spec.angle, spec.sign, dataclasses.replace(ard.WHOLE, slide_path=path)
+        )
+
+    specs = {s.name: s for s in programme()}
+    assert len(specs) == 29
+    assert all(rd.road_exit(kin(s, 0.45), (0.0, 0.0), xy, road) is None for s in specs.values())
+    # d045_a20n over 0.90 m stalled at 0.807 m: its patch is within one face of the edge from 0.62 m
+    ex = rd.road_exit(kin(specs["d045_a20n"], 0.90), (0.0, 0.0), xy, road)
+    assert ex is not None and 0.61 < ex.t * 0.90 < 0.63
+    assert rd.road_exit(kin(specs["d045_a20n"], 0.60), (0.0, 0.0), xy, road) is None
+
+
+def test_check_on_road_names_each_run_that_would_leave_it():
+    from types import SimpleNamespace
+
+    from scripts.tiremodel.rig_run import Base, check_on_road
+    from scripts.tiremodel.solve import ModelError
+
+    xy = _square(0.1)
+    mesh = SimpleNamespace(nodes=np.column_stack([xy, np.zeros(len(xy))]))
+    base = Base(
+        nodes=rd.RigNodes(ref=1, rot=2, ref_xy=(0.0, 0.0)),
+        restart=Path("base.rout"),
+        static_load=np.zeros(3),
+        static_cpress=np.where(np.abs(xy[:, 0]) < 0.05, 1e5, 0.0),  # loaded: |x| < 0.05 only
+        static_u=np.zeros((len(xy), 3)),
+        runtime_s=0.0,
+        deck_sha256="",
+    )
+    road = cx.build_road(half_x=0.40, half_y=0.26, size=0.025)
+    runs = {"fits": rd.Kinematics(0.30, 0.0, 0.0), "off": rd.Kinematics(0.0, 0.30, 0.0)}
+    check_on_road(mesh, base, road, {"fits": runs["fits"]}, 0.30)  # loaded edge 0.05 + 0.30 < 0.375
+    # "off" slides along y: its loaded edge y = 0.10 + 0.30 t passes 0.235 m at t = 0.45
+    with pytest.raises(
+        ModelError, match=r": off from 0\.135 m of its 0\.30 m path \(1\.70 x as far out at most\)"
+    ):
+        check_on_road(mesh, base, road, runs, 0.30)

@@ -311,6 +311,7 @@ def run_programme(
     from fepost.sweep.engine import Cluster
 
     from .rig_export import write_static
+    from .rig_run import check_on_road
     from .solve import ccx_version, find_ccx
 
     exe = find_ccx()
@@ -331,6 +332,13 @@ def run_programme(
             f"load {base.static_load[2] / 1e3:.1f} kN, "
             f"{(base.static_cpress > 0).sum()} loaded nodes, solve {base.runtime_s:.0f} s"
             f"{_cpu(base.cpu_s)} (this call {time.perf_counter() - t0:.0f} s)"
+        )
+        check_on_road(
+            mesh,
+            base,
+            setup.tire.road(),
+            {s.name: rd.kinematics(s.direction, s.angle, s.sign, setup.tire) for s in specs},
+            setup.path,
         )
         info = model_info(mesh, setup, rim_travel, clearance, ccx_version(exe))
         static = out / "static.json"

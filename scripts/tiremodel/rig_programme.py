@@ -20,7 +20,7 @@ from . import deck as dk
 from . import rig_deck as rd
 from .geometry import TireParams, build_mesh, coarse_params
 from .rig_export import write_run, write_static
-from .rig_run import inflation_rim_travel, solve_base, solve_run
+from .rig_run import check_on_road, inflation_rim_travel, solve_base, solve_run
 from .solve import ccx_version, find_ccx
 
 SPIN_ANGLES = (40.0, 60.0, 20.0, 75.0)  # combined runs, degrees
@@ -113,6 +113,9 @@ def run_programme(
     runs = programme()
     if only:
         runs = [r for r in runs if r[0] in only]
+    check_on_road(
+        mesh, base, rd.SMALL.road(), {n: rd.kinematics(d, a, s) for n, d, a, s in runs}, rd.SLIDE_PATH
+    )
     sides = []
     for name, d, a, s in runs:
         kin = rd.kinematics(d, a, s)

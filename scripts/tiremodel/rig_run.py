@@ -163,6 +163,27 @@ def solve_base(
     )
 
 
+def check_on_road(mesh: TireMesh, base: Base, road, runs: dict[str, rd.Kinematics], path: float) -> None:
+    """Refuse, before any is solved, the runs whose static patch (the base's loaded nodes, moved by
+    the run's rigid motion) would come within one face of the road's edge (``rig_deck.road_exit``):
+    one ModelError naming each such run and where along its ``path`` (m) the patch gets there."""
+    loaded = base.static_cpress > 0.0
+    xy = mesh.nodes[loaded, :2] + base.static_u[loaded, :2]
+    bad = []
+    for name, kin in runs.items():
+        ex = rd.road_exit(kin, base.nodes.ref_xy, xy, road)
+        if ex is not None:
+            bad.append(
+                f"{name} from {ex.t * path:.3f} m of its {path:.2f} m path "
+                f"({ex.reach:.2f} x as far out at most)"
+            )
+    if bad:
+        raise ModelError(
+            "the patch would come within one face of the road's edge (its leading edge loses contact, "
+            "the solve stalls): " + "; ".join(bad) + ": give a shorter --path"
+        )
+
+
 def _history(dat: Path, start: float = SLIDE_START) -> History:
     blocks = read_dat_blocks(dat)
     rows: dict[tuple[str, str], dict[float, np.ndarray]] = {}
