@@ -678,20 +678,25 @@ def _square(half: float) -> np.ndarray:
 
 
 def test_road_exit_of_a_straight_slide_is_where_the_edge_meets_the_limit():
-    road = cx.build_road(half_x=0.40, half_y=0.26, size=0.025)  # limits 0.375 and 0.235 m
-    ex = rd.road_exit(rd.Kinematics(0.30, 0.0, 0.0), (0.0, 0.0), _square(0.10), road)
+    road = cx.build_road(half_x=0.40, half_y=0.26, size=0.025)  # less one face: 0.375 and 0.235 m
+    slide = rd.Kinematics(0.30, 0.0, 0.0)
+    ex = rd.road_exit(slide, (0.0, 0.0), _square(0.10), road, faces=1)
     # the leading edge x = 0.10 + 0.30 t passes 0.375 at t = 0.9167 (found to 1/1000)
     assert ex is not None and 0.9167 <= ex.t <= 0.9167 + 1e-3
     assert ex.reach == pytest.approx(0.40 / 0.375, rel=1e-12)  # |x| <= 0.40 against 0.375
-    assert rd.road_exit(rd.Kinematics(0.27, 0.0, 0.0), (0.0, 0.0), _square(0.10), road) is None
+    # ... and reaches the road's edge, 0.40, only at its end: it stays on the road
+    assert rd.road_exit(slide, (0.0, 0.0), _square(0.10), road) is None
+    assert rd.road_exit(rd.Kinematics(0.31, 0.0, 0.0), (0.0, 0.0), _square(0.10), road).t == pytest.approx(
+        0.30 / 0.31, abs=1e-3
+    )
 
 
 def test_road_exit_of_a_pure_spin_is_where_the_turning_corner_meets_the_limit():
     road = cx.build_road(half_x=0.40, half_y=0.26, size=0.025)
     # a square of half side 0.2 m turned by 90 degrees: its largest |x| is 0.2 (cos th + sin th),
-    # 0.235 m (the y limit) at th = asin(0.235 / (0.2 sqrt 2)) - 45 degrees
+    # 0.235 m (the y limit less one face) at th = asin(0.235 / (0.2 sqrt 2)) - 45 degrees
     th = np.degrees(np.arcsin(0.235 / (0.2 * np.sqrt(2.0)))) - 45.0
-    ex = rd.road_exit(rd.Kinematics(0.0, 0.0, np.pi / 2.0), (0.0, 0.0), _square(0.2), road)
+    ex = rd.road_exit(rd.Kinematics(0.0, 0.0, np.pi / 2.0), (0.0, 0.0), _square(0.2), road, faces=1)
     assert ex is not None and th / 90.0 <= ex.t <= th / 90.0 + 1e-3
     assert ex.reach == pytest.approx(0.2 * np.sqrt(2.0) / 0.235, rel=1e-6)
 
@@ -716,14 +721,18 @@ def test_the_programme_stays_on_the_road_and_the_stalled_path_does_not():
 
     specs = {s.name: s for s in programme()}
     assert len(specs) == 29
-    assert all(rd.road_exit(kin(s, 0.45), (0.0, 0.0), xy, road) is None for s in specs.values())
-    # d045_a20n over 0.90 m stalled at 0.807 m: its patch is within one face of the edge from 0.62 m
-    ex = rd.road_exit(kin(specs["d045_a20n"], 0.90), (0.0, 0.0), xy, road)
-    assert ex is not None and 0.61 < ex.t * 0.90 < 0.63
-    assert rd.road_exit(kin(specs["d045_a20n"], 0.60), (0.0, 0.0), xy, road) is None
+    # the 0.45 m programme keeps every patch off the road's last face
+    assert all(rd.road_exit(kin(s, 0.45), (0.0, 0.0), xy, road, faces=1) is None for s in specs.values())
+    # d045_a20n over 0.90 m stalled at 0.807 m (90 %): its patch enters the last face at 0.62 m
+    # and leaves the road at 0.675 m (75 %)
+    last = rd.road_exit(kin(specs["d045_a20n"], 0.90), (0.0, 0.0), xy, road, faces=1)
+    off = rd.road_exit(kin(specs["d045_a20n"], 0.90), (0.0, 0.0), xy, road)
+    assert last is not None and 0.61 < last.t * 0.90 < 0.63
+    assert off is not None and 0.74 < off.t < 0.76
+    assert rd.road_exit(kin(specs["d045_a20n"], 0.60), (0.0, 0.0), xy, road, faces=1) is None
 
 
-def test_check_on_road_names_each_run_that_would_leave_it():
+def test_check_on_road_refuses_the_runs_that_leave_it_and_reports_those_near_its_edge():
     from types import SimpleNamespace
 
     from scripts.tiremodel.rig_run import Base, check_on_road
@@ -735,16 +744,51 @@ def test_check_on_road_names_each_run_that_would_leave_it():
         nodes=rd.RigNodes(ref=1, rot=2, ref_xy=(0.0, 0.0)),
         restart=Path("base.rout"),
         static_load=np.zeros(3),
-        static_cpress=np.where(np.abs(xy[:, 0]) < 0.05, 1e5, 0.0),  # loaded: |x| < 0.05 only
+        static_cpress=np.where(np.abs(xy[:, 0]) < 0.095, 1e5, 0.0),  # loaded: |x| <= 0.09 only
         static_u=np.zeros((len(xy), 3)),
         runtime_s=0.0,
         deck_sha256="",
     )
     road = cx.build_road(half_x=0.40, half_y=0.26, size=0.025)
-    runs = {"fits": rd.Kinematics(0.30, 0.0, 0.0), "off": rd.Kinematics(0.0, 0.30, 0.0)}
-    check_on_road(mesh, base, road, {"fits": runs["fits"]}, 0.30)  # loaded edge 0.05 + 0.30 < 0.375
-    # "off" slides along y: its loaded edge y = 0.10 + 0.30 t passes 0.235 m at t = 0.45
+    fits, near = rd.Kinematics(-0.20, 0.0, 0.0), rd.Kinematics(0.30, 0.0, 0.0)
+    lines: list[str] = []
+    # near: its loaded edge x = 0.09 + 0.30 t passes 0.375 (the last face) at t = 0.95, not 0.40
+    check_on_road(mesh, base, road, {"fits": fits, "near": near}, 0.30, lines.append)
+    assert lines == ["near: the patch enters the road's last face from 0.285 m of its 0.30 m path"]
+    # off slides along y: its loaded edge y = 0.10 + 0.30 t passes the edge 0.26 m at t = 0.533
+    runs = {"fits": fits, "off": rd.Kinematics(0.0, 0.30, 0.0)}
     with pytest.raises(
-        ModelError, match=r": off from 0\.135 m of its 0\.30 m path \(1\.70 x as far out at most\)"
+        ModelError, match=r"off the road .*: off from 0\.160 m of its 0\.30 m path \(1\.54 x as far out\)"
     ):
         check_on_road(mesh, base, road, runs, 0.30)
+
+
+def _committed_slides() -> list[Path]:
+    folders = [WHOLE, REPO / "meshes" / "rig-aircraft"]
+    return sorted(
+        p
+        for f in folders
+        for p in f.glob("**/*.json")
+        if (p.parent / "static.vtu").is_file()
+        and p.name != "static.json"
+        and "direction_deg" in p.read_text()
+    )
+
+
+@pytest.mark.parametrize(
+    "folder", sorted({p.parent for p in _committed_slides()}), ids=lambda p: str(p.relative_to(REPO))
+)
+def test_every_committed_slide_kept_its_patch_on_the_road(folder):
+    import meshio
+
+    m = meshio.read(folder / "static.vtu")
+    loaded = m.point_data["CPRESS"] > 0.0
+    xy = (m.points + m.point_data["displacement"])[loaded, :2]
+    runs = [p for p in _committed_slides() if p.parent == folder]
+    assert runs
+    for p in runs:
+        side = json.loads(p.read_text())
+        base = ard.WHOLE if "whole" in side["mesh"]["name"] else ard.AIRCRAFT
+        tire = dataclasses.replace(base, slide_path=side["model"]["slide_path"])
+        kin = rd.kinematics(side["direction_deg"], side["spin_angle_deg"], side["spin_sign"], tire)
+        assert rd.road_exit(kin, (0.0, 0.0), xy, tire.road(), samples=201) is None, p.name

@@ -339,6 +339,7 @@ def run_programme(
             setup.tire.road(),
             {s.name: rd.kinematics(s.direction, s.angle, s.sign, setup.tire) for s in specs},
             setup.path,
+            _log,
         )
         info = model_info(mesh, setup, rim_travel, clearance, ccx_version(exe))
         static = out / "static.json"

@@ -291,32 +291,37 @@ def tire_motion(kin: Kinematics, origin: tuple[float, float], t: float) -> tuple
 
 @dataclass(frozen=True)
 class RoadExit:
-    """Where a moving patch first comes within one road face of the road's edge (the limit: the
-    road's half extent less one face, along x and along y)."""
+    """Where a moving patch first passes a limit near the road's edge (the road's half extent,
+    less a number of road faces, along x and along y)."""
 
     t: float  # pseudo-time (share of the path) of the first sample past the limit
     reach: float  # the farthest a patch point gets over the whole run: |x|, |y| over the axis' limit
 
 
 def road_exit(
-    kin: Kinematics, origin: tuple[float, float], points: np.ndarray, road: cx.Road, samples: int = 1001
+    kin: Kinematics,
+    origin: tuple[float, float],
+    points: np.ndarray,
+    road: cx.Road,
+    faces: int = 0,
+    samples: int = 1001,
 ) -> RoadExit | None:
-    """The first pseudo-time at which one of ``points`` (the static patch's (x, y), m) comes within
-    one road face of the edge of ``road`` under the run's rigid motion, or None if none does.
+    """The first pseudo-time at which one of ``points`` (the static patch's (x, y), m) passes the edge
+    of ``road`` less ``faces`` road faces under the run's rigid motion, or None if none does.
 
     A patch that runs off the road loses its leading edge's contact while the slide goes on: the
     forces fall and CalculiX cuts the increment until it stops. The whole tire's 45 degree run with
-    20 degrees of spin over 0.90 m (``d045_a20n``, road |x|, |y| <= 0.80 m): its farthest loaded
-    node passed the road's edge at 75 % of the path, the rim's force in the tire's frame, steady to
-    0.0011 f N over 56-76 %, fell by 0.014 f N over 83-90 %, and the solve stalled at 90 %
-    (increments cut to 2e-6). The last face is kept clear as well: a point on it is at the road's
-    edge. The motion is sampled at ``samples`` pseudo-times: the crossing is found to 1/(samples-1)
-    of the path; an arc bulges out between samples by under 1 micrometre for the rig's runs.
+    20 degrees of spin over 0.90 m (``d045_a20n``, road |x|, |y| <= 0.80 m, 50 mm faces): its
+    farthest loaded node entered the last face at 69 % of the path and passed the road's edge at
+    75 %; the rim's force in the tire's frame, steady to 0.0011 f N over 56-76 %, fell by 0.014 f N
+    over 83-90 %, and the solve stalled at 90 % (increments cut to 2e-6). The motion is sampled at
+    ``samples`` pseudo-times: the crossing is found to 1/(samples-1) of the path; an arc bulges out
+    between samples by under 1 micrometre for the rig's runs.
     """
     xy = np.asarray(points, dtype=float).reshape(-1, 2)
     half = np.abs(road.nodes[:, :2]).max(axis=0)
     face = max(float(np.diff(np.unique(road.nodes[:, k])).max()) for k in (0, 1))
-    limit = half - face
+    limit = half - faces * face
     ts = np.linspace(0.0, 1.0, samples)
     maps = np.array([tire_motion(kin, origin, float(t))[1] for t in ts])  # (samples, 2, 3)
     moved = np.einsum("tij,nj->tni", maps[:, :, :2], xy) + maps[:, None, :, 2]  # (samples, n, 2)

@@ -114,7 +114,7 @@ def run_programme(
     if only:
         runs = [r for r in runs if r[0] in only]
     check_on_road(
-        mesh, base, rd.SMALL.road(), {n: rd.kinematics(d, a, s) for n, d, a, s in runs}, rd.SLIDE_PATH
+        mesh, base, rd.SMALL.road(), {n: rd.kinematics(d, a, s) for n, d, a, s in runs}, rd.SLIDE_PATH, log
     )
     sides = []
     for name, d, a, s in runs:

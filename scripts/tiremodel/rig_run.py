@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import shutil
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -163,24 +164,37 @@ def solve_base(
     )
 
 
-def check_on_road(mesh: TireMesh, base: Base, road, runs: dict[str, rd.Kinematics], path: float) -> None:
+def check_on_road(
+    mesh: TireMesh,
+    base: Base,
+    road,
+    runs: dict[str, rd.Kinematics],
+    path: float,
+    log: Callable[[str], None] | None = None,
+) -> None:
     """Refuse, before any is solved, the runs whose static patch (the base's loaded nodes, moved by
-    the run's rigid motion) would come within one face of the road's edge (``rig_deck.road_exit``):
-    one ModelError naming each such run and where along its ``path`` (m) the patch gets there."""
+    the run's rigid motion) would leave the road (``rig_deck.road_exit``): one ModelError naming
+    each such run and where along its ``path`` (m) the patch gets there. Runs whose patch only
+    enters the road's last face are reported through ``log``."""
     loaded = base.static_cpress > 0.0
     xy = mesh.nodes[loaded, :2] + base.static_u[loaded, :2]
     bad = []
     for name, kin in runs.items():
-        ex = rd.road_exit(kin, base.nodes.ref_xy, xy, road)
-        if ex is not None:
+        off = rd.road_exit(kin, base.nodes.ref_xy, xy, road)
+        if off is not None:
             bad.append(
-                f"{name} from {ex.t * path:.3f} m of its {path:.2f} m path "
-                f"({ex.reach:.2f} x as far out at most)"
+                f"{name} from {off.t * path:.3f} m of its {path:.2f} m path ({off.reach:.2f} x as far out)"
+            )
+        elif log is not None and (last := rd.road_exit(kin, base.nodes.ref_xy, xy, road, faces=1)):
+            log(
+                f"{name}: the patch enters the road's last face from {last.t * path:.3f} m "
+                f"of its {path:.2f} m path"
             )
     if bad:
         raise ModelError(
-            "the patch would come within one face of the road's edge (its leading edge loses contact, "
-            "the solve stalls): " + "; ".join(bad) + ": give a shorter --path"
+            "the patch would run off the road (its leading edge loses contact, the solve stalls): "
+            + "; ".join(bad)
+            + ": give a shorter --path"
         )
 
 
