@@ -4,6 +4,7 @@
     python scripts/rig_study.py --rig meshes/rig-aircraft          # -> out/rig-aircraft
     python scripts/rig_study.py --rig meshes/rig-aircraft --update # -> docs/rig/aircraft (tracked)
     python scripts/rig_study.py --rig meshes/rig-tire360 --no-extension [--runs NAME ...]
+    python scripts/rig_study.py --rig meshes/rig-tire360/xfine --longer DIR ... [--out DIR]
 
 Writes into ``out/<rig folder name>`` (or ``--out``); only ``--update`` rewrites the
 tracked copies the documentation shows (``docs/rig/`` for ``meshes/rig``,
@@ -38,6 +39,9 @@ N the run's load, R the static patch radius. Writes ``misfit.csv`` (per run),
 forces against the sliding path, ``rig_history.png``.
 
 ``--runs`` takes only the named runs (the runs two rigs share, set side by side);
+``--longer DIR ...`` puts the runs found in those folders (longer paths, smaller increments:
+solved from the same base, which their ``static.json`` must name) in place of the rig's
+runs of the same names, so the study reads each run at its steadiest solve;
 ``--no-extension`` stops after (a)-(d) and the decomposition, for a programme whose
 held-out folds cannot identify (e) yet (a fold with no force along x or y).
 
@@ -92,6 +96,37 @@ def _runs(rig: Path) -> list[Path]:
         if "kinematics" in data:
             out.append(side.with_suffix(".vtu"))
     return out
+
+
+def replace_runs(rig: Path, runs: list[Path], longer: list[Path]) -> tuple[list[Path], list[str]]:
+    """``runs`` with each run found in a ``longer`` folder in place of the rig's of the same name,
+    and a line per replaced run (name, folder, path). Every folder's ``static.json`` must name the
+    rig's base deck (the runs restart from the same static solution); a run may come from one
+    folder only, and only in place of one of ``runs``."""
+    from fepost.errors import ArgumentError
+
+    def base_of(folder: Path) -> str | None:
+        try:
+            return json.loads((folder / "static.json").read_text()).get("base_deck_sha256")
+        except (OSError, ValueError) as err:
+            raise ArgumentError(f"--longer: {folder}: no readable static.json ({err})") from err
+
+    own = base_of(rig)
+    names = {p.stem: i for i, p in enumerate(runs)}
+    out, lines, seen = list(runs), [], {}
+    for folder in longer:
+        if own is None or base_of(folder) != own:
+            raise ArgumentError(f"--longer: {folder}: its static.json names another base than {rig}'s")
+        for run in _runs(folder):
+            if run.stem not in names:
+                raise ArgumentError(f"--longer: {folder}: run {run.stem} is not one of the runs of {rig}")
+            if run.stem in seen:
+                raise ArgumentError(f"--longer: run {run.stem} is in both {seen[run.stem]} and {folder}")
+            seen[run.stem] = folder
+            out[names[run.stem]] = run
+            model = json.loads(run.with_suffix(".json").read_text())["model"]
+            lines.append(f"{run.stem}: {folder} ({model['slide_path']:.2f} m, {model['slide_steps']} steps)")
+    return out, lines
 
 
 def predictions(rig: Path, runs: list[Path], friction: float, tick=None):
@@ -607,6 +642,15 @@ def _main(argv) -> int:
         help="only these runs of the folder (e.g. the runs two rigs share, to set them side by side)",
     )
     ap.add_argument(
+        "--longer",
+        nargs="+",
+        type=Path,
+        default=[],
+        metavar="DIR",
+        help="folders of the same runs solved longer or with smaller increments from the same base: "
+        "each replaces the rig's run of its name",
+    )
+    ap.add_argument(
         "--no-extension",
         action="store_true",
         help="(a)-(d) and the decomposition only: no load-transfer extension (e) and no heights "
@@ -625,6 +669,7 @@ def _main(argv) -> int:
             print(f"rig_study: --runs: no run {', '.join(unknown)} in {args.rig}", file=sys.stderr)
             return 2
         runs = [names[n] for n in dict.fromkeys(args.runs)]
+    runs, replaced = replace_runs(args.rig, runs, args.longer)
     step = _Progress(5 if args.no_extension else 8)
     table, static, preds, shifts = step(
         f"predictions (a)-(d) over {len(runs)} runs, a dot per run's own map",
@@ -648,6 +693,9 @@ def _main(argv) -> int:
     rows, summary = misfit_table(table, static, preds, args.friction)
     write_outputs(out, rows, summary, static, len(runs))
     with open(out / "table.txt", "a") as fh:
+        if replaced:
+            fh.write(f"\n{len(replaced)} runs from other folders (path, slide steps):\n")
+            fh.write("".join(f"- {line}\n" for line in replaced))
         if shift_law is None:
             fh.write("\n(e) and the load-transfer heights not computed (--no-extension).\n")
         else:

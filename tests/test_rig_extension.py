@@ -7,6 +7,7 @@ import csv
 import importlib.util
 import json
 import re
+import shutil
 import sys
 from pathlib import Path
 from types import SimpleNamespace
@@ -321,3 +322,44 @@ def test_convergence_rows_print_a_zero_force_as_zero(committed):
     spin = next(r for r in rows if r.startswith("| spin_p | finer mesh |"))
     assert "-0.0000" not in "".join(rows)
     assert "| 0.0000, 0.0000, -0.4953 | -0.0063, -0.0054, -0.4906 |" in spin
+
+
+# -- runs replaced by their longer or finer-stepped solves ------------------------------------------
+
+XFINE = ROOT / "meshes" / "rig-tire360" / "xfine"
+
+
+def _copy_run(src: Path, dst: Path, name: str) -> None:
+    dst.mkdir(parents=True, exist_ok=True)
+    for suffix in (".json", ".vtu"):
+        shutil.copyfile(src / f"{name}{suffix}", dst / f"{name}{suffix}")
+
+
+def test_longer_folders_replace_the_runs_of_their_names():
+    study = _study()
+    runs = study._runs(XFINE)
+    inc05 = XFINE / "inc05"
+    out, lines = study.replace_runs(XFINE, runs, [inc05])
+    moved = {p.stem for p in study._runs(inc05)}
+    assert len(out) == len(runs) == 29 and moved and len(lines) == len(moved)
+    for before, after in zip(runs, out, strict=True):
+        assert after == (inc05 / before.name if before.stem in moved else before)
+    assert "d090_a40p: " in "".join(lines) and "(0.45 m, 31 steps)" in lines[0]
+
+
+def test_longer_folders_must_share_the_base_and_the_run_names(tmp_path):
+    study = _study()
+    runs = study._runs(XFINE)
+    other = tmp_path / "other"  # a static map of another base: the coarser whole-tire mesh
+    shutil.copytree(ROOT / "meshes" / "rig-tire360" / "inc05", other)
+    with pytest.raises(ArgumentError, match=r"other: its static.json names another base"):
+        study.replace_runs(XFINE, runs, [other])
+    same = tmp_path / "same"
+    _copy_run(XFINE / "inc05", same, "d090_a40p")
+    shutil.copyfile(XFINE / "static.json", same / "static.json")
+    with pytest.raises(ArgumentError, match=r"run d090_a40p is in both .*inc05 and .*same"):
+        study.replace_runs(XFINE, runs, [XFINE / "inc05", same])
+    with pytest.raises(ArgumentError, match=r"same: run d090_a40p is not one of the runs"):
+        study.replace_runs(XFINE, [r for r in runs if r.stem != "d090_a40p"], [same])
+    with pytest.raises(ArgumentError, match=r"nowhere: no readable static.json"):
+        study.replace_runs(XFINE, runs, [tmp_path / "nowhere"])
