@@ -245,8 +245,7 @@ def _committed() -> list[Path]:
     have their own contract and test (tests/test_roll360.py)."""
     if not WHOLE.is_dir():
         return []
-    sub = [p for p in sorted(WHOLE.glob("*/*.json")) if p.parent.name != "roll"]
-    return sorted(WHOLE.glob("*.json")) + sub
+    return sorted(p for p in WHOLE.glob("**/*.json") if "roll" not in p.relative_to(WHOLE).parts)
 
 
 @pytest.mark.skipif(not _committed(), reason="meshes/rig-tire360/ holds no runs yet")
