@@ -41,7 +41,8 @@ forces against the sliding path, ``rig_history.png``.
 ``--runs`` takes only the named runs (the runs two rigs share, set side by side);
 ``--longer DIR ...`` puts the runs found in those folders (longer paths, smaller increments:
 solved from the same base, which their ``static.json`` must name) in place of the rig's
-runs of the same names, so the study reads each run at its steadiest solve;
+runs of the same names (a later folder's in place of an earlier one's), so the study reads
+each run at its steadiest solve;
 ``--no-extension`` stops after (a)-(d) and the decomposition, for a programme whose
 held-out folds cannot identify (e) yet (a fold with no force along x or y).
 
@@ -101,8 +102,8 @@ def _runs(rig: Path) -> list[Path]:
 def replace_runs(rig: Path, runs: list[Path], longer: list[Path]) -> tuple[list[Path], list[str]]:
     """``runs`` with each run found in a ``longer`` folder in place of the rig's of the same name,
     and a line per replaced run (name, folder, path). Every folder's ``static.json`` must name the
-    rig's base deck (the runs restart from the same static solution); a run may come from one
-    folder only, and only in place of one of ``runs``."""
+    rig's base deck (the runs restart from the same static solution); a run found in several
+    folders is taken from the last of them, and only in place of one of ``runs``."""
     from fepost.errors import ArgumentError
 
     def base_of(folder: Path) -> str | None:
@@ -113,19 +114,18 @@ def replace_runs(rig: Path, runs: list[Path], longer: list[Path]) -> tuple[list[
 
     own = base_of(rig)
     names = {p.stem: i for i, p in enumerate(runs)}
-    out, lines, seen = list(runs), [], {}
+    out, taken = list(runs), {}
     for folder in longer:
         if own is None or base_of(folder) != own:
             raise ArgumentError(f"--longer: {folder}: its static.json names another base than {rig}'s")
         for run in _runs(folder):
             if run.stem not in names:
                 raise ArgumentError(f"--longer: {folder}: run {run.stem} is not one of the runs of {rig}")
-            if run.stem in seen:
-                raise ArgumentError(f"--longer: run {run.stem} is in both {seen[run.stem]} and {folder}")
-            seen[run.stem] = folder
-            out[names[run.stem]] = run
-            model = json.loads(run.with_suffix(".json").read_text())["model"]
-            lines.append(f"{run.stem}: {folder} ({model['slide_path']:.2f} m, {model['slide_steps']} steps)")
+            out[names[run.stem]] = taken[run.stem] = run
+    lines = []
+    for name, run in sorted(taken.items(), key=lambda item: names[item[0]]):
+        model = json.loads(run.with_suffix(".json").read_text())["model"]
+        lines.append(f"{name}: {run.parent} ({model['slide_path']:.2f} m, {model['slide_steps']} steps)")
     return out, lines
 
 
@@ -648,7 +648,7 @@ def _main(argv) -> int:
         default=[],
         metavar="DIR",
         help="folders of the same runs solved longer or with smaller increments from the same base: "
-        "each replaces the rig's run of its name",
+        "each replaces the rig's run of its name (a later folder's an earlier one's)",
     )
     ap.add_argument(
         "--no-extension",

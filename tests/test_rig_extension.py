@@ -357,8 +357,11 @@ def test_longer_folders_must_share_the_base_and_the_run_names(tmp_path):
     same = tmp_path / "same"
     _copy_run(XFINE / "inc05", same, "d090_a40p")
     shutil.copyfile(XFINE / "static.json", same / "static.json")
-    with pytest.raises(ArgumentError, match=r"run d090_a40p is in both .*inc05 and .*same"):
-        study.replace_runs(XFINE, runs, [XFINE / "inc05", same])
+    # a run in two folders: the last folder's
+    out, lines = study.replace_runs(XFINE, runs, [XFINE / "inc05", same])
+    assert same / "d090_a40p.vtu" in out and XFINE / "inc05" / "d090_a40p.vtu" not in out
+    assert XFINE / "inc05" / "d090_a60p.vtu" in out
+    assert sum("d090_a40p" in line for line in lines) == 1 and f"d090_a40p: {same} " in "".join(lines)
     with pytest.raises(ArgumentError, match=r"same: run d090_a40p is not one of the runs"):
         study.replace_runs(XFINE, [r for r in runs if r.stem != "d090_a40p"], [same])
     with pytest.raises(ArgumentError, match=r"nowhere: no readable static.json"):
