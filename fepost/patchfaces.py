@@ -27,7 +27,7 @@ from .errors import PatchError, PatchWarning
 from .facegroups import exact_load, folded_faces, next_triangles, only_triangles, refine
 from .facesums import FaceSums, face_loads, face_sums
 from .field import ContactField
-from .frame import Frame
+from .frame import Frame, frame_rows
 from .regions import FRAGMENT_SHARE, loaded_regions
 
 #: Largest |load of the triangles / exact element load − 1| before the faces are cut finer.
@@ -63,13 +63,8 @@ def project_faces(source, points, tri, vals, location, thr, base: Frame) -> Geom
         pts = points[used]
         nvals = vals[used] if location == "point" else vals
     w = np.where(nvals > thr, nvals, 0.0) if location == "point" else np.ones(len(pts))
-    # patch coordinates: (pts − o)·e_k = pts·e_k − o·e_k; xy column by column (Fortran order), so
-    # the passes that gather x and y (`face_sums`, `fepost.locate`) take them without a copy
-    xy = np.empty((len(pts), 2), order="F")
-    np.matmul(base.axes[:2], pts.T, out=xy.T)  # = pts @ axes[:2].T, into the transposed (C-ordered) view
-    xy -= base.origin @ base.axes[:2].T
-    z = pts @ base.axes[2]
-    z -= base.origin @ base.axes[2]
+    rows = frame_rows(pts, base)  # patch coordinates as rows: x and y columns of xy contiguous
+    xy, z = rows[:2].T, rows[2]
     sums = face_sums(xy[:, 0], xy[:, 1], tri_local, nvals, location)
     if not sums.N > 0:
         raise PatchError(f"{source}: the contact patch carries no load")
