@@ -111,16 +111,13 @@ def _steep(points: np.ndarray, corners: np.ndarray, normal: np.ndarray, cos_max:
     """True where a face's normal makes more than arccos(``cos_max``) with ``normal`` (and for
     degenerate faces, which have no normal). ``corners``: (m, 3) triangles or (m, 4) quadrilaterals
     (the normal of a quadrilateral is that of its diagonals)."""
-    if corners.shape[1] == 3:
-        u = points[corners[:, 1]] - points[corners[:, 0]]
-        v = points[corners[:, 2]] - points[corners[:, 0]]
-    else:
-        u = points[corners[:, 2]] - points[corners[:, 0]]
-        v = points[corners[:, 3]] - points[corners[:, 1]]
+    p = points.take(corners, axis=0)  # (m, corners, 3): one gather of whole rows
+    uv = p[:, 1:] - p[:, :1] if corners.shape[1] == 3 else p[:, 2:] - p[:, :2]
+    u, v = uv[:, 0].T, uv[:, 1].T
     # n = u × v by components (np.cross is several times slower on long arrays)
-    nx = u[:, 1] * v[:, 2] - u[:, 2] * v[:, 1]
-    ny = u[:, 2] * v[:, 0] - u[:, 0] * v[:, 2]
-    nz = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    nx = u[1] * v[2] - u[2] * v[1]
+    ny = u[2] * v[0] - u[0] * v[2]
+    nz = u[0] * v[1] - u[1] * v[0]
     along = np.abs(nx * normal[0] + ny * normal[1] + nz * normal[2])
     norm = np.sqrt(nx * nx + ny * ny + nz * nz)
     return (along < cos_max * norm) | (norm == 0)

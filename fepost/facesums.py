@@ -14,7 +14,8 @@ the pressure of the three corners): each of these integrals is 2A times a
 quadratic or linear form in those nine numbers, so one weighted Gram matrix
 per chunk (a matrix product) and its first sums give them all. The
 temporaries stay in cache and their memory stays bounded on million-node
-meshes. Many chunks are shared by two threads (`fepost._chunks`);
+meshes. With many chunks, a second thread gathers the corners of the next block
+of chunks while the caller's sums the last (`fepost._chunks.map_gathered`);
 every chunk's totals are kept and added in chunk order afterwards, so the
 result does not depend on the number of threads, bit for bit.
 """
@@ -28,11 +29,14 @@ from typing import NamedTuple
 import numpy as np
 
 from ._blas import one_blas_thread
-from ._chunks import map_chunks, slices
+from ._chunks import map_chunks, map_gathered, slices
 
 #: Faces per chunk: the (9, chunk) corner matrix and its weighted copy, 576 kB together,
 #: stay in a core's cache (16 384 faces, twice that, ran 2-3x slower on a 1 MB L2 cache).
 CHUNK = 1 << 13
+#: Faces per block of gathered corners (`fepost._chunks.map_gathered`): a few chunks, so that
+#: the gathering thread makes few, long numpy calls.
+BLOCK = 4 * CHUNK
 
 # 7-point degree-5 rule on the triangle (barycentric coordinates; weights sum to 1)
 _A1, _B1 = 0.059715871789770, 0.470142064105115
@@ -142,9 +146,20 @@ def face_sums(x: np.ndarray, y: np.ndarray, tri: np.ndarray, values: np.ndarray,
     Y = np.ascontiguousarray(y, dtype=float)
     V = np.ascontiguousarray(values, dtype=float)
     near = POLAR_NEAR * max(float(np.ptp(X)), float(np.ptp(Y))) if X.size else 0.0
-    # one BLAS thread for the chunks' thin matrix products (more would only spin beside map_chunks')
+
+    def work(c: np.ndarray, block: slice) -> list:
+        return [_chunk_sums(c[:, k : k + CHUNK], location, near) for k in range(0, c.shape[1], CHUNK)]
+
+    # the blocks' corners gathered on a second thread while this one sums the block before
+    # (`fepost._chunks.map_gathered`); one BLAS thread for the chunks' thin matrix products
     with one_blas_thread():
-        parts = map_chunks(lambda sl: _chunk_sums(X, Y, V, tri, sl, location, near), slices(len(tri), CHUNK))
+        blocks = map_gathered(
+            lambda sl: _corners(X, Y, V, tri, sl, location),
+            work,
+            slices(len(tri), BLOCK),
+            chunks=-(-len(tri) // CHUNK),
+        )
+    parts = [part for block in blocks for part in block]
     # the chunks' totals in their order: the same sums on one thread or two
     gram = np.zeros((_ROWS, _ROWS))
     first = np.zeros(_ROWS)
@@ -168,17 +183,8 @@ _ROWS = 9
 _X, _Y, _P = slice(0, 3), slice(3, 6), slice(6, 9)
 
 
-def _chunk_sums(
-    X, Y, V, tri: np.ndarray, sl: slice, location: str, near: float
-) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
-    """The weighted Gram matrix G = Σ 2A c cᵀ of the faces ``tri[sl]``' corner vectors c (the
-    rows of `_ROWS`), their first sums Σ 2A c, Σ 2A, their longest edge² and their terms of
-    `PolarSums` (`_polar_terms`).
-
-    Every integral of the module docstring is 2A times a quadratic or linear form in c, so
-    sums of G's entries and of the first sums give them all (`_integrals`): one matrix
-    product instead of a pass per integral.
-    """
+def _corners(X, Y, V, tri: np.ndarray, sl: slice, location: str) -> np.ndarray:
+    """The corner vectors of the faces ``tri[sl]``, as the rows of `_ROWS` (one column a face)."""
     t = np.ascontiguousarray(tri[sl].T)
     c = np.empty((_ROWS, t.shape[1]))
     # the faces' indices are in range (the reader checked them): no bounds check per gather
@@ -189,6 +195,20 @@ def _chunk_sums(
     else:
         c[6] = V[sl]
         c[7:] = 0.0
+    return c
+
+
+def _chunk_sums(
+    c: np.ndarray, location: str, near: float
+) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
+    """The weighted Gram matrix G = Σ 2A c cᵀ of a chunk's corner vectors c (the rows of
+    `_ROWS`, one column a face: `_corners`), their first sums Σ 2A c, Σ 2A, their longest
+    edge² and their terms of `PolarSums` (`_polar_terms`).
+
+    Every integral of the module docstring is 2A times a quadratic or linear form in c, so
+    sums of G's entries and of the first sums give them all (`_integrals`): one matrix
+    product instead of a pass per integral.
+    """
     x0, x1, x2 = c[_X]
     y0, y1, y2 = c[_Y]
     ax, ay = x1 - x0, y1 - y0

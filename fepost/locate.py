@@ -89,8 +89,16 @@ def _cells(v: np.ndarray, lo: float, inv_h: float, n: int) -> np.ndarray:
 def _candidates(X, Y, tri, origin, h, shape, sat) -> tuple[np.ndarray, np.ndarray]:
     """Triangles whose bounding box holds a query point, with their boxes (cells)."""
     inv_h = 1.0 / h
-    # one gather per corner: the node's cell (i, j) packed as i·2¹⁶ + j (both < 2¹⁶)
-    packed = (_cells(X, origin[0], inv_h, shape[0]) << 16) | _cells(Y, origin[1], inv_h, shape[1])
+    # one gather per corner: the node's cell (i, j) packed as i·2¹⁶ + j (both < 2¹⁶), node
+    # chunks shared by two threads
+    packed = np.empty(len(X), np.int32)
+
+    def pack(sl: slice) -> None:
+        i = _cells(X[sl], origin[0], inv_h, shape[0])
+        i <<= 16
+        np.bitwise_or(i, _cells(Y[sl], origin[1], inv_h, shape[1]), out=packed[sl])
+
+    map_chunks(pack, slices(len(X), CHUNK))
     flat = sat.ravel()
     width = sat.shape[1]
 
@@ -170,7 +178,10 @@ def locate(xy, triangles, points) -> Location:
     occupied = np.zeros(shape, np.int32)
     np.add.at(occupied, (qi, qj), 1)
     sat = np.zeros((shape[0] + 1, shape[1] + 1), np.int32)
-    sat[1:, 1:] = occupied.cumsum(0).cumsum(1)
+    inner = sat[1:, 1:]  # the summed-area table, summed in place in int32 (no int64 copies):
+    np.cumsum(occupied, axis=1, dtype=np.int32, out=inner)  # along the rows, then down them row
+    for i in range(1, len(inner)):  # by row (numpy's cumsum down the columns: 2x slower)
+        np.add(inner[i - 1], inner[i], out=inner[i])
 
     cand, boxes = _candidates(X, Y, tri, origin, h, shape, sat)
     if cand.size == 0:

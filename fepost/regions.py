@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._chunks import map_chunks, slices
 from .components import item_parts
 from .errors import PatchError
 from .facegroups import FaceGroup
@@ -20,6 +21,8 @@ from .reader.quadratic import face_surface_loads
 
 #: Regions closer than this fraction of √area belong to one patch (tread grooves).
 GAP_FRACTION = 0.05
+#: Nodes per chunk of the raster's pass over the nodes (two threads share the chunks).
+NODE_CHUNK = 1 << 16
 #: Largest raster side, cells.
 RASTER_MAX = 2048
 #: Loaded regions carrying more than this share of the load are patches (smaller ones: fragments).
@@ -118,20 +121,36 @@ def loaded_regions(x: np.ndarray, y: np.ndarray, tri: np.ndarray, sums: FaceSums
     always fall in touching cells; one dilation closes gaps narrower than ~h.
     """
     h = max(GAP_FRACTION * np.sqrt(sums.A), sums.max_edge)
-    lo = np.array([x.min(), y.min()])
-    ext = np.array([x.max(), y.max()]) - lo
+    chunks = slices(len(x), NODE_CHUNK)
+    ends = np.array(map_chunks(lambda sl: (x[sl].min(), y[sl].min(), x[sl].max(), y[sl].max()), chunks))
+    lo = ends[:, :2].min(axis=0)
+    ext = ends[:, 2:].max(axis=0) - lo
     n = np.floor(ext / h).astype(int) + 3
     if n.max() > RASTER_MAX:  # a very sparse region: coarsen the raster
         h *= n.max() / RASTER_MAX
         n = np.floor(ext / h).astype(int) + 3
-    # coordinates are >= lo, so truncation is the floor
-    i = ((x - lo[0]) * (1.0 / h)).astype(np.int32) + 1
-    j = ((y - lo[1]) * (1.0 / h)).astype(np.int32) + 1
     occupied = np.zeros(tuple(n), bool)
-    occupied.ravel()[i * int(n[1]) + j] = True  # a flat index: 2-D fancy assignment is slower
+    flat = occupied.ravel()
+
+    def cells(sl: slice) -> tuple[np.ndarray, np.ndarray]:
+        # coordinates are >= lo, so truncation is the floor
+        i = ((x[sl] - lo[0]) * (1.0 / h)).astype(np.int32)
+        i += 1
+        j = ((y[sl] - lo[1]) * (1.0 / h)).astype(np.int32)
+        j += 1
+        return i, j
+
+    def mark(sl: slice) -> None:
+        i, j = cells(sl)
+        i *= int(n[1])
+        i += j
+        flat[i] = True  # a flat index: 2-D fancy assignment is slower (the same True from either thread)
+
+    map_chunks(mark, chunks)  # the nodes' cells, in chunks shared by two threads
     labels, count = label(dilate(occupied))
     if count == 1:
         return 1, np.zeros(len(tri), np.int64)
+    i, j = cells(slice(0, len(x)))
     first = tri[:, 0]
     return int(count), labels[i[first], j[first]] - 1
 

@@ -41,6 +41,50 @@ def test_an_error_on_the_second_thread_reaches_the_caller(monkeypatch):
         _chunks.map_chunks(work, _chunks.slices(40, 1))
 
 
+# ----------------------------------------------------------------------------- map_gathered
+@pytest.mark.parametrize(("chunks", "cpus", "threads"), [(40, 2, 2), (15, 2, 1), (40, 1, 1)])
+def test_gathered_blocks_are_worked_in_order(monkeypatch, chunks, cpus, threads):
+    """The gathers on a second thread (from `SPLIT` chunks on, with more than one thread
+    allowed), the work on the caller's, the results in block order."""
+    monkeypatch.setattr(_chunks, "default_threads", lambda: cpus)
+    gathered, worked = set(), set()
+
+    def gather(sl):
+        gathered.add(threading.get_ident())
+        return sl.start * 10
+
+    def work(got, sl):
+        worked.add(threading.get_ident())
+        assert got == sl.start * 10
+        return sl.start
+
+    blocks = _chunks.slices(100, 10)
+    assert _chunks.map_gathered(gather, work, blocks, chunks=chunks) == list(range(0, 100, 10))
+    assert worked == {threading.get_ident()}
+    assert len(gathered | worked) == threads
+
+
+@pytest.mark.parametrize("where", ["gather", "work"])
+def test_an_error_while_gathering_or_working_reaches_the_caller(monkeypatch, where):
+    """Either side's error is raised in the caller, and the gathering thread has ended."""
+    monkeypatch.setattr(_chunks, "default_threads", lambda: 2)
+    started = threading.active_count()
+
+    def gather(sl):
+        if where == "gather" and sl.start == 50:
+            raise ValueError("block 50")
+        return sl.start
+
+    def work(got, sl):
+        if where == "work" and sl.start == 20:
+            raise ValueError("block 20")
+        return got
+
+    with pytest.raises(ValueError, match="^block (50|20)$"):
+        _chunks.map_gathered(gather, work, _chunks.slices(100, 10), chunks=100)
+    assert threading.active_count() == started
+
+
 # ----------------------------------------------------------------------------- FEPOST_THREADS
 def test_threads_default_to_the_cpu_count(monkeypatch):
     import os

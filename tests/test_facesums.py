@@ -77,20 +77,27 @@ def test_face_sums_equal_a_quadrature(location):
 @pytest.mark.parametrize("location", ["point", "face"])
 def test_two_threads_give_the_bits_of_one(monkeypatch, location):
     """Chunks small enough that the faces make many of them: split over two threads (the
-    default from `fepost._chunks.SPLIT` chunks on) and on one, the totals are identical."""
+    default from `fepost._chunks.SPLIT` chunks on: one gathers the corners, the caller's
+    sums them, `fepost._chunks.map_gathered`) and on one, the totals are identical."""
     x, y, tri, p = mesh()
     values = p if location == "point" else p[tri].mean(axis=1)
     monkeypatch.setattr(facesums, "CHUNK", 97)
+    monkeypatch.setattr(facesums, "BLOCK", 4 * 97)
     assert len(tri) > _chunks.SPLIT * 97
     monkeypatch.setattr(_chunks, "default_threads", lambda: 2)
     threads = set()
-    real = facesums._chunk_sums
+    real, real_sums = facesums._corners, facesums._chunk_sums
 
     def spy(*args):
         threads.add(threading.get_ident())
         return real(*args)
 
-    monkeypatch.setattr(facesums, "_chunk_sums", spy)
+    def spy_sums(*args):
+        threads.add(threading.get_ident())
+        return real_sums(*args)
+
+    monkeypatch.setattr(facesums, "_corners", spy)
+    monkeypatch.setattr(facesums, "_chunk_sums", spy_sums)
     two = facesums.face_sums(x, y, tri, values, location)
     assert len(threads) == 2
     monkeypatch.setattr(_chunks, "SPLIT", 10**9)
