@@ -124,6 +124,45 @@ def test_arrays_arrive_intact_as_views_of_one_receiving_map():
         assert got[name].ctypes.data % 64 == 0
 
 
+def _reserving_reader(reserve_bytes):
+    """A reader that reserves its answer's memory (`transfer.reserve`) before making it, and
+    says whether a memory file was there to reserve in."""
+    transfer.reserve(reserve_bytes)
+    return {**_mixed_arrays(), "reserved": "thread" in transfer._ANSWER}
+
+
+@pytest.mark.parametrize("reserve_bytes", [1 << 27, 1000])
+def test_an_answer_written_into_reserved_pages_arrives_intact(reserve_bytes):
+    """A reservation larger than the answer (128 MB for a 7 MB answer) or smaller: the arrays
+    arrive the same, and the memory file is cut to the answer's size."""
+    if transfer.shared_file() is None:
+        pytest.skip("no memory file on this platform")
+    sizes = []
+    real = transfer._mapped_file
+
+    def spy(shared, lengths, offsets):
+        sizes.append(os.fstat(shared).st_size)
+        return real(shared, lengths, offsets)
+
+    transfer._mapped_file = spy
+    try:
+        got = isolate.call(_reserving_reader, reserve_bytes, what="reserved")
+    finally:
+        transfer._mapped_file = real
+    assert got.pop("reserved") is True
+    for name, arr in _mixed_arrays().items():
+        assert got[name].dtype == arr.dtype and got[name].shape == arr.shape, name
+        np.testing.assert_array_equal(got[name], arr)
+    answer = sum(-(-a.nbytes // 64) * 64 for a in _mixed_arrays().values() if a.nbytes)
+    assert sizes and sizes[0] <= answer + 64, (sizes, answer)
+
+
+def test_a_reservation_outside_a_reading_child_does_nothing():
+    transfer.answer_file(None)
+    transfer.reserve(1 << 20)
+    assert "thread" not in transfer._ANSWER
+
+
 def _lying_send(fd, payload, ack, shared=None):
     # a header that declares far more than a reading child can hold (a compromised child)
     head = transfer.LEN.pack(10) + transfer.LEN.pack(1) + transfer.LEN.pack(transfer.IN_CHILD)

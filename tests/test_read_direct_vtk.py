@@ -304,6 +304,28 @@ def test_the_answer_arrives_whole_with_and_without_the_shared_file(monkeypatch, 
     got["a"][0, 0] = 1.0  # the caller owns its arrays
 
 
+def test_a_surface_mesh_reserves_about_its_answer_and_a_volume_mesh_nothing(grids, tmp_path, monkeypatch):
+    """The decoder asks for its answer's memory early (`fepost.reader.transfer.reserve`): for a
+    surface mesh about the bytes of the field's arrays; for a volume mesh, whose answer is its
+    boundary, nothing."""
+    asked: list[int] = []
+    monkeypatch.setattr(vtkdirect, "reserve", asked.append)
+    surface = _write(grids, tmp_path / "surface.vtu", "ug", "binary", True, "zlib")
+    fld = contact.read_here(surface)
+    held = (
+        fld.points.nbytes
+        + fld.triangles.nbytes
+        + fld.values.nbytes
+        + sum(c.nbytes for c in fld.faces.values())
+    )
+    assert len(asked) == 1 and 0.5 * held <= asked[0] <= 2.0 * held, (asked, held)
+    volume = pv.ImageData(dimensions=(6, 6, 4)).cast_to_unstructured_grid()
+    volume.point_data["CPRESS"] = np.where(volume.points[:, 2] == 0, 1e5, 0.0)
+    asked.clear()
+    contact.read_here(xml_file(volume, tmp_path / "volume.vtu", "binary", True, "zlib"))
+    assert asked == [0]
+
+
 def test_the_memory_file_is_closed_after_the_answer(monkeypatch):
     made: list[int] = []
     real = transfer.shared_file

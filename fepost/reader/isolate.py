@@ -319,6 +319,7 @@ def _child_main(wfd: int, ack: int, shared: int | None, func, args, kwargs, nbyt
     os.dup2(cap, 2)
     afterfork.fresh_streams()  # the inherited stream objects are not flushed (afterfork)
     _limit_memory(nbytes)
+    transfer.answer_file(shared)  # a reader may have its pages allocated early (`transfer.reserve`)
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
         try:

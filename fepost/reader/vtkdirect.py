@@ -60,10 +60,11 @@ import pybase64
 
 from ..errors import InputFileError
 from . import b64text
+from .cells import SPECS, VTK_TYPES
 from .checks import release
 from .names import ArrayInfo, needed_point_arrays
 from .raw import RawMesh, defer_point_arrays
-from .transfer import fresh_array
+from .transfer import fresh_array, reserve
 from .vtkassemble import POLY_SECTIONS, Part, assemble, no_cells, poly_cells
 from .xmlarrays import NUMPY_TYPES, DataArray, text_end
 from .xmlcheck import Xml
@@ -158,10 +159,22 @@ def read_direct(path: Path, *, field: str | None = None, displacement: str | Non
             _unmap(data)
     if len(part.points) == 0:
         raise InputFileError(f"{path}: the file holds no mesh (0 nodes or 0 cells)")
+    reserve(_answer_size(part))  # the answer's memory allocated while the mesh is assembled
     raw = assemble(path, [part], _FORMATS[suffix])
     if lazy:
         _add_lazy(raw, fmt, piece, lazy, stamp)
     return raw
+
+
+def _answer_size(part: Part) -> int:
+    """About the bytes a reading child answers with for ``part`` (`fepost.reader.transfer.reserve`):
+    a surface mesh's points, connectivity and decoded arrays; 0 for a mesh with cells of
+    another dimension (a volume mesh's answer is its boundary, a small part of it)."""
+    present = np.flatnonzero(np.bincount(part.types, minlength=256)).tolist() if len(part.types) else []
+    if any(t not in VTK_TYPES or SPECS[VTK_TYPES[t][0]].dim != 2 for t in present):
+        return 0
+    arrays = [*part.point_data.values(), *part.cell_data.values()]
+    return part.points.nbytes + part.conn.nbytes + sum(a.nbytes for a in arrays)
 
 
 def _mapped(fh) -> mmap.mmap:
