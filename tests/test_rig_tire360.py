@@ -658,11 +658,35 @@ def test_half_the_increment_leaves_the_other_unsteady_runs_unsteady():
     is the slide's, not the steps'."""
     from scripts.tiremodel.steadiness import run_motion
 
-    others = [p for p in sorted((WHOLE / "xfine" / "inc05").glob("d*.json")) if p.stem != "d090_a40p"]
+    others = [
+        p for p in sorted((WHOLE / "xfine" / "inc05").glob("d*.json")) if not p.stem.startswith("d090_a40")
+    ]
     assert len(others) >= 3
     for half in others:
         assert np.abs(_end(half) - _end(WHOLE / "xfine" / half.name)).max() < 0.0025, half.stem
         assert not run_motion(half).steady(), half.stem
+
+
+STEADY = WHOLE / "xfine-steady"
+
+
+def _steady_runs() -> list[Path]:
+    return sorted(STEADY.glob("path*/d*.json"))
+
+
+def test_the_runs_unsteady_at_045_m_settle_over_their_longest_paths():
+    """Each run not steady after 0.45 m on whole-xfine, solved again over the longest path that
+    keeps its patch off the road's last face (15 mm increments), is steady on Fx, Fy and N over
+    that path's last fifth, and its path is the folder's."""
+    from scripts.tiremodel.steadiness import run_motion
+
+    runs = _steady_runs()
+    assert len(runs) >= 4, "meshes/rig-tire360/xfine-steady/ (committed runs) is missing"
+    for run in runs:
+        side = json.loads(run.read_text())
+        assert side["model"]["slide_path"] == pytest.approx(int(run.parent.name[4:]) / 100), run
+        assert not run_motion(WHOLE / "xfine" / run.name).steady(), run.stem
+        assert run_motion(run).steady(), run.stem
 
 
 # -- the patch stays on the road -------------------------------------------------------------------
