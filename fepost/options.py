@@ -13,19 +13,14 @@ The friction coefficient has one default, `DEFAULT_FRICTION`, and one rule,
 
 This module is light at import (the standard library, `fepost.errors` and
 `fepost.friction_coefficient`):
-the command line's option types use it before numpy is imported. So are the
-defaults of the loaded threshold and the polar grid (`DEFAULT_THRESHOLD`,
-`DEFAULT_NR`, `DEFAULT_NPHI`, re-exported by `fepost.patch` and `fepost.polar`,
-where they act) and the rule of a grid's size (`check_grid`, which
-`fepost.polar.PolarGrid.make` applies too): making an `AnalysisOptions` imports
-neither numpy nor the pipeline, so a command starts reading its files (in a
-forked child, `fepost.reader.isolate`) before it imports them.
+the command line's option types use it before numpy is imported. The library
+defaults that live in heavy modules (grid size, threshold) are read when an
+`AnalysisOptions` is made.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
@@ -37,55 +32,6 @@ from .friction_coefficient import is_real as _real
 
 #: Largest accepted inflation pressure, Pa (1 GPa: no tire; a unit slip above it).
 PRESSURE_MAX = 1e9
-#: A face is loaded where its pressure exceeds this fraction of the peak (`fepost.patch`).
-DEFAULT_THRESHOLD = 1e-6
-#: Default polar grid, chosen from the convergence study (see README, "Accuracy"; `fepost.polar`).
-DEFAULT_NR = 64
-DEFAULT_NPHI = 128
-#: Memory a grid node costs in one run, bytes: measured (peak of ``analyse`` and of the Table 1
-#: exact-data fit at 2-8 million nodes: 140-220 bytes per node), doubled for the report's extra
-#: maps (the command line's check, `fepost.cli._validate.check_grid`, uses the same figure).
-BYTES_PER_NODE = 400
-#: The radial rules of a polar grid (`fepost.polar`).
-GRID_RULES = ("gauss", "trapezoid")
-
-
-def _memory_limit() -> int:
-    """Half the machine's physical memory (4 GB where it cannot be read), bytes."""
-    try:
-        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES")) // 2
-    except (AttributeError, OSError, ValueError):
-        return 4 << 30
-
-
-def _size(n: float) -> str:
-    for unit, f in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
-        if n >= f:
-            return f"{n / f:.3g} {unit}"
-    return f"{n / 1e3:.3g} kB"
-
-
-def check_grid(nr: Any, nphi: Any, rule: Any = "gauss") -> tuple[int, int]:
-    """``nr``, ``nphi`` as ints when they make a polar grid that fits in half this machine's
-    memory (`BYTES_PER_NODE` a node) and ``rule`` is one of `GRID_RULES`; else
-    `ArgumentError` naming the value."""
-    if int(nr) != nr or nr < 2:
-        raise ArgumentError(f"nr must be an integer >= 2, got {nr!r}")
-    if int(nphi) != nphi or nphi < 4:
-        raise ArgumentError(f"nphi must be an integer >= 4, got {nphi!r}")
-    n_r, n_phi = int(nr), int(nphi)
-    need = float(n_r) * float(n_phi) * BYTES_PER_NODE
-    limit = _memory_limit()
-    if need > limit:
-        raise ArgumentError(
-            f"polar grid nr x nphi = {n_r} x {n_phi} = {float(n_r) * n_phi:.3g} nodes would need about "
-            f"{_size(need)} of memory (limit {_size(limit)}, half this machine's, about "
-            f"{limit // BYTES_PER_NODE:,} nodes); the default {DEFAULT_NR} x {DEFAULT_NPHI} "
-            "is accurate to ~1e-5 on smooth maps"
-        )
-    if rule not in GRID_RULES:
-        raise ArgumentError(f"rule must be 'gauss' or 'trapezoid', got {rule!r}")
-    return n_r, n_phi
 
 
 def check_pressure(p: object, *, name: str = "inflation_pressure") -> float:
@@ -140,7 +86,9 @@ class AnalysisOptions:
     inflation_pressure: float | None = None
 
     def __post_init__(self) -> None:
-        from .reader.units import unit_system  # a light module: no numpy
+        from .patch import DEFAULT_THRESHOLD
+        from .polar import DEFAULT_NPHI, DEFAULT_NR, PolarGrid
+        from .reader.units import unit_system
 
         for name in ("field", "displacement", "surface"):
             value = getattr(self, name)
@@ -155,7 +103,7 @@ class AnalysisOptions:
             object.__setattr__(self, "units", None if system is None else system.name)
         object.__setattr__(self, "nr", self.nr or DEFAULT_NR)
         object.__setattr__(self, "nphi", self.nphi or DEFAULT_NPHI)
-        check_grid(self.nr, self.nphi, self.rule)  # the rule of `fepost.polar.PolarGrid.make`
+        PolarGrid.make(self.nr, self.nphi, self.rule)  # type: ignore[arg-type]  # raises on a bad grid
         t = self.threshold or DEFAULT_THRESHOLD
         if not (_real(t) and 0.0 < t < 1.0):
             raise ArgumentError(f"threshold must be a number between 0 and 1 (exclusive), got {t!r}")

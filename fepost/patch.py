@@ -55,7 +55,6 @@ from .facegroups import STEEP_DEG, drop_edge_faces, loaded_groups
 from .facesums import FaceSums, PolarSums, load_outside, triangle_areas
 from .field import ContactField
 from .frame import NODE_CHUNK, Frame, fit_plane, patch_axes
-from .options import DEFAULT_THRESHOLD as DEFAULT_THRESHOLD
 
 # the patch rules' tolerances, documented here
 from .patchfaces import REFINE_MAX_TRIANGLES as REFINE_MAX_TRIANGLES
@@ -66,6 +65,7 @@ from .reader.units import check_scale
 from .regions import GAP_FRACTION as GAP_FRACTION
 from .regions import check_single_surface
 
+DEFAULT_THRESHOLD = 1e-6
 ASPECT_TOL = 0.10
 RMAX_TOL = 1.15
 PLANARITY_TOL = 0.02

@@ -21,6 +21,7 @@ radius R (m). Its integrals are in `fepost.moments`.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -28,15 +29,31 @@ import numpy as np
 
 from ._arrays import frozen
 from .errors import ArgumentError
-from .options import BYTES_PER_NODE as BYTES_PER_NODE
-from .options import DEFAULT_NPHI as DEFAULT_NPHI
-from .options import DEFAULT_NR as DEFAULT_NR
-from .options import check_grid
 
 Rule = Literal["gauss", "trapezoid"]
 
-# The default grid and the rule of its size live in the light `fepost.options` (the command line
-# reads them before numpy is imported); here they are re-exported.
+#: Default grid, chosen from the convergence study (see README, "Accuracy").
+DEFAULT_NR = 64
+DEFAULT_NPHI = 128
+#: Memory a grid node costs in one run, bytes: measured (peak of ``analyse`` and of the Table 1
+#: exact-data fit at 2-8 million nodes: 140-220 bytes per node), doubled for the report's extra
+#: maps (the command line's check, `fepost.cli._validate.check_grid`, uses the same figure).
+BYTES_PER_NODE = 400
+
+
+def _memory_limit() -> int:
+    """Half the machine's physical memory (4 GB where it cannot be read), bytes."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES")) // 2
+    except (AttributeError, OSError, ValueError):
+        return 4 << 30
+
+
+def _size(n: float) -> str:
+    for unit, f in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
+        if n >= f:
+            return f"{n / f:.3g} {unit}"
+    return f"{n / 1e3:.3g} kB"
 
 
 @dataclass(frozen=True)
@@ -52,14 +69,29 @@ class PolarGrid:
     @classmethod
     def make(cls, nr: int = DEFAULT_NR, nphi: int = DEFAULT_NPHI, rule: Rule = "gauss") -> PolarGrid:
         """Build a grid with ``nr`` radial and ``nphi`` angular nodes."""
-        nr, nphi = check_grid(nr, nphi, rule)
+        if int(nr) != nr or nr < 2:
+            raise ArgumentError(f"nr must be an integer >= 2, got {nr!r}")
+        if int(nphi) != nphi or nphi < 4:
+            raise ArgumentError(f"nphi must be an integer >= 4, got {nphi!r}")
+        nr, nphi = int(nr), int(nphi)
+        need = float(nr) * float(nphi) * BYTES_PER_NODE
+        limit = _memory_limit()
+        if need > limit:
+            raise ArgumentError(
+                f"polar grid nr x nphi = {nr} x {nphi} = {float(nr) * nphi:.3g} nodes would need about "
+                f"{_size(need)} of memory (limit {_size(limit)}, half this machine's, about "
+                f"{limit // BYTES_PER_NODE:,} nodes); the default {DEFAULT_NR} x {DEFAULT_NPHI} "
+                "is accurate to ~1e-5 on smooth maps"
+            )
         if rule == "gauss":
             x, w = np.polynomial.legendre.leggauss(nr)
             rho, w_rho = 0.5 * (x + 1.0), 0.5 * w
-        else:  # "trapezoid" (check_grid refused any other)
+        elif rule == "trapezoid":
             rho = np.linspace(0.0, 1.0, nr)
             w_rho = np.full(nr, 1.0 / (nr - 1))
             w_rho[[0, -1]] *= 0.5
+        else:
+            raise ArgumentError(f"rule must be 'gauss' or 'trapezoid', got {rule!r}")
         phi = np.arange(nphi) * (2.0 * np.pi / nphi)
         w_phi = np.full(nphi, 2.0 * np.pi / nphi)
         return cls(frozen(rho), frozen(w_rho), frozen(phi), frozen(w_phi), rule)

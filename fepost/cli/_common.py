@@ -90,19 +90,19 @@ def add_input_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--threshold",
         type=v.fraction,
-        default=v.LibraryDefault("fepost.options", "DEFAULT_THRESHOLD"),
+        default=v.LibraryDefault("fepost.patch", "DEFAULT_THRESHOLD"),
         help="loaded if pressure > THRESHOLD x peak (default %(default)s)",
     )
     g.add_argument(
         "--nr",
         type=v.radial_nodes,
-        default=v.LibraryDefault("fepost.options", "DEFAULT_NR"),
+        default=v.LibraryDefault("fepost.polar", "DEFAULT_NR"),
         help="radial grid nodes (default %(default)s)",
     )
     g.add_argument(
         "--nphi",
         type=v.angular_nodes,
-        default=v.LibraryDefault("fepost.options", "DEFAULT_NPHI"),
+        default=v.LibraryDefault("fepost.polar", "DEFAULT_NPHI"),
         help="angular grid nodes (default %(default)s)",
     )
     g.add_argument("--rule", choices=("gauss", "trapezoid"), default="gauss", help="radial quadrature rule")
