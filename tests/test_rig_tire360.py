@@ -527,8 +527,9 @@ def test_only_runs_are_solved_in_the_order_given():
 MIRRORS = [("spin_p", "spin_n", (-1, -1, -1))]
 MIRRORS += [(f"d090_a{a}p", f"d090_a{a}n", (-1, 1, -1)) for a in ("20", "40", "60", "75")]
 MIRRORS += [(f"d000_a{a}p", f"d000_a{a}n", (1, -1, -1)) for a in ("20", "40", "60", "75")]
-#: the folders holding a programme: the programme's mesh and the finest (``xfine/``)
-PROGRAMMES = (".", "xfine")
+#: the folders holding a programme (the programme's mesh and the finest, ``xfine/``) and runs
+#: solved again on the finest (half the increment; a longer path)
+PROGRAMMES = (".", "xfine", "xfine/inc05", "xfine-steady/path090")
 #: the pairs whose both runs are committed, with their folder (the pure spins always are, in ./)
 MIRRORED = [
     (*pair, sub)
