@@ -102,8 +102,9 @@ def _runs(rig: Path) -> list[Path]:
 def replace_runs(rig: Path, runs: list[Path], longer: list[Path]) -> tuple[list[Path], list[str]]:
     """``runs`` with each run found in a ``longer`` folder in place of the rig's of the same name,
     and a line per replaced run (name, folder, path). Every folder's ``static.json`` must name the
-    rig's base deck (the runs restart from the same static solution); a run found in several
-    folders is taken from the last of them, and only in place of one of ``runs``."""
+    rig's base deck (the runs restart from the same static solution) and hold only runs of the
+    rig; a run found in several folders is taken from the last of them, one left out of ``runs``
+    stays out."""
     from fepost.errors import ArgumentError
 
     def base_of(folder: Path) -> str | None:
@@ -114,14 +115,16 @@ def replace_runs(rig: Path, runs: list[Path], longer: list[Path]) -> tuple[list[
 
     own = base_of(rig)
     names = {p.stem: i for i, p in enumerate(runs)}
+    known = {p.stem for p in _runs(rig)}
     out, taken = list(runs), {}
     for folder in longer:
         if own is None or base_of(folder) != own:
             raise ArgumentError(f"--longer: {folder}: its static.json names another base than {rig}'s")
         for run in _runs(folder):
-            if run.stem not in names:
+            if run.stem not in known:
                 raise ArgumentError(f"--longer: {folder}: run {run.stem} is not one of the runs of {rig}")
-            out[names[run.stem]] = taken[run.stem] = run
+            if run.stem in names:  # a run of the rig left out of ``runs`` stays out
+                out[names[run.stem]] = taken[run.stem] = run
     lines = []
     for name, run in sorted(taken.items(), key=lambda item: names[item[0]]):
         model = json.loads(run.with_suffix(".json").read_text())["model"]

@@ -362,7 +362,15 @@ def test_longer_folders_must_share_the_base_and_the_run_names(tmp_path):
     assert same / "d090_a40p.vtu" in out and XFINE / "inc05" / "d090_a40p.vtu" not in out
     assert XFINE / "inc05" / "d090_a60p.vtu" in out
     assert sum("d090_a40p" in line for line in lines) == 1 and f"d090_a40p: {same} " in "".join(lines)
-    with pytest.raises(ArgumentError, match=r"same: run d090_a40p is not one of the runs"):
-        study.replace_runs(XFINE, [r for r in runs if r.stem != "d090_a40p"], [same])
+    # a run of the rig left out of the selection stays out
+    fewer = [r for r in runs if r.stem != "d090_a40p"]
+    assert study.replace_runs(XFINE, fewer, [same]) == (fewer, [])
+    stranger = tmp_path / "stranger"
+    _copy_run(XFINE / "inc05", stranger, "d090_a40p")
+    shutil.copyfile(XFINE / "static.json", stranger / "static.json")
+    for suffix in (".json", ".vtu"):
+        (stranger / f"d090_a40p{suffix}").rename(stranger / f"d090_a99p{suffix}")
+    with pytest.raises(ArgumentError, match=r"stranger: run d090_a99p is not one of the runs"):
+        study.replace_runs(XFINE, runs, [stranger])
     with pytest.raises(ArgumentError, match=r"nowhere: no readable static.json"):
         study.replace_runs(XFINE, runs, [tmp_path / "nowhere"])
