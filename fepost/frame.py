@@ -79,10 +79,7 @@ def fit_plane(points: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.n
     ref = points[int(np.argmax(weights))]
 
     def chunk(sl: slice) -> tuple[np.ndarray, np.ndarray]:
-        # coordinates about a node of the patch (large global offsets cost no precision), as
-        # three rows: numpy's loops then run along the chunk, not along each node's 3 values
-        d = np.empty((3, sl.stop - sl.start))
-        np.subtract(points[sl].T, ref[:, None], out=d)
+        d = _rows_about(points, sl, ref)  # about a node of the patch: no precision lost to offsets
         wd = d * w[sl]
         return wd.sum(axis=1), wd @ d.T
 
@@ -110,12 +107,30 @@ def frame_rows(points: np.ndarray, frame: Frame) -> np.ndarray:
     rows = np.empty((3, len(points)))
 
     def chunk(sl: slice) -> None:
-        d = np.empty((3, sl.stop - sl.start))
-        np.subtract(points[sl].T, frame.origin[:, None], out=d)
-        rows[:, sl] = frame.axes @ d
+        rows[:, sl] = frame.axes @ _rows_about(points, sl, frame.origin)
 
     map_chunks(chunk, slices(len(points), NODE_CHUNK))
     return rows
+
+
+def farthest_from_plane(points: np.ndarray, weights: np.ndarray, c: np.ndarray, normal: np.ndarray) -> float:
+    """The largest distance from the plane through ``c`` of unit ``normal`` of the ``points`` of
+    positive weight (0 without any), in chunks of `NODE_CHUNK` nodes shared by two threads."""
+
+    def chunk(sl: slice) -> float:
+        h = normal @ _rows_about(points, sl, c)
+        np.abs(h, out=h)
+        return float(h.max(where=weights[sl] > 0, initial=0.0))
+
+    return max(map_chunks(chunk, slices(len(points), NODE_CHUNK)), default=0.0)
+
+
+def _rows_about(points: np.ndarray, sl: slice, ref: np.ndarray) -> np.ndarray:
+    """``points[sl] - ref`` as three rows (3, chunk): numpy's loops then run along the chunk,
+    not along each node's three values."""
+    d = np.empty((3, sl.stop - sl.start))
+    np.subtract(points[sl].T, ref[:, None], out=d)
+    return d
 
 
 _AXIS_NAMES = ("x", "y", "z")

@@ -49,12 +49,11 @@ from typing import NamedTuple
 import numpy as np
 
 from ._arrays import frozen, sealed
-from ._chunks import map_chunks, slices
 from .errors import ArgumentError, DimensionError, PatchError, PressureError, PressureWarning
 from .facegroups import STEEP_DEG, drop_edge_faces, loaded_groups
 from .facesums import FaceSums, PolarSums, load_outside, triangle_areas
 from .field import ContactField
-from .frame import NODE_CHUNK, Frame, fit_plane, patch_axes
+from .frame import Frame, farthest_from_plane, fit_plane, patch_axes
 
 # the patch rules' tolerances, documented here
 from .patchfaces import REFINE_MAX_TRIANGLES as REFINE_MAX_TRIANGLES
@@ -269,7 +268,7 @@ def _fit_frame(fld: ContactField, *, values: np.ndarray, thr: float, groups, rol
     if np.count_nonzero(w) < 3:
         raise PatchError(f"{src}: the contact patch has fewer than 3 loaded nodes")
     c, normal, var = fit_plane(pts_sel, w)
-    flat = bool(_farthest(pts_sel, w, c, normal) <= 1e-9 * np.sqrt(var[2]))
+    flat = bool(farthest_from_plane(pts_sel, w, c, normal) <= 1e-9 * np.sqrt(var[2]))
     if var[1] <= LINE_TOL**2 * var[2]:
         raise DimensionError(
             f"{src}: the loaded nodes lie on one line: the contact is a line, not a patch "
@@ -277,20 +276,6 @@ def _fit_frame(fld: ContactField, *, values: np.ndarray, thr: float, groups, rol
         )
     axes, axis_note = patch_axes(normal, rolling_axis, src)
     return _Plane(Frame(origin=c, axes=axes), flat, axis_note)
-
-
-def _farthest(points: np.ndarray, weights: np.ndarray, c: np.ndarray, normal: np.ndarray) -> float:
-    """The largest distance from the plane through ``c`` of ``normal`` of the points of positive
-    weight (0 without any), in chunks shared by two threads (`fepost.frame.NODE_CHUNK`)."""
-
-    def chunk(sl: slice) -> float:
-        d = np.empty((3, sl.stop - sl.start))  # as rows, as in `fepost.frame.fit_plane`
-        np.subtract(points[sl].T, c[:, None], out=d)
-        h = normal @ d
-        np.abs(h, out=h)
-        return float(h.max(where=weights[sl] > 0, initial=0.0))
-
-    return max(map_chunks(chunk, slices(len(points), NODE_CHUNK)), default=0.0)
 
 
 class _Ellipse(NamedTuple):

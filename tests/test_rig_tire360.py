@@ -725,10 +725,11 @@ def test_road_exit_of_a_pure_spin_is_where_the_turning_corner_meets_the_limit():
     assert ex.reach == pytest.approx(0.2 * np.sqrt(2.0) / 0.235, rel=1e-6)
 
 
-def _whole_xfine_patch() -> np.ndarray:
+def _loaded_xy(static: Path) -> np.ndarray:
+    """The (x, y) of a committed static map's loaded nodes, deformed (m), read with meshio."""
     import meshio
 
-    m = meshio.read(WHOLE / "xfine" / "static.vtu")
+    m = meshio.read(static)
     loaded = m.point_data["CPRESS"] > 0.0
     return (m.points + m.point_data["displacement"])[loaded, :2]
 
@@ -736,7 +737,7 @@ def _whole_xfine_patch() -> np.ndarray:
 def test_the_programme_stays_on_the_road_and_the_stalled_path_does_not():
     from scripts.tiremodel.aircraft_rig_programme import programme
 
-    xy, road = _whole_xfine_patch(), ard.whole_road()
+    xy, road = _loaded_xy(WHOLE / "xfine" / "static.vtu"), ard.whole_road()
 
     def kin(spec, path):
         return rd.kinematics(
@@ -787,32 +788,23 @@ def test_check_on_road_refuses_the_runs_that_leave_it_and_reports_those_near_its
         check_on_road(mesh, base, road, runs, 0.30)
 
 
-def _committed_slides() -> list[Path]:
+def _slides(folder: Path) -> list[Path]:
+    """A folder's slide/spin sidecars (``d<direction>_*``, ``spin_*``), as the rig study reads them."""
+    return sorted([*folder.glob("d[0-9][0-9][0-9]_*.json"), *folder.glob("spin_*.json")])
+
+
+def _slide_folders() -> list[Path]:
+    """The committed folders of slides beside their static map (whole tire and sector)."""
     folders = [WHOLE, REPO / "meshes" / "rig-aircraft"]
-    return sorted(
-        p
-        for f in folders
-        for p in f.glob("**/*.json")
-        if (p.parent / "static.vtu").is_file()
-        and p.name != "static.json"
-        and "direction_deg" in p.read_text()
-    )
+    return sorted({p.parent for f in folders for p in f.glob("**/static.vtu") if _slides(p.parent)})
 
 
-@pytest.mark.parametrize(
-    "folder", sorted({p.parent for p in _committed_slides()}), ids=lambda p: str(p.relative_to(REPO))
-)
+@pytest.mark.parametrize("folder", _slide_folders(), ids=lambda p: str(p.relative_to(REPO)))
 def test_every_committed_slide_kept_its_patch_on_the_road(folder):
-    import meshio
-
-    m = meshio.read(folder / "static.vtu")
-    loaded = m.point_data["CPRESS"] > 0.0
-    xy = (m.points + m.point_data["displacement"])[loaded, :2]
-    runs = [p for p in _committed_slides() if p.parent == folder]
-    assert runs
-    for p in runs:
-        side = json.loads(p.read_text())
+    xy = _loaded_xy(folder / "static.vtu")
+    for run in _slides(folder):
+        side = json.loads(run.read_text())
         base = ard.WHOLE if "whole" in side["mesh"]["name"] else ard.AIRCRAFT
         tire = dataclasses.replace(base, slide_path=side["model"]["slide_path"])
         kin = rd.kinematics(side["direction_deg"], side["spin_angle_deg"], side["spin_sign"], tire)
-        assert rd.road_exit(kin, (0.0, 0.0), xy, tire.road(), samples=201) is None, p.name
+        assert rd.road_exit(kin, (0.0, 0.0), xy, tire.road(), samples=201) is None, run.name

@@ -180,12 +180,15 @@ def check_on_road(
     xy = mesh.nodes[loaded, :2] + base.static_u[loaded, :2]
     bad = []
     for name, kin in runs.items():
+        last = rd.road_exit(kin, base.nodes.ref_xy, xy, road, faces=1)
+        if last is None:  # clear of the last face, so on the road (the usual case: one pass)
+            continue
         off = rd.road_exit(kin, base.nodes.ref_xy, xy, road)
         if off is not None:
             bad.append(
                 f"{name} from {off.t * path:.3f} m of its {path:.2f} m path ({off.reach:.2f} x as far out)"
             )
-        elif log is not None and (last := rd.road_exit(kin, base.nodes.ref_xy, xy, road, faces=1)):
+        elif log is not None:
             log(
                 f"{name}: the patch enters the road's last face from {last.t * path:.3f} m "
                 f"of its {path:.2f} m path"
